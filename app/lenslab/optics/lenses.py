@@ -1,0 +1,220 @@
+"""Lens presets: primes and zooms with their aperture range and iris, one JSON file each.
+
+A lens preset limits what the camera panel offers (focal length, f-number)
+and tells the renderer the shape of the aperture: ``aperture_blades`` straight
+(or rounded) blades make polygonal bokeh, 0 means a circular stop.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import KW_ONLY, dataclass, field
+from typing import Iterable, Sequence
+
+from .presetfiles import FieldError, PresetError, build_preset, merge_by_name, preset_dirs, read_json
+from .stops import EXTENDED_THIRD_STOPS, MAX_F_NUMBER, MIN_F_NUMBER, is_valid_f_number
+
+__all__ = ["LensPreset", "LENSES_DIR", "MAX_APERTURE_BLADES", "load_lens_presets"]
+
+#: Folder of lens files inside a presets folder.
+LENSES_DIR = "lenses"
+
+#: More blades than this is indistinguishable from a circle; use 0 instead.
+MAX_APERTURE_BLADES = 32
+
+# Longest focal length we accept (mm); beyond is a typo rather than a lens.
+_MAX_FOCAL_LENGTH_MM = 5000.0
+
+
+@dataclass(frozen=True)
+class LensPreset:
+    """A lens: a prime (``focal_length_mm``) or a zoom (``focal_range_mm``), never both.
+
+    Fields after ``name`` are keyword-only, since exactly one of the two focal
+    fields is given.
+    """
+
+    name: str
+    _: KW_ONLY
+    #: Focal length of a prime, mm.
+    focal_length_mm: float | None = None
+    #: (shortest, longest) focal length of a zoom, mm.
+    focal_range_mm: tuple[float, float] | None = None
+    #: Largest aperture, e.g. 1.4 (constant over the zoom range).
+    widest_f_number: float
+    #: Smallest aperture, e.g. 22.
+    narrowest_f_number: float = 22.0
+    #: Number of iris blades; 0 = circular aperture, else 3..32.
+    aperture_blades: int = 0
+    #: Rotation of the blade polygon about the optical axis, degrees,
+    #: counter-clockwise seen from behind the camera; 0 puts a vertex on +x.
+    blade_rotation_deg: float = 0.0
+    #: 0 = straight blades (sharp polygon) .. 1 = fully rounded (a circle).
+    #: Modern lenses with "rounded blades" sit around 0.5 to 0.8.
+    blade_roundness: float = 0.0
+    #: Minimum focus distance as marked on the lens (from the sensor plane), m.
+    min_focus_distance_m: float | None = None
+    #: Free text shown as a tooltip.
+    description: str = field(default="", compare=False)
+
+    def __post_init__(self):
+        if not isinstance(self.name, str) or not self.name.strip():
+            raise FieldError("name", "must be a non-empty string")
+        self._check_focal()
+        for key in ("widest_f_number", "narrowest_f_number"):
+            value = getattr(self, key)
+            if not is_valid_f_number(value):
+                raise FieldError(
+                    key, f"f-number must lie in ({MIN_F_NUMBER:g}, {MAX_F_NUMBER:g}], got {value!r}"
+                )
+            object.__setattr__(self, key, float(value))
+        if self.narrowest_f_number < self.widest_f_number:
+            raise FieldError(
+                "narrowest_f_number",
+                f"f/{self.narrowest_f_number:g} is wider than widest_f_number f/{self.widest_f_number:g}",
+            )
+        blades = self.aperture_blades
+        if isinstance(blades, bool) or not isinstance(blades, int) or not (
+            blades == 0 or 3 <= blades <= MAX_APERTURE_BLADES
+        ):
+            raise FieldError(
+                "aperture_blades", f"must be 0 (circular) or 3..{MAX_APERTURE_BLADES}, got {blades!r}"
+            )
+        if not math.isfinite(self.blade_rotation_deg):
+            raise FieldError("blade_rotation_deg", "must be finite")
+        object.__setattr__(self, "blade_rotation_deg", float(self.blade_rotation_deg))
+        if not 0.0 <= self.blade_roundness <= 1.0:
+            raise FieldError("blade_roundness", f"must lie in [0, 1], got {self.blade_roundness!r}")
+        object.__setattr__(self, "blade_roundness", float(self.blade_roundness))
+        mfd = self.min_focus_distance_m
+        if mfd is not None:
+            if not (0.0 < mfd < math.inf):
+                raise FieldError("min_focus_distance_m", f"must be positive, got {mfd!r}")
+            object.__setattr__(self, "min_focus_distance_m", float(mfd))
+
+    def _check_focal(self):
+        def check_mm(key, value):
+            if not (0.0 < value <= _MAX_FOCAL_LENGTH_MM):
+                raise FieldError(key, f"must lie in (0, {_MAX_FOCAL_LENGTH_MM:g}] mm, got {value!r}")
+            return float(value)
+
+        prime, zoom = self.focal_length_mm, self.focal_range_mm
+        if (prime is None) == (zoom is None):
+            raise FieldError(
+                "focal_length_mm", "give exactly one of focal_length_mm (prime) and focal_range_mm (zoom)"
+            )
+        if prime is not None:
+            object.__setattr__(self, "focal_length_mm", check_mm("focal_length_mm", prime))
+            return
+        zoom = tuple(zoom)
+        if len(zoom) != 2:
+            raise FieldError("focal_range_mm", "must be [shortest, longest]")
+        short, long_ = (check_mm("focal_range_mm", v) for v in zoom)
+        if not short < long_:
+            raise FieldError(
+                "focal_range_mm",
+                f"shortest {short:g} mm must be below longest {long_:g} mm (a prime uses focal_length_mm)",
+            )
+        object.__setattr__(self, "focal_range_mm", (short, long_))
+
+    @property
+    def is_zoom(self) -> bool:
+        return self.focal_range_mm is not None
+
+    @property
+    def min_focal_length_mm(self) -> float:
+        return self.focal_range_mm[0] if self.is_zoom else self.focal_length_mm
+
+    @property
+    def max_focal_length_mm(self) -> float:
+        return self.focal_range_mm[1] if self.is_zoom else self.focal_length_mm
+
+    def clamp_focal_length(self, mm: float) -> float:
+        """``mm`` limited to what the lens covers (a prime always returns its focal length)."""
+        mm = float(mm)
+        if math.isnan(mm):
+            raise ValueError("focal length is NaN")
+        return min(max(mm, self.min_focal_length_mm), self.max_focal_length_mm)
+
+    def clamp_f_number(self, n: float) -> float:
+        """``n`` limited to [widest_f_number, narrowest_f_number]."""
+        n = float(n)
+        if math.isnan(n):
+            raise ValueError("f-number is NaN")
+        return min(max(n, self.widest_f_number), self.narrowest_f_number)
+
+    def available_stops(self, scale: Sequence[float] = EXTENDED_THIRD_STOPS) -> tuple[float, ...]:
+        """The marks of ``scale`` this lens can set, plus its own end stops.
+
+        f/1.2 .. f/16 gives (1.2, 1.4, 1.6, ..., 16).  The lens's own widest
+        and narrowest f-numbers are always included, even when they are not
+        marks (an f/1.8 lens on a full-stop scale starts at 1.8).  Pass the result as ``scale`` to
+        ``stops.step_stop`` to step within the lens.
+        """
+        rel = 1e-3  # same tolerance as stops.py: 5.6 and 5.600001 are one mark
+        inside = [
+            float(s) for s in scale
+            if self.widest_f_number * (1 - rel) <= s <= self.narrowest_f_number * (1 + rel)
+        ]
+        if not inside or not math.isclose(inside[0], self.widest_f_number, rel_tol=rel):
+            inside.insert(0, self.widest_f_number)
+        if not math.isclose(inside[-1], self.narrowest_f_number, rel_tol=rel):
+            inside.append(self.narrowest_f_number)
+        return tuple(inside)
+
+
+_KINDS = {
+    "name": "string",
+    "focal_length_mm": "number or null",
+    "focal_range_mm": "number pair or null",
+    "widest_f_number": "number",
+    "narrowest_f_number": "number",
+    "aperture_blades": "integer",
+    "blade_rotation_deg": "number",
+    "blade_roundness": "number",
+    "min_focus_distance_m": "number or null",
+    "description": "string",
+}
+
+
+def read_lens_file(path) -> LensPreset:
+    """One lens from one JSON file (PresetError naming file and key on any problem)."""
+    return build_preset(LensPreset, read_json(path), _KINDS, path)
+
+
+def _read_lens_dir(folder) -> list[LensPreset]:
+    lenses: list[LensPreset] = []
+    seen: dict[str, object] = {}
+    # Sorted so that the result does not depend on the file system; dot files
+    # are editor backups and lock files, not presets.
+    for path in sorted(folder.glob("*.json")):
+        if path.name.startswith("."):
+            continue
+        lens = read_lens_file(path)
+        if lens.name in seen:
+            raise PresetError(path, "name", f"{lens.name!r} is also the name in {seen[lens.name]}")
+        seen[lens.name] = path.name
+        lenses.append(lens)
+    return lenses
+
+
+def load_lens_presets(
+    extra_dirs: Iterable[os.PathLike | str] = (),
+    *,
+    include_shipped: bool = True,
+    include_user: bool = True,
+) -> list[LensPreset]:
+    """All lens presets from ``<folder>/lenses/*.json``: shipped, user's, then ``extra_dirs``.
+
+    A lens whose name was already defined in an earlier folder replaces it.
+    Sorted by focal length (shortest end first), primes before zooms that
+    start at the same length.  Raises PresetError on any broken file.
+    """
+    groups = []
+    for folder in preset_dirs(extra_dirs, include_shipped=include_shipped, include_user=include_user):
+        lens_dir = folder / LENSES_DIR
+        if lens_dir.is_dir():
+            groups.append(_read_lens_dir(lens_dir))
+    lenses = merge_by_name(groups)
+    return sorted(lenses, key=lambda l: (l.min_focal_length_mm, l.max_focal_length_mm, l.name))

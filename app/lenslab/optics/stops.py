@@ -1,0 +1,160 @@
+"""Aperture stops: the marked f-number scale, snapping and stepping along it, text in and out.
+
+An f-number ``N`` is focal length over entrance-pupil diameter; each *stop*
+halves the light, i.e. multiplies ``N`` by ``sqrt(2)``, and a third stop by
+``2 ** (1/6)``.  Lenses and cameras mark the rounded values in
+:data:`THIRD_STOPS` (5.6 rather than 5.657, 11 rather than 11.31); distances
+along the scale are therefore measured in stops (``log2 N^2``), not in N.
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+import re
+from typing import Sequence
+
+__all__ = [
+    "THIRD_STOPS",
+    "EXTENDED_THIRD_STOPS",
+    "MIN_F_NUMBER",
+    "MAX_F_NUMBER",
+    "is_valid_f_number",
+    "stops_between",
+    "nearest_stop",
+    "step_stop",
+    "format_f_number",
+    "parse_f_number",
+]
+
+#: The third-stop scale as marked on lenses and camera displays, f/1.4 to f/22.
+THIRD_STOPS: tuple[float, ...] = (
+    1.4, 1.6, 1.8, 2, 2.2, 2.5, 2.8, 3.2, 3.5, 4, 4.5, 5, 5.6,
+    6.3, 7.1, 8, 9, 10, 11, 13, 14, 16, 18, 20, 22,
+)
+
+#: The same scale continued both ways over the whole valid range, f/0.7 to
+#: f/128 (marked values: 1.1 and 1.2 for 1.12 and 1.26, 25 and 29 for 25.4
+#: and 28.5, ...).  Lens presets use it for apertures outside f/1.4..f/22,
+#: such as f/1.2 primes and f/32 macros.
+EXTENDED_THIRD_STOPS: tuple[float, ...] = (
+    (0.7, 0.8, 0.9, 1, 1.1, 1.2)
+    + THIRD_STOPS
+    + (25, 29, 32, 36, 40, 45, 51, 57, 64, 72, 81, 90, 102, 114, 128)
+)
+
+#: Valid f-numbers lie in the half-open interval (MIN_F_NUMBER, MAX_F_NUMBER].
+#: 0.5 is the theoretical limit of an aplanatic lens in air (N = 1 / (2 NA),
+#: NA < 1); f/128 is about the smallest aperture ever marked on a lens.
+MIN_F_NUMBER = 0.5
+MAX_F_NUMBER = 128.0
+
+# Two values closer than this (relative) are the same marked stop.  Adjacent
+# third stops differ by about 12 %, so this only absorbs float noise and
+# rounding such as 5.6 vs 5.60001.
+_SAME_STOP_REL_TOL = 1e-3
+
+
+def is_valid_f_number(n: float) -> bool:
+    """True when ``n`` is a finite number in (0.5, 128]."""
+    try:
+        n = float(n)
+    except (TypeError, ValueError):
+        return False
+    return MIN_F_NUMBER < n <= MAX_F_NUMBER
+
+
+def _checked(n: float) -> float:
+    if not is_valid_f_number(n):
+        raise ValueError(f"f-number must lie in ({MIN_F_NUMBER:g}, {MAX_F_NUMBER:g}], got {n!r}")
+    return float(n)
+
+
+def stops_between(n1: float, n2: float) -> float:
+    """Exposure difference in stops going from f/n1 to f/n2: ``2 log2(n2 / n1)``.
+
+    Positive when n2 lets in less light.  f/2.8 -> f/5.6 is 2.0 stops.
+    """
+    return 2.0 * math.log2(_checked(n2) / _checked(n1))
+
+
+def nearest_stop(n: float, scale: Sequence[float] = THIRD_STOPS) -> float:
+    """The value on ``scale`` closest to ``n`` in stops (log scale).
+
+    Values outside the scale snap to its end.  ``scale`` must be ascending;
+    pass ``lens.available_stops()`` to snap within what a lens can do.
+    """
+    n = _checked(n)
+    return min(scale, key=lambda stop: abs(math.log(stop / n)))
+
+
+def _index_on_scale(n: float, scale: Sequence[float]) -> int | None:
+    for i, stop in enumerate(scale):
+        if math.isclose(n, stop, rel_tol=_SAME_STOP_REL_TOL):
+            return i
+    return None
+
+
+def step_stop(n: float, steps: int, scale: Sequence[float] = THIRD_STOPS) -> float:
+    """Move ``steps`` marks along ``scale`` from ``n`` (positive = smaller aperture).
+
+    From a value on the scale, one step is one mark.  From a value between
+    marks, the first step lands on the next mark in that direction (so from
+    f/3, +1 gives f/3.2 and -1 gives f/2.8).  The result is clamped to the
+    ends of the scale, but never moves against the requested direction: from
+    f/1.2 on a scale starting at f/1.4, -1 returns f/1.2 unchanged.
+    ``steps == 0`` snaps to the nearest mark.
+    """
+    n = _checked(n)
+    steps = int(steps)
+    if steps == 0:
+        return nearest_stop(n, scale)
+    last = len(scale) - 1
+    i = _index_on_scale(n, scale)
+    if i is None:
+        if steps > 0:
+            i = bisect.bisect_right(scale, n)  # first mark above n
+            if i > last:
+                return n  # already past the narrow end
+            i += steps - 1
+        else:
+            i = bisect.bisect_left(scale, n) - 1  # last mark below n
+            if i < 0:
+                return n  # already past the wide end
+            i += steps + 1
+    else:
+        i += steps
+    return float(scale[min(max(i, 0), last)])
+
+
+def format_f_number(n: float) -> str:
+    """Text as photographers write it: ``"f/2.8"``, ``"f/2"``, ``"f/0.95"``, ``"f/22"``.
+
+    One decimal (two below f/1, where 0.95 vs 0.9 matters), trailing zeros dropped.
+    """
+    n = _checked(n)
+    text = f"{n:.2f}" if n < 1.0 else f"{n:.1f}"
+    return "f/" + text.rstrip("0").rstrip(".")
+
+
+# "f/2.8", "F2.8", "ƒ/2.8", "1:2.8", "2.8", "2,8" (decimal comma); spaces allowed around parts.
+_F_NUMBER_RE = re.compile(
+    r"^\s*(?:[fƒ]\s*/?|1\s*:)?\s*(\d+(?:[.,]\d*)?|[.,]\d+)\s*$", re.IGNORECASE
+)
+
+
+def parse_f_number(text: str) -> float:
+    """Parse ``"f/2.8"``, ``"2.8"``, ``"F2.8"``, ``"1:2.8"`` (and ``"2,8"``) to ``2.8``.
+
+    Raises ValueError naming the text when it is not an f-number or is
+    outside (0.5, 128].
+    """
+    match = _F_NUMBER_RE.match(text) if isinstance(text, str) else None
+    if match is None:
+        raise ValueError(f"not an f-number: {text!r} (expected e.g. 'f/2.8' or '2.8')")
+    n = float(match.group(1).replace(",", "."))
+    if not is_valid_f_number(n):
+        raise ValueError(
+            f"f-number out of range ({MIN_F_NUMBER:g}, {MAX_F_NUMBER:g}]: {text!r}"
+        )
+    return n
