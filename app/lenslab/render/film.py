@@ -1,0 +1,117 @@
+"""From accumulated samples to pictures: the linear image, display tone mapping, and export.
+
+EXR holds the linear radiance as float32 RGB with the camera's settings as metadata (standard Exif names
+where they exist); PNG holds a display-referred 8-bit sRGB picture. Files are written to a temporary name
+beside the target and renamed into place, so an export is whole or absent, never half-written.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+EXPORT_SUFFIXES = (".exr", ".png")
+TONE_MAPS = ("clamp", "reinhard", "filmic")
+
+
+class ExportError(RuntimeError):
+    pass
+
+
+def resolve(accumulation: np.ndarray) -> np.ndarray:
+    """Mean radiance per pixel from (sum rgb, count); pixels with no samples yet are black."""
+    count = accumulation[..., 3:4]
+    return np.where(count > 0, accumulation[..., :3] / np.maximum(count, 1), 0.0).astype(np.float32)
+
+
+def merge(*accumulations: np.ndarray) -> np.ndarray:
+    """Combine partial renders of the same view (different seeds): sums and counts add."""
+    return np.sum(accumulations, axis=0)
+
+
+def linear_to_srgb(x: np.ndarray) -> np.ndarray:
+    x = np.clip(x, 0.0, 1.0)
+    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
+
+
+def _filmic(x: np.ndarray) -> np.ndarray:
+    # Narkowicz's fit of the ACES reference rendering transform: a gentle shoulder that keeps highlights.
+    a, b, c, d, e = 2.51, 0.03, 2.43, 0.59, 0.14
+    return np.clip((x * (a * x + b)) / (x * (c * x + d) + e), 0.0, 1.0)
+
+
+def tone_map(linear: np.ndarray, exposure_stops: float = 0.0, operator: str = "clamp") -> np.ndarray:
+    """Display-referred sRGB in [0, 1] from linear radiance. ``exposure_stops`` scales by 2**stops first."""
+    x = np.maximum(linear, 0.0) * np.float32(2.0**exposure_stops)
+    if operator == "reinhard":
+        x = x / (1.0 + x)
+    elif operator == "filmic":
+        x = _filmic(x)
+    elif operator != "clamp":
+        raise ValueError(f"unknown tone map '{operator}' (choose from {', '.join(TONE_MAPS)})")
+    return linear_to_srgb(x).astype(np.float32)
+
+
+def to_8bit(display: np.ndarray) -> np.ndarray:
+    return np.clip(np.round(display * 255.0), 0, 255).astype(np.uint8)
+
+
+def write_image(path: str | os.PathLike, linear: np.ndarray, metadata: dict[str, object] | None = None,
+                *, exposure_stops: float = 0.0, tone_map_operator: str = "clamp") -> Path:
+    """Write ``linear`` (H, W, 3) to an .exr (linear float) or .png (sRGB, tone mapped), atomically."""
+    import OpenImageIO as oiio  # imported here: only exporting needs it
+
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in EXPORT_SUFFIXES:
+        raise ExportError(f"{path}: unsupported output type '{path.suffix}' (use .exr or .png)")
+    if not path.parent.is_dir():
+        raise ExportError(f"{path}: folder {path.parent} does not exist")
+    height, width = linear.shape[:2]
+    if suffix == ".exr":
+        pixels = np.ascontiguousarray(linear[..., :3], dtype=np.float32)
+        spec = oiio.ImageSpec(width, height, 3, oiio.FLOAT)
+        spec.attribute("compression", "zip")
+    else:
+        pixels = to_8bit(tone_map(linear, exposure_stops, tone_map_operator))
+        spec = oiio.ImageSpec(width, height, 3, oiio.UINT8)
+        spec.attribute("oiio:ColorSpace", "sRGB")
+    for key, value in (metadata or {}).items():
+        spec.attribute(key, value if not isinstance(value, bool) else int(value))
+
+    fd, tmp_name = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=suffix, dir=path.parent)
+    os.close(fd)
+    tmp = Path(tmp_name)
+    try:
+        out = oiio.ImageOutput.create(str(tmp))
+        if out is None or not out.open(str(tmp), spec):
+            raise ExportError(f"{path}: cannot open for writing ({oiio.geterror() or (out and out.geterror())})")
+        ok = out.write_image(pixels)
+        error = out.geterror()
+        out.close()
+        if not ok:
+            raise ExportError(f"{path}: write failed ({error})")
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    return path
+
+
+def read_image(path: str | os.PathLike) -> tuple[np.ndarray, dict[str, object]]:
+    """(pixels as float32 (H, W, C), metadata) of an image file; for tests and for resuming renders."""
+    import OpenImageIO as oiio
+
+    image = oiio.ImageInput.open(str(path))
+    if image is None:
+        raise ExportError(f"{path}: cannot read ({oiio.geterror()})")
+    try:
+        spec = image.spec()
+        pixels = image.read_image(format=oiio.FLOAT)
+        metadata = {attr.name: attr.value for attr in spec.extra_attribs}
+    finally:
+        image.close()
+    return np.asarray(pixels, dtype=np.float32), metadata

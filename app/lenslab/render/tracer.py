@@ -1,0 +1,228 @@
+"""The progressive render session: accumulate samples into a float32 image in bounded GPU dispatches.
+
+A :class:`Renderer` owns a GL context and the compiled trace kernels. A :class:`RenderSession` holds one
+scene on the GPU and its accumulation buffer: each call to :meth:`RenderSession.step` runs dispatches for
+about a given time and returns, so a caller can show, save or stop the image between any two dispatches.
+Every dispatch is sized from the measured cost of the last one to stay near a target duration, well under
+any GPU watchdog.
+
+Each pixel's running sum is kept with its own sample count (alpha channel): the image is the sum divided by
+the count, partial renders can be merged by adding, and the same seed gives the same image however the work
+was split.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from lenslab.render import gl
+from lenslab.render.buffers import ACCUMULATION_BINDING, GpuScene, pack_scene
+from lenslab.render.sobol import glsl_array_literal
+from lenslab.scene.camera import ThinLensCamera
+from lenslab.scene.scene import RenderSettings, Scene
+
+LOCAL_SIZE_X = 32  # GPU-NOTES: 32x1 work groups traversed the kd-tree fastest on llvmpipe
+DEFAULT_DISPATCH_SECONDS = 0.1
+
+
+class Renderer:
+    """A GL context and the trace kernels compiled for it (one per set of compile-time defines)."""
+
+    def __init__(self, device_index: int | None = None, ctx=None):
+        self.ctx = ctx if ctx is not None else gl.create_context(device_index)
+        self.limits = gl.device_limits(self.ctx)
+        self._programs: dict[tuple, object] = {}
+
+    def program(self, stack_size: int, sampler: str):
+        key = (stack_size, sampler)
+        if key not in self._programs:
+            defines = {"LOCAL_SIZE_X": LOCAL_SIZE_X, "KD_STACK_SIZE": stack_size, "SOBOL_DIRECTIONS": glsl_array_literal()}
+            if sampler == "independent":
+                defines["SAMPLER_INDEPENDENT"] = 1
+            self._programs[key] = self.ctx.compute_shader(gl.load_shader_source("trace.comp", defines))
+        return self._programs[key]
+
+    def describe(self) -> dict[str, str]:
+        return gl.describe_device(self.ctx)
+
+    def release(self) -> None:
+        for program in self._programs.values():
+            program.release()
+        self._programs.clear()
+        self.ctx.release()
+
+
+def camera_uniforms(camera: ThinLensCamera, width: int, height: int) -> dict[str, object]:
+    tan_x = float(np.tan(camera.fov_x / 2))
+    return {
+        "cam_position": tuple(float(v) for v in camera.position),
+        "cam_to_world": tuple(float(v) for v in camera.basis().reshape(-1)),  # rows of basis = columns
+        "cam_tan_half_fov": (tan_x, tan_x * height / width),
+        "cam_lens_radius": float(camera.lens_radius),
+        "cam_focus_distance": float(camera.focus_distance_m),
+        "cam_blades": int(camera.aperture_blades),
+        "cam_blade_rotation": float(np.radians(camera.blade_rotation_deg)),
+        "image_size": (width, height),
+    }
+
+
+@dataclass(frozen=True)
+class Progress:
+    samples_per_pixel: int  # every pixel has at least this many
+    target_spp: int | None
+    elapsed_seconds: float
+    samples_per_second: float
+
+
+class RenderSession:
+    """One scene on the GPU, one image accumulating. Not thread-safe: use it from the context's thread."""
+
+    def __init__(self, renderer: Renderer, scene: Scene, *, width: int | None = None, height: int | None = None,
+                 settings: RenderSettings | None = None, dispatch_seconds: float = DEFAULT_DISPATCH_SECONDS):
+        self.renderer = renderer
+        self.ctx = renderer.ctx
+        self.dispatch_seconds = dispatch_seconds
+        self._gpu_scene: GpuScene | None = None
+        self._accumulation = None
+        self.set_scene(scene, width=width, height=height, settings=settings)
+
+    # -- scene and camera ---------------------------------------------------------------------------------
+    def set_scene(self, scene: Scene, *, width: int | None = None, height: int | None = None,
+                  settings: RenderSettings | None = None) -> None:
+        """Upload a (new or edited) scene and restart accumulation."""
+        self.scene = scene
+        self.settings = settings or scene.render
+        packed = pack_scene(scene.flatten(), scene.environment)
+        gpu_scene = GpuScene(self.ctx, packed, self.renderer.limits.max_storage_block_bytes)
+        if self._gpu_scene is not None:
+            self._gpu_scene.release()
+        self._gpu_scene = gpu_scene
+        self.width = int(width or scene.camera.resolution[0])
+        self.height = int(height or scene.camera.resolution[1])
+        self.program = self.renderer.program(self.program_stack_size, self.settings.sampler)
+        self.set_camera(scene.camera)
+
+    def set_camera(self, camera: ThinLensCamera) -> None:
+        """A camera-only edit: no re-upload of geometry, just restart accumulation."""
+        camera.validate()
+        self.camera = camera
+        self.reset()
+
+    def set_settings(self, settings: RenderSettings) -> None:
+        if settings.sampler != self.settings.sampler:
+            self.program = self.renderer.program(self.program_stack_size, settings.sampler)
+        self.settings = settings
+        self.reset()
+
+    @property
+    def program_stack_size(self) -> int:
+        # The traversal stack holds at most one far child per level below the root.
+        return max(1, self._gpu_scene.packed.kdtree.max_depth)
+
+    def reset(self) -> None:
+        """Discard the accumulated samples (after any edit)."""
+        pixels = self.width * self.height
+        if self._accumulation is None or self._accumulation.size != pixels * 16:
+            if self._accumulation is not None:
+                self._accumulation.release()
+            self._accumulation = self.ctx.buffer(reserve=pixels * 16)
+        self._accumulation.clear()
+        self._pixels_done = 0  # pixels of the current pass that have their samples
+        self.samples_per_pixel = 0  # completed passes, in samples
+        self._pass_samples = 1
+        self._seconds_per_pixel_sample = None
+        self.elapsed_seconds = 0.0
+        self._samples_traced = 0
+
+    # -- rendering ----------------------------------------------------------------------------------------
+    def _set_uniforms(self) -> None:
+        program = self.program
+        values = dict(self._gpu_scene.packed.uniforms)
+        values.update(camera_uniforms(self.camera, self.width, self.height))
+        values.update(max_depth=self.settings.max_depth, rr_depth=self.settings.rr_depth, seed=self.settings.seed)
+        for name, value in values.items():
+            if name in program:  # the GLSL compiler drops uniforms a kernel never reads
+                program[name].value = value
+
+    def _plan_dispatch(self, target_spp: int | None) -> tuple[int, int]:
+        """(pixels, samples) for the next dispatch, aiming at dispatch_seconds of GPU time."""
+        pixels_total = self.width * self.height
+        remaining_pixels = pixels_total - self._pixels_done
+        if self._seconds_per_pixel_sample is None:
+            return min(remaining_pixels, 16384), 1  # a small first dispatch to measure the cost
+        budget = self.dispatch_seconds / self._seconds_per_pixel_sample  # pixel-samples that fit
+        if self._pixels_done == 0 and budget >= 2 * pixels_total:
+            # The whole image fits more than twice: take several samples per pixel in one dispatch.
+            samples = max(1, int(budget // pixels_total))
+            if target_spp is not None:
+                samples = min(samples, target_spp - self.samples_per_pixel)
+            self._pass_samples = samples
+            return pixels_total, samples
+        if self._pixels_done == 0:
+            self._pass_samples = 1
+        pixels = int(max(LOCAL_SIZE_X, budget // self._pass_samples))
+        pixels = min(remaining_pixels, (pixels + LOCAL_SIZE_X - 1) // LOCAL_SIZE_X * LOCAL_SIZE_X)
+        return pixels, self._pass_samples
+
+    def _dispatch(self, pixels: int, samples: int) -> None:
+        program = self.program
+        program["tile_start"].value = self._pixels_done
+        program["tile_pixels"].value = pixels
+        program["sample_start"].value = self.samples_per_pixel
+        program["sample_count"].value = samples
+        groups = (pixels + LOCAL_SIZE_X - 1) // LOCAL_SIZE_X
+        start = time.perf_counter()
+        program.run(groups, 1, 1)
+        self.ctx.finish()  # bound the work in flight: the caller may read or stop right after
+        seconds = time.perf_counter() - start
+        self.elapsed_seconds += seconds
+        self._samples_traced += pixels * samples
+        measured = seconds / (pixels * samples)
+        previous = self._seconds_per_pixel_sample
+        self._seconds_per_pixel_sample = measured if previous is None else 0.5 * (previous + measured)
+        self._pixels_done += pixels
+        if self._pixels_done >= self.width * self.height:
+            self._pixels_done = 0
+            self.samples_per_pixel += samples
+
+    def step(self, seconds: float, target_spp: int | None = None) -> Progress:
+        """Render for about ``seconds`` (at least one dispatch) or until ``target_spp`` is reached."""
+        self._gpu_scene.bind()
+        self._accumulation.bind_to_storage_buffer(ACCUMULATION_BINDING)
+        self._set_uniforms()
+        deadline = time.perf_counter() + seconds
+        while target_spp is None or self.samples_per_pixel < target_spp:
+            self._dispatch(*self._plan_dispatch(target_spp))
+            if time.perf_counter() >= deadline:
+                break
+        return self.progress(target_spp)
+
+    def done(self, target_spp: int) -> bool:
+        return self.samples_per_pixel >= target_spp
+
+    def progress(self, target_spp: int | None = None) -> Progress:
+        rate = self._samples_traced / self.elapsed_seconds if self.elapsed_seconds > 0 else 0.0
+        return Progress(self.samples_per_pixel, target_spp, self.elapsed_seconds, rate)
+
+    # -- reading the image --------------------------------------------------------------------------------
+    def accumulation(self) -> np.ndarray:
+        """(H, W, 4) float32: radiance sums and sample counts; rows top to bottom."""
+        data = np.frombuffer(self._accumulation.read(), dtype=np.float32)
+        return data.reshape(self.height, self.width, 4).copy()
+
+    def image(self) -> np.ndarray:
+        """(H, W, 3) float32 linear radiance: the mean of the samples so far."""
+        from lenslab.render.film import resolve
+
+        return resolve(self.accumulation())
+
+    def release(self) -> None:
+        if self._gpu_scene is not None:
+            self._gpu_scene.release()
+            self._gpu_scene = None
+        if self._accumulation is not None:
+            self._accumulation.release()
+            self._accumulation = None

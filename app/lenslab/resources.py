@@ -1,0 +1,33 @@
+"""Where the data that ships with LensLab lives: shaders, ready scenes and presets.
+
+In an installed wheel these folders sit inside the package (``lenslab/glsl`` ...); in a source checkout
+they sit at the top of the repository. We look in the package first so that an installed copy never
+picks up a stray checkout.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+_PACKAGE_DIR = Path(__file__).resolve().parent
+_CHECKOUT_DIR = _PACKAGE_DIR.parents[1]
+
+
+def resource_dir(name: str) -> Path:
+    """Return the folder holding the shipped resource ``name`` ("glsl", "scenes" or "presets")."""
+    for candidate in (_PACKAGE_DIR / name, _CHECKOUT_DIR / name):
+        if candidate.is_dir():
+            return candidate
+    raise FileNotFoundError(f"LensLab's '{name}' folder is missing from {_PACKAGE_DIR} (broken install?)")
+
+
+def glsl_dir() -> Path:
+    return resource_dir("glsl")
+
+
+def scenes_dir() -> Path:
+    return resource_dir("scenes")
+
+
+def presets_dir() -> Path:
+    return resource_dir("presets")

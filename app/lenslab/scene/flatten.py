@@ -1,0 +1,145 @@
+"""Resolve a scene's node tree into world-space primitive arrays, the form the renderer and ray queries use.
+
+Primitives are numbered triangles first, then spheres; ``prim_node`` maps each back to the node that made it
+(so a click in the viewport can select a node).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from lenslab.scene.materials import Material
+from lenslab.scene.scene import DEFAULT_MATERIAL, Node, Scene, SceneError
+from lenslab.scene.shapes import Box, MeshFile, Rectangle, Sphere, TriangleMesh
+from lenslab.scene.transform import transform_normals, transform_points
+
+
+@dataclass(frozen=True)
+class FlatScene:
+    triangles: np.ndarray  # (T, 3, 3) float32 world-space corners
+    triangle_normals: np.ndarray  # (T, 3, 3) float32 shading normals at the corners
+    triangle_uvs: np.ndarray  # (T, 3, 2) float32
+    triangle_material: np.ndarray  # (T,) int32 index into materials
+    spheres: np.ndarray  # (S, 4) float32 centre xyz, radius
+    sphere_material: np.ndarray  # (S,) int32
+    materials: list[Material]
+    material_names: list[str]
+    prim_node: np.ndarray  # (T + S,) int32 index into nodes
+    nodes: list[Node]  # every node, depth first
+
+    @property
+    def triangle_count(self) -> int:
+        return len(self.triangles)
+
+    @property
+    def sphere_count(self) -> int:
+        return len(self.spheres)
+
+    @property
+    def prim_count(self) -> int:
+        return self.triangle_count + self.sphere_count
+
+    def prim_bounds(self) -> np.ndarray:
+        """(N, 2, 3) axis-aligned boxes, triangles then spheres."""
+        tri = np.stack([self.triangles.min(axis=1), self.triangles.max(axis=1)], axis=1)
+        c, r = self.spheres[:, :3], self.spheres[:, 3:4]
+        sph = np.stack([c - r, c + r], axis=1)
+        return np.concatenate([tri, sph]).astype(np.float32)
+
+    def bounds(self) -> np.ndarray:
+        if self.prim_count == 0:
+            return np.zeros((2, 3), np.float32)
+        b = self.prim_bounds()
+        return np.stack([b[:, 0].min(axis=0), b[:, 1].max(axis=0)])
+
+
+def _flat_normals(corners: np.ndarray) -> np.ndarray:
+    n = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-30)
+    return np.repeat(n[:, None, :], 3, axis=1)
+
+
+def _mesh_for(scene: Scene, node: Node, loader) -> TriangleMesh:
+    shape = node.shape
+    if isinstance(shape, (Rectangle, Box)):
+        return shape.mesh()
+    assert isinstance(shape, MeshFile)
+    path = Path(shape.file)
+    if not path.is_absolute():
+        path = scene.base_dir() / path
+    return loader(path, shape.smooth)
+
+
+def flatten_scene(scene: Scene, mesh_loader=None) -> FlatScene:
+    if mesh_loader is None:
+        from lenslab.scene.io.meshes import load_mesh as mesh_loader
+
+    material_names = list(scene.materials)
+    materials = [scene.materials[n] for n in material_names]
+    default_index = None
+
+    def material_index(node: Node) -> int:
+        nonlocal default_index
+        if node.material:
+            if node.material not in scene.materials:
+                raise SceneError(f"node '{node.name}': unknown material '{node.material}'")
+            return material_names.index(node.material)
+        if default_index is None:  # nodes without a material get a neutral grey
+            material_names.append("(default)")
+            materials.append(DEFAULT_MATERIAL)
+            default_index = len(materials) - 1
+        return default_index
+
+    tris, tri_normals, tri_uvs, tri_mat, tri_node = [], [], [], [], []
+    spheres, sph_mat, sph_node = [], [], []
+    nodes: list[Node] = []
+    for node, matrix in scene.walk():
+        node_index = len(nodes)
+        nodes.append(node)
+        if node.shape is None:
+            continue
+        mat = material_index(node)
+        if isinstance(node.shape, Sphere):
+            scale = np.linalg.norm(matrix[:3, :3], axis=0)
+            if np.ptp(scale) > 1e-6 * scale.max():
+                raise SceneError(f"node '{node.name}': a sphere cannot take a non-uniform scale {tuple(scale.round(6))}")
+            spheres.append([*matrix[:3, 3], node.shape.radius * scale[0]])
+            sph_mat.append(mat)
+            sph_node.append(node_index)
+            continue
+        mesh = _mesh_for(scene, node, mesh_loader)
+        corners = transform_points(matrix, mesh.vertices)[mesh.faces]
+        if np.linalg.det(matrix[:3, :3]) < 0:  # a mirroring transform flips winding: keep the front face in front
+            corners = corners[:, ::-1]
+            faces = mesh.faces[:, ::-1]
+        else:
+            faces = mesh.faces
+        if mesh.normals is not None:
+            normals = transform_normals(matrix, mesh.normals)[faces]
+        else:
+            normals = _flat_normals(corners)
+        uvs = mesh.uvs[faces] if mesh.uvs is not None else np.zeros((len(faces), 3, 2))
+        tris.append(corners)
+        tri_normals.append(normals)
+        tri_uvs.append(uvs)
+        tri_mat.append(np.full(len(faces), mat))
+        tri_node.append(np.full(len(faces), node_index))
+
+    def cat(parts, shape, dtype):
+        return np.concatenate(parts).astype(dtype) if parts else np.zeros(shape, dtype)
+
+    return FlatScene(
+        triangles=cat(tris, (0, 3, 3), np.float32),
+        triangle_normals=cat(tri_normals, (0, 3, 3), np.float32),
+        triangle_uvs=cat(tri_uvs, (0, 3, 2), np.float32),
+        triangle_material=cat(tri_mat, (0,), np.int32),
+        spheres=np.asarray(spheres, np.float32).reshape(-1, 4),
+        sphere_material=np.asarray(sph_mat, np.int32),
+        materials=materials,
+        material_names=material_names,
+        prim_node=np.concatenate([cat(tri_node, (0,), np.int32), np.asarray(sph_node, np.int32)]),
+        nodes=nodes,
+    )

@@ -1,0 +1,47 @@
+"""Triangle meshes from files (OBJ, PLY, glTF/GLB, STL and whatever else trimesh reads).
+
+Loaded meshes are cached by (path, modification time, smooth) so that re-flattening a scene after an edit
+does not re-read a large file.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from lenslab.scene.shapes import TriangleMesh
+
+MESH_SUFFIXES = (".obj", ".ply", ".gltf", ".glb", ".stl", ".off")
+
+
+class MeshLoadError(ValueError):
+    pass
+
+
+def load_mesh(path: Path, smooth: bool = True) -> TriangleMesh:
+    path = Path(path)
+    if not path.is_file():
+        raise MeshLoadError(f"{path}: mesh file not found")
+    return _load_cached(str(path.resolve()), path.stat().st_mtime_ns, smooth)
+
+
+@lru_cache(maxsize=32)
+def _load_cached(path: str, mtime_ns: int, smooth: bool) -> TriangleMesh:
+    import trimesh  # imported here: a scene without mesh files never pays for it
+
+    try:
+        mesh = trimesh.load(path, force="mesh", process=False)
+    except Exception as exc:  # trimesh raises many kinds; all mean the same to the user
+        raise MeshLoadError(f"{path}: cannot read mesh ({exc})") from exc
+    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
+        raise MeshLoadError(f"{path}: no triangles in file")
+    vertices = np.asarray(mesh.vertices, dtype=np.float64)
+    faces = np.asarray(mesh.faces, dtype=np.int64)
+    normals = np.asarray(mesh.vertex_normals, dtype=np.float64) if smooth else None
+    uvs = None
+    visual_uv = getattr(mesh.visual, "uv", None)
+    if visual_uv is not None and len(visual_uv) == len(vertices):
+        uvs = np.asarray(visual_uv, dtype=np.float64)
+    return TriangleMesh(vertices, faces, normals, uvs)

@@ -1,0 +1,232 @@
+"""LensLab's native scene format: JSON, versioned, documented in docs/scene-format.md.
+
+Reading is strict: an unknown key, a value of the wrong type, a value out of range or a mesh file that does not
+exist is a :class:`SceneError` whose one-line message names the file and the key path
+(``scene.json: camera.f_number: 0.2 is out of range [0.5, 128]``). Saving writes every value, defaults
+included, so a saved file says exactly what was rendered; ``load(save(scene)) == scene``.
+
+The reader and writer are generic over the scene's dataclasses: each field's type annotation says what JSON
+value it takes and its ``metadata`` carries the range, choices and whether it is required.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import os
+import tempfile
+import types
+import typing
+from pathlib import Path
+from typing import Any
+
+from lenslab.scene.materials import MATERIAL_TYPES, Material
+from lenslab.scene.scene import ENVIRONMENT_TYPES, Environment, Node, Scene, SceneError
+from lenslab.scene.shapes import SHAPE_TYPES, MeshFile, Shape
+
+FORMAT_KEY = "lenslab_scene"
+FORMAT_VERSION = 1
+SCENE_SUFFIX = ".json"
+
+# Polymorphic fields: the JSON object's "type" key picks the dataclass.
+_TAGGED = {Shape: SHAPE_TYPES, Material: MATERIAL_TYPES, Environment: ENVIRONMENT_TYPES}
+
+
+class _Invalid(Exception):
+    """Raised inside the reader with a key path; turned into a SceneError naming the file."""
+
+    def __init__(self, path: str, message: str):
+        super().__init__(f"{path}: {message}" if path else message)
+
+
+def _join(path: str, key: str | int) -> str:
+    if isinstance(key, int):
+        return f"{path}[{key}]"
+    return f"{path}.{key}" if path else key
+
+
+def _type_hints(cls) -> dict[str, Any]:
+    return typing.get_type_hints(cls)
+
+
+def _describe(value: Any) -> str:
+    text = json.dumps(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Reading
+# ---------------------------------------------------------------------------------------------------------
+def _read_number(value: Any, kind: type, path: str, meta: dict) -> float | int:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise _Invalid(path, f"expected a number, got {_describe(value)}")
+    if kind is int and not float(value).is_integer():
+        raise _Invalid(path, f"expected a whole number, got {_describe(value)}")
+    if not math.isfinite(value):
+        raise _Invalid(path, f"{value} is not a finite number")
+    if "range" in meta:
+        lo, hi = meta["range"]
+        if not lo <= value <= hi:
+            raise _Invalid(path, f"{_describe(value)} is out of range [{lo:g}, {hi:g}]")
+    if meta.get("nonzero") and value == 0:
+        raise _Invalid(path, "must not be zero")
+    return int(value) if kind is int else float(value)
+
+
+def _read_value(value: Any, annotation: Any, path: str, meta: dict) -> Any:
+    origin = typing.get_origin(annotation)
+    args = typing.get_args(annotation)
+    if origin in (typing.Union, types.UnionType):
+        if value is None and type(None) in args:
+            return None
+        (annotation,) = [a for a in args if a is not type(None)]
+        return _read_value(value, annotation, path, meta)
+    if annotation in (int, float):
+        return _read_number(value, annotation, path, meta)
+    if annotation is bool:
+        if not isinstance(value, bool):
+            raise _Invalid(path, f"expected true or false, got {_describe(value)}")
+        return value
+    if annotation is str:
+        if not isinstance(value, str):
+            raise _Invalid(path, f"expected a string, got {_describe(value)}")
+        if "choices" in meta and value not in meta["choices"]:
+            raise _Invalid(path, f"'{value}' is not one of {', '.join(meta['choices'])}")
+        return value
+    if origin is tuple:
+        if not isinstance(value, list) or len(value) != len(args):
+            raise _Invalid(path, f"expected a list of {len(args)} numbers, got {_describe(value)}")
+        return tuple(_read_value(v, a, _join(path, i), meta) for i, (v, a) in enumerate(zip(value, args)))
+    if origin is list:
+        if not isinstance(value, list):
+            raise _Invalid(path, f"expected a list, got {_describe(value)}")
+        return [_read_value(v, args[0], _join(path, i), meta) for i, v in enumerate(value)]
+    if origin is dict:
+        if not isinstance(value, dict):
+            raise _Invalid(path, f"expected an object, got {_describe(value)}")
+        return {k: _read_value(v, args[1], _join(path, k), meta) for k, v in value.items()}
+    if isinstance(annotation, type) and annotation in _TAGGED:
+        return _read_tagged(value, _TAGGED[annotation], path)
+    if dataclasses.is_dataclass(annotation):
+        return _read_dataclass(value, annotation, path)
+    if annotation is typing.Any or annotation is object:
+        return value
+    raise TypeError(f"no reader for {annotation!r}")  # a programming error, not a user's
+
+
+def _read_tagged(value: Any, registry: dict[str, type], path: str) -> Any:
+    if not isinstance(value, dict):
+        raise _Invalid(path, f"expected an object, got {_describe(value)}")
+    kind = value.get("type")
+    if kind not in registry:
+        raise _Invalid(_join(path, "type"), f"unknown type {_describe(kind)}; expected one of {', '.join(registry)}")
+    return _read_dataclass({k: v for k, v in value.items() if k != "type"}, registry[kind], path)
+
+
+def _read_dataclass(value: Any, cls: type, path: str) -> Any:
+    if not isinstance(value, dict):
+        raise _Invalid(path, f"expected an object, got {_describe(value)}")
+    fields = {f.name: f for f in dataclasses.fields(cls) if f.init and f.name != "source_path"}
+    hints = _type_hints(cls)
+    for key in value:
+        if key not in fields:
+            raise _Invalid(_join(path, key), f"unknown key (expected one of {', '.join(fields)})")
+    kwargs = {}
+    for name, f in fields.items():
+        if name in value:
+            kwargs[name] = _read_value(value[name], hints[name], _join(path, name), dict(f.metadata))
+        elif f.metadata.get("required"):
+            raise _Invalid(_join(path, name), "missing required key")
+    return cls(**kwargs)
+
+
+def _check_references(scene: Scene) -> None:
+    """Cross-field checks the types alone cannot express."""
+    try:
+        scene.camera.validate()
+    except ValueError as exc:
+        raise _Invalid("camera", str(exc)) from None
+
+    def visit(nodes: list[Node], path: str) -> None:
+        for i, node in enumerate(nodes):
+            node_path = _join(path, i)
+            if node.material and node.material not in scene.materials:
+                raise _Invalid(_join(node_path, "material"), f"unknown material '{node.material}'")
+            if isinstance(node.shape, MeshFile):
+                mesh_path = Path(node.shape.file)
+                if not mesh_path.is_absolute():
+                    mesh_path = scene.base_dir() / mesh_path
+                if not mesh_path.is_file():
+                    raise _Invalid(_join(_join(node_path, "shape"), "file"), f"mesh file not found: {mesh_path}")
+            visit(node.children, _join(node_path, "children"))
+
+    visit(scene.nodes, "nodes")
+
+
+def scene_from_dict(data: Any, source_path: Path | None = None) -> Scene:
+    """Build a Scene from parsed JSON; raises _Invalid with the key path."""
+    if not isinstance(data, dict):
+        raise _Invalid("", "the file does not hold a JSON object")
+    version = data.get(FORMAT_KEY)
+    if version is None:
+        raise _Invalid(FORMAT_KEY, "missing: this is not a LensLab scene")
+    if version != FORMAT_VERSION:
+        raise _Invalid(FORMAT_KEY, f"version {_describe(version)} is not supported (this LensLab reads {FORMAT_VERSION})")
+    scene = _read_dataclass({k: v for k, v in data.items() if k != FORMAT_KEY}, Scene, "")
+    scene.source_path = source_path
+    _check_references(scene)
+    return scene
+
+
+def load_scene(path: str | os.PathLike) -> Scene:
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise SceneError(f"{path}: no such scene file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise SceneError(f"{path}: cannot read ({exc})") from None
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise SceneError(f"{path}: line {exc.lineno} column {exc.colno}: not valid JSON ({exc.msg})") from None
+    try:
+        return scene_from_dict(data, path.resolve())
+    except _Invalid as exc:
+        raise SceneError(f"{path}: {exc}") from None
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Writing
+# ---------------------------------------------------------------------------------------------------------
+def _write_value(value: Any) -> Any:
+    if dataclasses.is_dataclass(value):
+        out = {"type": value.type_name} if getattr(value, "type_name", "") else {}
+        for f in dataclasses.fields(value):
+            if f.name != "source_path":
+                out[f.name] = _write_value(getattr(value, f.name))
+        return out
+    if isinstance(value, (tuple, list)):
+        return [_write_value(v) for v in value]
+    if isinstance(value, dict):
+        return {k: _write_value(v) for k, v in value.items()}
+    return value
+
+
+def scene_to_dict(scene: Scene) -> dict:
+    return {FORMAT_KEY: FORMAT_VERSION, **_write_value(scene)}
+
+
+def save_scene(scene: Scene, path: str | os.PathLike) -> None:
+    """Write atomically: a crash mid-save leaves the previous file intact."""
+    path = Path(path)
+    text = json.dumps(scene_to_dict(scene), indent=2) + "\n"
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise

@@ -1,0 +1,96 @@
+"""The scene as data: a tree of named nodes, a material library, a camera, an environment and render settings.
+
+Nothing here knows about OpenGL or Qt. The renderer asks for :meth:`Scene.flatten`, which resolves the node
+tree into world-space arrays of triangles and spheres; the GUI edits the dataclasses and says so through
+:class:`SceneEvents` listeners.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable, ClassVar, Iterator
+
+import numpy as np
+
+from lenslab.scene.camera import ThinLensCamera
+from lenslab.scene.materials import Diffuse, Material
+from lenslab.scene.shapes import Shape
+from lenslab.scene.transform import Transform
+
+RGB = tuple[float, float, float]
+
+
+class SceneError(ValueError):
+    """A scene that cannot be loaded or rendered; the message is one line naming the file and the key."""
+
+
+@dataclass
+class Node:
+    name: str = field(default="node", metadata={"required": True})
+    transform: Transform = field(default_factory=Transform)
+    shape: Shape | None = None
+    material: str = field(default="", metadata={"doc": "name of an entry in the scene's materials"})
+    children: list["Node"] = field(default_factory=list)
+
+    def walk(self, parent_matrix: np.ndarray | None = None) -> Iterator[tuple["Node", np.ndarray]]:
+        """Yield (node, local-to-world matrix) depth first."""
+        matrix = self.transform.matrix() if parent_matrix is None else parent_matrix @ self.transform.matrix()
+        yield self, matrix
+        for child in self.children:
+            yield from child.walk(matrix)
+
+
+@dataclass
+class Environment:
+    """Light arriving from infinitely far away, seen where a ray leaves the scene."""
+
+    type_name: ClassVar[str] = ""
+
+
+@dataclass
+class ConstantEnvironment(Environment):
+    """Light arriving from every direction with the same radiance (the sky of a white furnace)."""
+
+    type_name: ClassVar[str] = "constant"
+    radiance: RGB = field(default=(0.0, 0.0, 0.0), metadata={"range": (0.0, 1e6)})
+
+
+ENVIRONMENT_TYPES = {cls.type_name: cls for cls in (ConstantEnvironment,)}
+
+
+@dataclass
+class RenderSettings:
+    spp: int = field(default=64, metadata={"range": (1, 1 << 24), "doc": "samples per pixel"})
+    max_depth: int = field(
+        default=8, metadata={"range": (1, 1024), "doc": "longest path in segments; 1 = emitters only, 2 = direct light"}
+    )
+    rr_depth: int = field(default=5, metadata={"range": (1, 1024), "doc": "path length at which Russian roulette starts"})
+    seed: int = field(default=0, metadata={"range": (0, 2**31 - 1)})
+    sampler: str = field(default="sobol", metadata={"choices": ("sobol", "independent")})
+
+
+@dataclass
+class Scene:
+    camera: ThinLensCamera = field(default_factory=ThinLensCamera)
+    environment: Environment = field(default_factory=ConstantEnvironment)
+    render: RenderSettings = field(default_factory=RenderSettings)
+    materials: dict[str, Material] = field(default_factory=dict)
+    nodes: list[Node] = field(default_factory=list)
+    # Where the scene came from: relative mesh paths resolve against its folder. Not saved.
+    source_path: Path | None = field(default=None, compare=False, repr=False)
+
+    def walk(self) -> Iterator[tuple[Node, np.ndarray]]:
+        for root in self.nodes:
+            yield from root.walk()
+
+    def base_dir(self) -> Path:
+        return self.source_path.parent if self.source_path else Path.cwd()
+
+    def flatten(self, mesh_loader: Callable[[Path, bool], object] | None = None) -> "FlatScene":
+        from lenslab.scene.flatten import flatten_scene
+
+        return flatten_scene(self, mesh_loader)
+
+
+DEFAULT_MATERIAL = Diffuse(albedo=(0.8, 0.8, 0.8))

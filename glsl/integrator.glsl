@@ -1,0 +1,73 @@
+// Unidirectional path tracing with next-event estimation and multiple importance sampling (Veach 1997,
+// power heuristic), as in pbrt-v4's PathIntegrator. Path length follows Mitsuba's max_depth: 1 sees only
+// emitters, 2 adds direct light, and so on. Russian roulette from rr_depth keeps the estimator unbiased.
+
+uniform int max_depth;
+uniform int rr_depth;
+
+vec3 path_radiance(Ray ray, inout Sampler sampler) {
+    vec3 radiance = vec3(0.0);
+    vec3 throughput = vec3(1.0);
+    float prev_bsdf_pdf = 0.0;
+    bool prev_delta = true;  // the camera ray: nothing to weigh emission against
+    vec3 prev_p = ray.o;
+
+    for (int segments = 1; ; segments++) {
+        Hit hit;
+        if (!trace_bsp(ray, 0.0, INFINITY, false, hit)) {
+            vec3 le = environment_radiance(ray.d);
+            float w = prev_delta ? 1.0 : power_heuristic(prev_bsdf_pdf, environment_pdf(ray.d));
+            radiance += throughput * le * w;
+            break;
+        }
+        SurfaceHit s = surface_at(ray, hit);
+
+        vec3 le = emitted_radiance(s.material, s.front_face);
+        if (max_component(le) > 0.0) {
+            float w = 1.0;
+            if (!prev_delta) {
+                // ng was turned towards the ray; the light pdf only needs |cos|, so its sign does not matter.
+                w = power_heuristic(prev_bsdf_pdf, area_light_pdf(s.prim, prev_p, s.p, s.ng));
+            }
+            radiance += throughput * le * w;
+        }
+        if (segments >= max_depth || !material_scatters(s.material)) break;
+
+        vec4 u_light = sample4(sampler);
+        vec4 u_bsdf = sample4(sampler);
+
+        // Next-event estimation: one shadow ray towards a light chosen by power.
+        LightSample ls;
+        if (sample_light(s.p, u_light, ls)) {
+            float bsdf_pdf;
+            vec3 f = bsdf_eval(s, ls.wi, bsdf_pdf);
+            if (max_component(f) > 0.0) {
+                Ray shadow = spawn_ray(s, ls.wi);
+                float t_max = isinf(ls.dist) ? INFINITY : ls.dist * (1.0 - 1e-4);
+                if (!occluded(shadow, t_max)) {
+                    float w = power_heuristic(ls.pdf, bsdf_pdf);
+                    radiance += throughput * f * ls.radiance * (w / ls.pdf);
+                }
+            }
+        }
+
+        // Continue the path by sampling the BSDF.
+        vec3 wi, weight;
+        float pdf;
+        bool delta;
+        if (!bsdf_sample(s, u_bsdf.xyz, wi, weight, pdf, delta)) break;
+        throughput *= weight;
+        prev_bsdf_pdf = pdf;
+        prev_delta = delta;
+        prev_p = s.p;
+        ray = spawn_ray(s, wi);
+
+        if (segments >= rr_depth) {
+            // Survive with probability q (at most 0.95), then divide by it: unbiased.
+            float q = min(max_component(throughput), 0.95);
+            if (u_bsdf.w >= q) break;
+            throughput /= q;
+        }
+    }
+    return radiance;
+}
