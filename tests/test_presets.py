@@ -1,0 +1,345 @@
+"""Lens and sensor presets: every shipped file loads, every broken file is reported by name and key."""
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+
+from lenslab.optics import presetfiles
+from lenslab.optics.lenses import LensPreset, load_lens_presets, read_lens_file
+from lenslab.optics.presetfiles import PresetError, shipped_presets_dir, user_presets_dir
+from lenslab.optics.sensors import FULL_FRAME, SensorPreset, load_sensor_presets
+from lenslab.optics.stops import THIRD_STOPS, step_stop
+
+REPO = Path(__file__).resolve().parents[1]
+SHIPPED_LENS_FILES = sorted((REPO / "presets" / "lenses").glob("*.json"))
+
+
+@pytest.fixture(autouse=True)
+def isolated_user_dir(tmp_path, monkeypatch):
+    """Point the user presets folder at an empty temporary place, whatever the host has."""
+    config = tmp_path / "config"
+    config.mkdir()
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(config))
+    return config / "lenslab" / "presets"
+
+
+def write(path: Path, data) -> Path:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(data if isinstance(data, str) else json.dumps(data), encoding="utf-8")
+    return path
+
+
+# --- shipped presets ------------------------------------------------------------------------
+
+def test_shipped_folder_is_the_checkout_presets():
+    assert shipped_presets_dir() == REPO / "presets"
+
+
+def test_there_are_shipped_lens_files():
+    assert len(SHIPPED_LENS_FILES) >= 9
+
+
+@pytest.mark.parametrize("path", SHIPPED_LENS_FILES, ids=lambda p: p.name)
+def test_every_shipped_lens_file_loads(path):
+    lens = read_lens_file(path)
+    assert lens.widest_f_number < lens.narrowest_f_number
+    assert lens.aperture_blades >= 5, "shipped lenses have a real iris"
+    assert lens.min_focus_distance_m is not None and lens.min_focus_distance_m > 0
+    assert lens.description
+
+
+def test_shipped_lenses_are_the_promised_set():
+    lenses = {l.name: l for l in load_lens_presets(include_user=False)}
+    expected = {
+        "14 mm f/2.8": (14, 14, 2.8),
+        "24 mm f/1.4": (24, 24, 1.4),
+        "35 mm f/1.4": (35, 35, 1.4),
+        "50 mm f/1.2": (50, 50, 1.2),
+        "85 mm f/1.4": (85, 85, 1.4),
+        "100 mm f/2.8 Macro": (100, 100, 2.8),
+        "135 mm f/2": (135, 135, 2.0),
+        "24-70 mm f/2.8": (24, 70, 2.8),
+        "70-200 mm f/2.8": (70, 200, 2.8),
+    }
+    assert set(expected) <= set(lenses)
+    for name, (short, long_, n) in expected.items():
+        lens = lenses[name]
+        assert (lens.min_focal_length_mm, lens.max_focal_length_mm, lens.widest_f_number) == (short, long_, n)
+        assert lens.is_zoom == (short != long_)
+
+
+def test_lenses_come_sorted_by_focal_length():
+    lenses = load_lens_presets(include_user=False)
+    keys = [(l.min_focal_length_mm, l.max_focal_length_mm) for l in lenses]
+    assert keys == sorted(keys)
+
+
+def test_shipped_sensors():
+    sensors = {s.name: s for s in load_sensor_presets(include_user=False)}
+    expected = {
+        "Full frame": (36, 24),
+        "APS-C": (23.5, 15.6),
+        "APS-C (Canon)": (22.3, 14.9),
+        "Micro Four Thirds": (17.3, 13),
+        "Medium format 44x33": (44, 33),
+    }
+    for name, size in expected.items():
+        assert (sensors[name].width_mm, sensors[name].height_mm) == size
+    assert sensors["Full frame"] == FULL_FRAME
+    assert len(sensors) >= 8
+
+
+def test_sensor_properties():
+    aps_c = SensorPreset("APS-C", 23.5, 15.6)
+    # crop = 43.2666 / 28.2066 = 1.5339
+    assert aps_c.crop_factor == pytest.approx(1.5339, abs=1e-4)
+    assert FULL_FRAME.crop_factor == 1.0
+    assert FULL_FRAME.aspect_ratio == 1.5
+    assert FULL_FRAME.coc_mm == pytest.approx(0.028844, rel=1e-4)
+
+
+# --- lens behaviour -------------------------------------------------------------------------
+
+def test_prime_clamps():
+    lens = LensPreset("50", focal_length_mm=50, widest_f_number=1.2, narrowest_f_number=16)
+    assert lens.clamp_focal_length(24) == 50 and lens.clamp_focal_length(85) == 50
+    assert lens.clamp_f_number(0.95) == 1.2
+    assert lens.clamp_f_number(22) == 16
+    assert lens.clamp_f_number(5.6) == 5.6
+    assert not lens.is_zoom
+
+
+def test_zoom_clamps():
+    lens = LensPreset("24-70", focal_range_mm=(24, 70), widest_f_number=2.8)
+    assert lens.clamp_focal_length(10) == 24
+    assert lens.clamp_focal_length(35) == 35
+    assert lens.clamp_focal_length(200) == 70
+    assert lens.clamp_f_number(1.4) == 2.8
+    assert lens.clamp_f_number(32) == 22  # narrowest defaults to f/22
+    assert lens.is_zoom
+
+
+def test_available_stops_include_the_lens_ends():
+    fast = LensPreset("50", focal_length_mm=50, widest_f_number=1.2, narrowest_f_number=16)
+    stops = fast.available_stops()
+    assert stops[:3] == (1.2, 1.4, 1.6) and stops[-1] == 16
+    assert step_stop(1.4, -1, stops) == 1.2
+    odd = LensPreset("odd", focal_length_mm=40, widest_f_number=1.7, narrowest_f_number=21)
+    stops = odd.available_stops(THIRD_STOPS)
+    assert stops[0] == 1.7 and stops[1] == 1.8 and stops[-2:] == (20, 21)
+
+
+@pytest.mark.parametrize(
+    "kwargs,key",
+    [
+        (dict(widest_f_number=2), "focal_length_mm"),  # neither focal field
+        (dict(focal_length_mm=50, focal_range_mm=(24, 70), widest_f_number=2), "focal_length_mm"),
+        (dict(focal_length_mm=-50, widest_f_number=2), "focal_length_mm"),
+        (dict(focal_range_mm=(70, 24), widest_f_number=2), "focal_range_mm"),
+        (dict(focal_length_mm=50, widest_f_number=0), "widest_f_number"),
+        (dict(focal_length_mm=50, widest_f_number=4, narrowest_f_number=2), "narrowest_f_number"),
+        (dict(focal_length_mm=50, widest_f_number=2, aperture_blades=2), "aperture_blades"),
+        (dict(focal_length_mm=50, widest_f_number=2, blade_roundness=1.5), "blade_roundness"),
+        (dict(focal_length_mm=50, widest_f_number=2, min_focus_distance_m=0), "min_focus_distance_m"),
+    ],
+)
+def test_direct_construction_validates(kwargs, key):
+    with pytest.raises(ValueError, match=key):
+        LensPreset("bad", **kwargs)
+
+
+def test_presets_are_frozen():
+    with pytest.raises(AttributeError):
+        FULL_FRAME.width_mm = 24
+
+
+# --- broken files ---------------------------------------------------------------------------
+
+GOOD_LENS = {"name": "Test 40", "focal_length_mm": 40, "widest_f_number": 2}
+
+BROKEN_LENSES = [
+    # (file content, key that must be named; None where the file is not JSON at all)
+    ('{"name": "x", "focal_length_mm": 40,, }', None),
+    ("[1, 2]", None),
+    ("", None),
+    ({**GOOD_LENS, "focal_lenght_mm": 50}, "focal_lenght_mm"),
+    ({k: v for k, v in GOOD_LENS.items() if k != "widest_f_number"}, "widest_f_number"),
+    ({**GOOD_LENS, "focal_length_mm": "40"}, "focal_length_mm"),
+    ({**GOOD_LENS, "focal_length_mm": -40}, "focal_length_mm"),
+    ({**GOOD_LENS, "focal_length_mm": 0}, "focal_length_mm"),
+    ({**GOOD_LENS, "widest_f_number": 0}, "widest_f_number"),
+    ({**GOOD_LENS, "widest_f_number": 200}, "widest_f_number"),
+    ({**GOOD_LENS, "narrowest_f_number": 1.4}, "narrowest_f_number"),
+    ({**GOOD_LENS, "aperture_blades": 9.5}, "aperture_blades"),
+    ({**GOOD_LENS, "aperture_blades": True}, "aperture_blades"),
+    ({**GOOD_LENS, "aperture_blades": -9}, "aperture_blades"),
+    ({**GOOD_LENS, "blade_roundness": -0.1}, "blade_roundness"),
+    ({**GOOD_LENS, "blade_rotation_deg": None}, "blade_rotation_deg"),
+    ({**GOOD_LENS, "min_focus_distance_m": -1}, "min_focus_distance_m"),
+    ({**GOOD_LENS, "name": ""}, "name"),
+    ({**GOOD_LENS, "name": 40}, "name"),
+    ({**GOOD_LENS, "focal_range_mm": [24, 70]}, "focal_length_mm"),
+    ({"name": "z", "focal_range_mm": [24], "widest_f_number": 2}, "focal_range_mm"),
+    ({"name": "z", "focal_range_mm": [70, 24], "widest_f_number": 2}, "focal_range_mm"),
+    ({"name": "z", "focal_range_mm": [50, 50], "widest_f_number": 2}, "focal_range_mm"),
+]
+
+
+@pytest.mark.parametrize("content,key", BROKEN_LENSES)
+def test_broken_lens_file_raises_naming_file_and_key(tmp_path, content, key):
+    path = write(tmp_path / "extra" / "lenses" / "broken-lens.json", content)
+    write(tmp_path / "extra" / "lenses" / "good.json", GOOD_LENS | {"name": "Fine"})
+    with pytest.raises(PresetError) as info:
+        load_lens_presets([tmp_path / "extra"])
+    message = str(info.value)
+    assert "\n" not in message
+    assert str(path) in message
+    assert info.value.path == path
+    if key is not None:
+        assert f"'{key}'" in message
+        assert info.value.key == key
+
+
+def test_bad_json_names_the_line(tmp_path):
+    write(tmp_path / "lenses" / "a.json", '{\n  "name": "x",\n  "focal_length_mm": 4 0\n}')
+    with pytest.raises(PresetError, match=r"a\.json: invalid JSON at line 3"):
+        load_lens_presets([tmp_path], include_shipped=False)
+
+
+def test_non_utf8_file(tmp_path):
+    path = tmp_path / "lenses" / "latin1.json"
+    path.parent.mkdir(parents=True)
+    path.write_bytes('{"name": "Objectif 50 mm \u00e9"}'.encode("latin-1"))
+    with pytest.raises(PresetError, match="latin1.json: not UTF-8"):
+        load_lens_presets([tmp_path], include_shipped=False)
+
+
+def test_duplicate_lens_name_in_one_folder(tmp_path):
+    write(tmp_path / "lenses" / "a.json", GOOD_LENS)
+    second = write(tmp_path / "lenses" / "b.json", GOOD_LENS)
+    with pytest.raises(PresetError) as info:
+        load_lens_presets([tmp_path], include_shipped=False)
+    assert str(second) in str(info.value) and info.value.key == "name"
+
+
+GOOD_SENSOR = {"name": "Test", "width_mm": 30, "height_mm": 20}
+
+BROKEN_SENSORS = [
+    ("{not json", None),
+    ([GOOD_SENSOR], None),  # a bare list, not {"sensors": [...]}
+    ({"sensor": [GOOD_SENSOR]}, "sensor"),
+    ({"sensors": GOOD_SENSOR}, "sensors"),
+    ({"sensors": [GOOD_SENSOR, "APS-C"]}, "sensors[1]"),
+    ({"sensors": [GOOD_SENSOR | {"width_mm": -36}]}, "sensors[0].width_mm"),
+    ({"sensors": [GOOD_SENSOR | {"height_mm": 0}]}, "sensors[0].height_mm"),
+    ({"sensors": [GOOD_SENSOR | {"height_mm": "24"}]}, "sensors[0].height_mm"),
+    ({"sensors": [GOOD_SENSOR | {"width_mm": 36000}]}, "sensors[0].width_mm"),
+    ({"sensors": [{"name": "x", "width_mm": 36}]}, "sensors[0].height_mm"),
+    ({"sensors": [GOOD_SENSOR | {"crop": 1.5}]}, "sensors[0].crop"),
+    ({"sensors": [GOOD_SENSOR, GOOD_SENSOR]}, "sensors[1].name"),
+]
+
+
+@pytest.mark.parametrize("content,key", BROKEN_SENSORS)
+def test_broken_sensor_file_raises_naming_file_and_key(tmp_path, content, key):
+    path = write(tmp_path / "sensors.json", content)
+    with pytest.raises(PresetError) as info:
+        load_sensor_presets([tmp_path])
+    message = str(info.value)
+    assert "\n" not in message and str(path) in message
+    if key is not None:
+        assert f"'{key}'" in message
+
+
+def test_broken_shipped_file_is_reported_too(tmp_path, monkeypatch):
+    """The shipped folder gets no leniency: point it at a broken copy."""
+    fake = tmp_path / "shipped"
+    write(fake / "lenses" / "24mm.json", GOOD_LENS | {"widest_f_number": 0})
+    monkeypatch.setattr(presetfiles, "shipped_presets_dir", lambda: fake)
+    with pytest.raises(PresetError, match=r"24mm\.json: 'widest_f_number'"):
+        load_lens_presets()
+
+
+def test_missing_extra_dir_is_an_error(tmp_path):
+    with pytest.raises(PresetError, match="does not exist"):
+        load_lens_presets([tmp_path / "nowhere"])
+
+
+# --- user presets and overriding ------------------------------------------------------------
+
+def test_user_dir_follows_xdg(isolated_user_dir):
+    assert user_presets_dir() == isolated_user_dir
+
+
+def test_relative_xdg_is_ignored(monkeypatch, tmp_path):
+    monkeypatch.setenv("XDG_CONFIG_HOME", "relative/config")
+    monkeypatch.setenv("HOME", str(tmp_path))
+    assert user_presets_dir() == tmp_path / ".config" / "lenslab" / "presets"
+
+
+def test_user_lens_is_added_and_can_replace_a_shipped_one(isolated_user_dir):
+    write(isolated_user_dir / "lenses" / "mine.json", {"name": "40 mm f/2", "focal_length_mm": 40, "widest_f_number": 2})
+    write(isolated_user_dir / "lenses" / "retuned.json",
+          {"name": "85 mm f/1.4", "focal_length_mm": 85, "widest_f_number": 1.4, "aperture_blades": 6})
+    write(isolated_user_dir / "lenses" / ".mine.json.swp", "editor junk")  # dot files are ignored
+    lenses = {l.name: l for l in load_lens_presets()}
+    assert lenses["40 mm f/2"].focal_length_mm == 40
+    assert lenses["85 mm f/1.4"].aperture_blades == 6
+    assert sum(1 for l in load_lens_presets() if l.name == "85 mm f/1.4") == 1
+
+
+def test_user_sensor_replaces_in_place(isolated_user_dir):
+    shipped = [s.name for s in load_sensor_presets()]
+    write(isolated_user_dir / "sensors.json",
+          {"sensors": [{"name": "APS-C", "width_mm": 23.6, "height_mm": 15.7}, {"name": "Mine", "width_mm": 10, "height_mm": 10}]})
+    sensors = load_sensor_presets()
+    assert [s.name for s in sensors] == shipped + ["Mine"]
+    assert next(s for s in sensors if s.name == "APS-C").width_mm == 23.6
+
+
+def test_extra_dirs_win_over_user(isolated_user_dir, tmp_path):
+    write(isolated_user_dir / "lenses" / "a.json", GOOD_LENS | {"aperture_blades": 5})
+    write(tmp_path / "extra" / "lenses" / "a.json", GOOD_LENS | {"aperture_blades": 7})
+    lens = next(l for l in load_lens_presets([tmp_path / "extra"]) if l.name == GOOD_LENS["name"])
+    assert lens.aperture_blades == 7
+
+
+def test_broken_user_file_is_reported(isolated_user_dir):
+    path = write(isolated_user_dir / "lenses" / "oops.json", GOOD_LENS | {"focal_length_mm": -1})
+    with pytest.raises(PresetError) as info:
+        load_lens_presets()
+    assert str(path) in str(info.value) and "'focal_length_mm'" in str(info.value)
+
+
+# --- locating the shipped folder ------------------------------------------------------------
+
+def test_installed_package_location_wins_over_checkout(tmp_path, monkeypatch):
+    """In a wheel, presets sit in lenslab/presets next to the optics package."""
+    site = tmp_path / "checkout" / "app"
+    module = site / "lenslab" / "optics" / "presetfiles.py"
+    module.parent.mkdir(parents=True)
+    module.touch()
+    monkeypatch.setattr(presetfiles, "__file__", str(module))
+    (tmp_path / "checkout" / "presets").mkdir()
+    assert presetfiles.shipped_presets_dir() == tmp_path / "checkout" / "presets"
+    (site / "lenslab" / "presets").mkdir()
+    assert presetfiles.shipped_presets_dir() == site / "lenslab" / "presets"
+
+
+def test_missing_shipped_folder_is_a_preset_error(tmp_path, monkeypatch):
+    module = tmp_path / "a" / "b" / "lenslab" / "optics" / "presetfiles.py"
+    module.parent.mkdir(parents=True)
+    monkeypatch.setattr(presetfiles, "__file__", str(module))
+    with pytest.raises(PresetError, match="shipped presets folder not found"):
+        presetfiles.shipped_presets_dir()
+
+
+def test_readme_documents_every_key():
+    readme = (REPO / "presets" / "README.md").read_text(encoding="utf-8")
+    from dataclasses import fields
+    for cls in (LensPreset, SensorPreset):
+        for f in fields(cls):
+            if f.init and f.name != "_":
+                assert f"`{f.name}`" in readme, f.name
