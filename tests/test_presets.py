@@ -1,7 +1,6 @@
 """Lens and sensor presets: every shipped file loads, every broken file is reported by name and key."""
 
 import json
-import math
 from pathlib import Path
 
 import pytest

@@ -36,6 +36,7 @@ __all__ = [
     "preset_dirs",
     "read_json",
     "build_preset",
+    "merge_by_name",
 ]
 
 
