@@ -14,6 +14,7 @@ import numpy as np
 from lenslab.scene.materials import Material
 from lenslab.scene.scene import DEFAULT_MATERIAL, Node, Scene, SceneError
 from lenslab.scene.shapes import Box, MeshFile, Rectangle, Sphere, TriangleMesh
+from lenslab.scene.io.meshes import MeshLoadError
 from lenslab.scene.transform import transform_normals, transform_points
 
 
@@ -70,7 +71,11 @@ def _mesh_for(scene: Scene, node: Node, loader) -> TriangleMesh:
     path = Path(shape.file)
     if not path.is_absolute():
         path = scene.base_dir() / path
-    return loader(path, shape.smooth)
+    try:
+        return loader(path, shape.smooth)
+    except MeshLoadError as exc:
+        where = scene.source_path or "scene"
+        raise SceneError(f"{where}: node '{node.name}': {exc}") from None
 
 
 def flatten_scene(scene: Scene, mesh_loader=None) -> FlatScene:

@@ -218,10 +218,23 @@ def scene_to_dict(scene: Scene) -> dict:
     return {FORMAT_KEY: FORMAT_VERSION, **_write_value(scene)}
 
 
+def _format_json(value: Any, indent: str = "") -> str:
+    """Indented JSON with short lists of numbers kept on one line, so that a scene file reads like a table."""
+    inner = indent + "  "
+    if isinstance(value, dict):
+        if not value:
+            return "{}"
+        items = [f"{inner}{json.dumps(k)}: {_format_json(v, inner)}" for k, v in value.items()]
+        return "{\n" + ",\n".join(items) + f"\n{indent}}}"
+    if isinstance(value, list) and any(isinstance(v, (dict, list)) for v in value):
+        return "[\n" + ",\n".join(inner + _format_json(v, inner) for v in value) + f"\n{indent}]"
+    return json.dumps(value)
+
+
 def save_scene(scene: Scene, path: str | os.PathLike) -> None:
     """Write atomically: a crash mid-save leaves the previous file intact."""
     path = Path(path)
-    text = json.dumps(scene_to_dict(scene), indent=2) + "\n"
+    text = _format_json(scene_to_dict(scene)) + "\n"
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as f:

@@ -1,0 +1,250 @@
+"""The ``lenslab`` command: open the studio, or render a scene to a file without a window.
+
+``--headless`` never imports Qt. Every failure a user can cause (a bad argument, a broken scene, no GPU
+driver, an unwritable output) ends with a non-zero exit status and one line on stderr, never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import os
+import sys
+import time
+from pathlib import Path
+
+from lenslab import __version__
+
+EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
+HEADLESS_DISPATCH_SECONDS = 0.25
+
+
+class CliError(Exception):
+    """A failure to report as one line, with an exit status."""
+
+    def __init__(self, message: str, status: int = EXIT_ERROR):
+        super().__init__(message)
+        self.status = status
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str):  # one line, not argparse's usage block
+        raise CliError(f"{message} (see lenslab --help)", EXIT_USAGE)
+
+
+def _number(kind, low: float, high: float, what: str):
+    def parse(text: str):
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{what} must be a number, not '{text}'") from None
+        if not low <= value <= high or value != value:
+            raise argparse.ArgumentTypeError(f"{what} {text} is out of range [{low:g}, {high:g}]")
+        return value
+
+    return parse
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = _Parser(
+        prog="lenslab",
+        description="LensLab: a photographic studio on a physically based path tracer. Without --headless it "
+        "opens the studio window; with --headless it renders SCENE to a file and exits.",
+        epilog="Examples:\n"
+        "  lenslab cornell_box --headless -o cornell.png --spp 64\n"
+        "  lenslab my_scene.json --headless -o shot.exr --f-stop 1.4 --focus-distance 2.5 --time-limit 60\n"
+        "Focal length, f-number and focus distance override the scene's camera for this render only; "
+        "brightness does not change with the f-number. Shipped scenes: cornell_box, dof_chart.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("scene", nargs="?", help="a scene file (.json), a folder holding scene.json, or a shipped scene name")
+    p.add_argument("--headless", action="store_true", help="render to a file without opening a window")
+    p.add_argument("-o", "--output", metavar="FILE", help="where to write the image: .exr (linear, float) or .png (sRGB)")
+    p.add_argument("--spp", type=_number(int, 1, 1 << 24, "--spp"), metavar="N",
+                   help="samples per pixel (default: the scene's; with --time-limit alone, as many as fit)")
+    p.add_argument("--time-limit", type=_number(float, 0.001, 1e7, "--time-limit"), metavar="SECONDS",
+                   help="stop after this long, keeping what has been rendered")
+    p.add_argument("--width", type=_number(int, 1, 16384, "--width"), metavar="W", help="image width in pixels")
+    p.add_argument("--height", type=_number(int, 1, 16384, "--height"), metavar="H", help="image height in pixels")
+    p.add_argument("--f-stop", type=_number(float, 0.5, 128, "--f-stop"), metavar="N",
+                   help="aperture as an f-number (1.4 is wide open and blurry, 16 is deep focus)")
+    p.add_argument("--focal-length", type=_number(float, 1, 2000, "--focal-length"), metavar="MM",
+                   help="lens focal length in millimetres (sets the field of view with the sensor width)")
+    p.add_argument("--focus-distance", type=_number(float, 0.01, 1e6, "--focus-distance"), metavar="M",
+                   help="distance to the plane of focus, in metres")
+    p.add_argument("--seed", type=_number(int, 0, 2**31 - 1, "--seed"), metavar="S",
+                   help="random seed: the same seed gives the same image")
+    p.add_argument("--max-depth", type=_number(int, 1, 1024, "--max-depth"), metavar="D",
+                   help="longest light path in segments (2 = direct light only)")
+    p.add_argument("--sampler", choices=("sobol", "independent"), help="sample pattern (default: the scene's)")
+    p.add_argument("--exposure", type=_number(float, -30, 30, "--exposure"), default=0.0, metavar="STOPS",
+                   help="PNG only: brighten (+) or darken (-) by this many stops")
+    p.add_argument("--tone-map", choices=("clamp", "reinhard", "filmic"), default="clamp",
+                   help="PNG only: how radiance above 1 is brought into the displayable range")
+    p.add_argument("--device", type=_number(int, 0, 64, "--device"), metavar="N", help="which GPU to use (EGL device index)")
+    p.add_argument("--info", action="store_true", help="print the OpenGL device and the limits in use, then exit")
+    p.add_argument("--version", action="version", version=f"lenslab {__version__}")
+    return p
+
+
+# ---------------------------------------------------------------------------------------------------------
+def _print_info(device: int | None) -> int:
+    from lenslab.render.tracer import Renderer
+
+    renderer = Renderer(device)
+    width = max(len(k) for k in renderer.describe())
+    for key, value in renderer.describe().items():
+        print(f"{key:<{width}}  {value}")
+    renderer.release()
+    return EXIT_OK
+
+
+def _check_output(path_text: str | None) -> Path:
+    from lenslab.render.film import EXPORT_SUFFIXES
+
+    if not path_text:
+        raise CliError("--headless needs an output file: -o OUT.exr or -o OUT.png", EXIT_USAGE)
+    path = Path(path_text)
+    if path.suffix.lower() not in EXPORT_SUFFIXES:
+        raise CliError(f"{path}: unsupported output type '{path.suffix}' (use .exr or .png)", EXIT_USAGE)
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise CliError(f"{path}: folder '{folder}' does not exist")
+    if not os.access(folder, os.W_OK):
+        raise CliError(f"{path}: folder '{folder}' is not writable")
+    return path
+
+
+def _apply_overrides(scene, args):
+    camera_changes = {}
+    if args.f_stop is not None:
+        camera_changes["f_number"] = args.f_stop
+    if args.focal_length is not None:
+        camera_changes["focal_length_mm"] = args.focal_length
+    if args.focus_distance is not None:
+        camera_changes["focus_distance_m"] = args.focus_distance
+    if args.width is not None or args.height is not None:
+        width, height = scene.camera.resolution
+        if args.width and not args.height:  # keep the scene's aspect ratio
+            height = max(1, round(args.width * height / width))
+        elif args.height and not args.width:
+            width = max(1, round(args.height * width / height))
+        camera_changes["resolution"] = (args.width or width, args.height or height)
+    render_changes = {k: v for k, v in (("seed", args.seed), ("max_depth", args.max_depth),
+                                        ("sampler", args.sampler), ("spp", args.spp)) if v is not None}
+    return dataclasses.replace(scene, camera=dataclasses.replace(scene.camera, **camera_changes),
+                               render=dataclasses.replace(scene.render, **render_changes))
+
+
+def image_metadata(scene, spp: int) -> dict[str, object]:
+    """Camera settings under Exif's names where it has one, LensLab's own otherwise."""
+    cam = scene.camera
+    sensor_w, sensor_h = cam.sensor_mm
+    width, height = cam.resolution
+    crop_factor = (36.0**2 + 24.0**2) ** 0.5 / (sensor_w**2 + sensor_h**2) ** 0.5
+    return {
+        "Software": f"LensLab {__version__}",
+        "Exif:FNumber": float(cam.f_number),
+        "Exif:FocalLength": float(cam.focal_length_mm),
+        "Exif:FocalLengthIn35mmFilm": int(round(cam.focal_length_mm * crop_factor)),
+        "Exif:SubjectDistance": float(cam.focus_distance_m),
+        # Sensor size in Exif's terms: pixels per centimetre of focal plane.
+        "Exif:FocalPlaneXResolution": float(width / (sensor_w / 10.0)),
+        "Exif:FocalPlaneYResolution": float(width / (sensor_w / 10.0)),
+        "Exif:FocalPlaneResolutionUnit": 3,
+        "lenslab:SensorWidthMM": float(sensor_w),
+        "lenslab:SensorHeightMM": float(sensor_h),
+        "lenslab:FocusDistanceM": float(cam.focus_distance_m),
+        "lenslab:ApertureBlades": int(cam.aperture_blades),
+        "lenslab:SamplesPerPixel": int(spp),
+        "lenslab:Seed": int(scene.render.seed),
+        "lenslab:MaxDepth": int(scene.render.max_depth),
+        "lenslab:Sampler": scene.render.sampler,
+    }
+
+
+def _progress_display(total_spp: int | None, time_limit: float | None):
+    """A rich progress bar on a terminal; nothing when stderr is a file or pipe."""
+    from rich.console import Console
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+
+    console = Console(stderr=True)
+    return Progress(
+        TextColumn("[bold]rendering"), BarColumn(), TextColumn("{task.fields[status]}"),
+        TimeElapsedColumn(), TimeRemainingColumn(), console=console, disable=not console.is_terminal, transient=False,
+    )
+
+
+def render_headless(args) -> int:
+    from lenslab.render.film import write_image
+    from lenslab.render.tracer import Renderer, RenderSession
+    from lenslab.scene.io.loader import open_scene
+
+    output = _check_output(args.output)
+    scene = _apply_overrides(open_scene(args.scene), args)
+    target_spp = args.spp if args.spp is not None else (None if args.time_limit else scene.render.spp)
+    renderer = Renderer(args.device)
+    session = RenderSession(renderer, scene, dispatch_seconds=HEADLESS_DISPATCH_SECONDS)
+    start = time.perf_counter()
+    deadline = start + args.time_limit if args.time_limit else None
+    with _progress_display(target_spp, args.time_limit) as bar:
+        task = bar.add_task("render", total=target_spp or args.time_limit, status="")
+        while True:
+            remaining = deadline - time.perf_counter() if deadline else 0.5
+            if remaining <= 0 or (target_spp and session.done(target_spp)):
+                break
+            progress = session.step(min(0.5, remaining), target_spp)
+            done = progress.samples_per_pixel if target_spp else time.perf_counter() - start
+            bar.update(task, completed=done,
+                       status=f"{progress.samples_per_pixel} spp, {progress.samples_per_second / 1e6:.2f} M samples/s")
+    spp = session.samples_per_pixel
+    if spp == 0:  # a time limit shorter than one pass: keep what every pixel has
+        session.step(0.0, 1)
+        spp = session.samples_per_pixel
+    image = session.image()
+    write_image(output, image, image_metadata(scene, spp), exposure_stops=args.exposure, tone_map_operator=args.tone_map)
+    seconds = time.perf_counter() - start
+    print(f"wrote {output} ({session.width}x{session.height}, {spp} spp, {seconds:.1f} s)", file=sys.stderr)
+    session.release()
+    renderer.release()
+    return EXIT_OK
+
+
+def run(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    if args.info:
+        return _print_info(args.device)
+    if args.headless:
+        if not args.scene:
+            raise CliError("--headless needs a scene to render", EXIT_USAGE)
+        return render_headless(args)
+    from lenslab.gui.app import run_studio  # only the studio imports Qt
+
+    return run_studio(args)
+
+
+def main(argv: list[str] | None = None) -> int:
+    from lenslab.optics.presetfiles import PresetError
+    from lenslab.render.buffers import SceneTooLarge
+    from lenslab.render.film import ExportError
+    from lenslab.render.gl import GLUnavailable
+    from lenslab.scene.scene import SceneError
+
+    try:
+        return run(argv)
+    except CliError as exc:
+        print(f"lenslab: error: {exc}", file=sys.stderr)
+        return exc.status
+    except (SceneError, GLUnavailable, SceneTooLarge, ExportError, PresetError, ValueError) as exc:
+        print(f"lenslab: error: {exc}", file=sys.stderr)
+        return EXIT_ERROR
+    except KeyboardInterrupt:
+        print("lenslab: interrupted; nothing was written", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except OSError as exc:
+        print(f"lenslab: error: {exc}", file=sys.stderr)
+        return EXIT_ERROR
+
+
+if __name__ == "__main__":
+    sys.exit(main())
