@@ -1,0 +1,543 @@
+"""SAH kd-tree (axis-aligned BSP) built level by level in numpy, flattened for a GPU traversal.
+
+A kd-tree splits space, not primitives: every interior node cuts its box in two with an axis-aligned
+plane, and a primitive that straddles the plane is referenced by both children. Rays walk the tree front
+to back and can stop at the first leaf that holds a hit closer than the leaf's far end, which makes
+kd-trees the fastest acceleration structure for static scenes traced on a GPU with a short stack.
+
+The flat layout (a contract with ``glsl/bsp.glsl``)
+---------------------------------------------------
+``nodes`` is an (M, 2) uint32 array, one 8-byte node per row, root at row 0, in depth-first order:
+
+* interior node: ``nodes[i, 0]`` holds the float32 bits of the split position,
+  ``nodes[i, 1] = (above_child << 2) | axis`` with ``axis`` in {0, 1, 2}. The *below* child, the region
+  with ``p[axis] < split``, is always row ``i + 1``; ``above_child`` is the row of the region with
+  ``p[axis] >= split``.
+* leaf: ``nodes[i, 1] = (prim_count << 2) | 3`` and ``nodes[i, 0]`` is the offset of the leaf's first
+  entry in ``prim_refs``; the leaf's primitives are ``prim_refs[offset : offset + prim_count]``.
+
+``bounds`` is the root box. The depth of the tree never exceeds ``max_depth_limit``; a front-to-back
+traversal pushes at most one far child per level, so a stack of ``max_depth`` entries is enough.
+
+Which side gets a primitive
+---------------------------
+The below region is open at the plane and the above region is closed: a point exactly on the plane
+belongs above. A primitive (with box ``[lo, hi]`` on the split axis) goes below when ``lo < split`` and
+above when ``hi > split`` or ``lo >= split``. Hence a box that only touches the plane from below stays
+below alone, and a flat primitive lying in the plane (``lo == hi == split``) goes above alone, which is
+where a ray travelling inside the plane (direction component 0, origin on the plane) is sent.
+
+The build
+---------
+The surface area heuristic (MacDonald and Booth 1990; pbrt-v3 section 4.4) estimates the cost of a
+split as ``C_trav + C_isect * (1 - bonus) * (P_below N_below + P_above N_above)`` where ``P`` is the
+child's surface area over the node's, and compares it with the leaf cost ``C_isect * N``. ``bonus`` is
+pbrt's empty-space bonus, granted to cuts that leave one side empty: cutting away empty space is what
+makes kd-trees fast. Candidate planes are the boundaries of a few bins per axis (binned SAH, Wald and
+Havran 2006) rather than all primitive edges, so one level costs a handful of whole-array passes.
+
+A per-node recursive build in Python costs minutes per million triangles, so the build here works one
+*level* at a time: all references of all nodes of a level live in flat arrays, grouped by node, and
+every step (binning, prefix sums, choosing the best plane, partitioning) is a whole-array numpy
+operation over (node, axis, bin) keys. The only Python loops run over levels and over the three axes.
+
+When a triangle straddles a plane, each copy gets the bounds of the part of the triangle on its own
+side, intersected with its previous (already clipped) bounds. That keeps the references tight (a
+triangle crossing one corner of a node does not drag the whole node into the next SAH decisions) and
+drops the reference entirely when the triangle's box crosses the plane but the triangle does not.
+Spheres, and all primitives when no triangles are given, are clipped as boxes.
+
+Finally the level-order tree is renumbered depth first with prefix sums over subtree sizes.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+LEAF = 3
+"""Value of the two low bits of ``nodes[i, 1]`` that marks a leaf (axes are 0, 1 and 2)."""
+
+# Default SAH costs, in units of one node traversal step. On a GPU (and on llvmpipe, which runs eight
+# lanes in lockstep) a triangle test reads three vec4s and does about twenty flops, while a traversal
+# step reads one 8-byte node and may push the stack; 1.5 favours slightly shallower trees than pbrt's
+# CPU-tuned 1 : 80, which keeps the node array small and the stack short.
+TRAVERSAL_COST = 1.0
+INTERSECTION_COST = 1.5
+EMPTY_BONUS = 0.5  # pbrt-v3's value: a cut with one empty side costs half as much
+
+
+@dataclass(frozen=True)
+class KdTree:
+    """A flattened kd-tree; see the module docstring for the layout of ``nodes`` and ``prim_refs``."""
+
+    nodes: np.ndarray  # (M, 2) uint32
+    prim_refs: np.ndarray  # (R,) int32
+    bounds: np.ndarray  # (2, 3) float32, [min, max] of the root
+    max_depth: int  # deepest level reached, root = 0
+    max_depth_limit: int  # the cap the build honoured
+    build_seconds: float
+    node_count: int
+    leaf_count: int
+    empty_leaf_count: int
+    refs_per_prim: float  # R / N
+    sah_cost: float  # expected cost of a ray through the root, in traversal-step units
+    params: dict = field(default_factory=dict, compare=False)
+
+
+def default_depth_limit(prim_count: int) -> int:
+    """The depth cap: ``min(40, round(8 + 1.3 log2 N))``. The GPU stack is sized from it."""
+    return int(min(40, round(8 + 1.3 * math.log2(max(prim_count, 1)))))
+
+
+def build_kdtree(
+    prim_bounds: np.ndarray,
+    *,
+    triangles: np.ndarray | None = None,
+    traversal_cost: float = TRAVERSAL_COST,
+    intersection_cost: float = INTERSECTION_COST,
+    empty_bonus: float = EMPTY_BONUS,
+    max_bins: int = 64,
+    min_bins: int = 8,
+    leaf_prims: int = 2,
+    max_depth_limit: int | None = None,
+) -> KdTree:
+    """Build an SAH kd-tree over primitives given by their boxes.
+
+    prim_bounds: (N, 2, 3) float32 boxes ``[min, max]``, one per primitive; the row is the primitive
+        index stored in ``prim_refs``. Flat boxes (a triangle in an axis plane) are fine.
+    triangles: optional (T, 3, 3) vertices of the first T primitives; used to clip straddling triangles
+        exactly to each side of a split, which keeps references per triangle low.
+    traversal_cost, intersection_cost, empty_bonus: the SAH constants (see module docstring).
+    max_bins, min_bins: split candidates per axis and node are the boundaries of
+        ``clip(n_refs, min_bins, max_bins)`` equal bins.
+    leaf_prims: a node with this many references or fewer becomes a leaf without evaluating the SAH.
+    max_depth_limit: depth cap (root = 0); ``default_depth_limit(N)`` when None.
+    """
+    start = time.perf_counter()
+    prim_bounds = np.ascontiguousarray(prim_bounds, dtype=np.float32).reshape(-1, 2, 3)
+    prim_count = len(prim_bounds)
+    if triangles is not None:
+        triangles = np.ascontiguousarray(triangles, dtype=np.float32).reshape(-1, 3, 3)
+        if len(triangles) > prim_count:
+            raise ValueError("more triangles than primitive boxes")
+    depth_limit = default_depth_limit(prim_count) if max_depth_limit is None else int(max_depth_limit)
+    if not 0 <= depth_limit <= 64:
+        raise ValueError("max_depth_limit must lie in [0, 64]")
+    costs = _Costs(float(traversal_cost), float(intersection_cost), float(empty_bonus))
+
+    root = root_bounds(prim_bounds)
+    refs = _Refs(
+        node=np.zeros(prim_count, np.int32),
+        prim=np.arange(prim_count, dtype=np.int32),
+        lo=np.ascontiguousarray(prim_bounds[:, 0].T),
+        hi=np.ascontiguousarray(prim_bounds[:, 1].T),
+    )
+    node_lo, node_hi = root[0][:, None].copy(), root[1][:, None].copy()
+
+    levels: list[_Level] = []
+    while True:
+        depth = len(levels)
+        level = _Level(node_lo, node_hi, np.bincount(refs.node, minlength=node_lo.shape[1]))
+        levels.append(level)
+        # Small nodes and nodes at the depth cap are leaves whatever the SAH says.
+        level.is_leaf = (level.counts <= leaf_prims) | (depth >= depth_limit)
+        refs = level.emit_leaf_refs(refs)
+        if len(refs) == 0:
+            break
+        cost, axis, split = _best_splits(refs, level, costs, min_bins, max_bins)
+        level.is_leaf |= ~(cost < costs.intersection * level.counts)
+        level.axis, level.split = axis, split
+        refs = level.emit_leaf_refs(refs)
+        if len(refs) == 0:
+            break
+        refs, node_lo, node_hi = _split_level(refs, level, triangles)
+
+    nodes, prim_refs = _flatten(levels)
+    leaf_counts = np.concatenate([lv.counts[lv.is_leaf] for lv in levels])
+    return KdTree(
+        nodes=nodes,
+        prim_refs=prim_refs,
+        bounds=root,
+        max_depth=len(levels) - 1,
+        max_depth_limit=depth_limit,
+        build_seconds=time.perf_counter() - start,
+        node_count=len(nodes),
+        leaf_count=len(leaf_counts),
+        empty_leaf_count=int(np.count_nonzero(leaf_counts == 0)),
+        refs_per_prim=len(prim_refs) / max(prim_count, 1),
+        sah_cost=_tree_sah_cost(levels, root, costs),
+        params=dict(
+            traversal_cost=costs.traversal,
+            intersection_cost=costs.intersection,
+            empty_bonus=costs.empty_bonus,
+            max_bins=max_bins,
+            min_bins=min_bins,
+            leaf_prims=leaf_prims,
+        ),
+    )
+
+
+def root_bounds(prim_bounds: np.ndarray) -> np.ndarray:
+    """Union of the primitive boxes, padded so that no axis has zero extent.
+
+    Every axis grows by a few ulps, so that geometry on the root's faces stays strictly inside it under
+    the rounding of a ray-box test; an axis of zero extent (a ground plane of flat triangles) grows by
+    1e-4 of the largest extent, or by 1e-4 when the whole scene is a point.
+    """
+    if len(prim_bounds) == 0:
+        lo = np.zeros(3, np.float32)
+        hi = np.zeros(3, np.float32)
+    else:
+        lo = prim_bounds[:, 0].min(axis=0)
+        hi = prim_bounds[:, 1].max(axis=0)
+    extent = hi - lo
+    largest = float(extent.max())
+    flat_pad = 1e-4 * largest if largest > 0 else 1e-4
+    pad = np.where(extent > 0, 0, flat_pad).astype(np.float32)
+    pad += 4 * np.maximum(np.spacing(np.abs(lo)), np.spacing(np.abs(hi)))
+    return np.stack([lo - pad, hi + pad]).astype(np.float32)
+
+
+# --------------------------------------------------------------------------------------------------
+# Build state
+
+
+@dataclass(frozen=True)
+class _Costs:
+    traversal: float
+    intersection: float
+    empty_bonus: float
+
+
+class _Refs:
+    """The primitive references of one level, grouped by node (``node`` is non-decreasing).
+
+    ``lo`` and ``hi`` are (3, R) so that one axis is one contiguous row; they are the reference's
+    bounds clipped to its node's box (and, for triangles, to the part of the triangle inside it).
+    """
+
+    __slots__ = ("node", "prim", "lo", "hi")
+
+    def __init__(self, node, prim, lo, hi):
+        self.node, self.prim, self.lo, self.hi = node, prim, lo, hi
+
+    def __len__(self) -> int:
+        return len(self.node)
+
+    def take(self, index: np.ndarray) -> _Refs:
+        return _Refs(self.node[index], self.prim[index], self.lo[:, index], self.hi[:, index])
+
+
+class _Level:
+    """One level of the tree in level order: node boxes, decisions, and the references of its leaves.
+
+    The i-th interior node (in node order) has its below child at index i of the next level and its
+    above child at index ``S + i``, S being the number of interior nodes. With that numbering, keeping
+    the order of the references when partitioning leaves the next level grouped by node again.
+    """
+
+    def __init__(self, lo: np.ndarray, hi: np.ndarray, counts: np.ndarray):
+        self.lo, self.hi, self.counts = lo, hi, counts
+        self.is_leaf = np.ones(len(counts), bool)
+        self.axis = np.zeros(len(counts), np.int8)
+        self.split = np.zeros(len(counts), np.float32)
+        self.leaf_chunks: list[tuple[np.ndarray, np.ndarray]] = []  # (node, prim), grouped by node
+
+    def emit_leaf_refs(self, refs: _Refs) -> _Refs:
+        """Move the references of nodes now marked as leaves out of ``refs`` into this level."""
+        in_leaf = self.is_leaf[refs.node]
+        if not in_leaf.any():
+            return refs
+        leaf = np.flatnonzero(in_leaf)
+        self.leaf_chunks.append((refs.node[leaf], refs.prim[leaf]))
+        return refs.take(np.flatnonzero(~in_leaf))
+
+
+# --------------------------------------------------------------------------------------------------
+# Choosing the split planes of one level
+
+
+def _best_splits(refs: _Refs, level: _Level, costs: _Costs, min_bins: int, max_bins: int):
+    """Binned SAH for every node of a level at once.
+
+    Returns per node the best split's cost (inf where there is none), axis and position.
+
+    Node k gets ``B_k`` bins per axis; its bins occupy the slots ``off_k .. off_k + B_k - 1`` of one
+    flat array, so the bin of every reference is a single key and counting is one ``bincount``. Slot b
+    of node k stands for the plane at the upper boundary of bin b; the last slot (the node's far face)
+    is never a candidate.
+    """
+    node_count = len(level.counts)
+    has_refs = np.bincount(refs.node, minlength=node_count) > 0
+    bins = np.where(has_refs, np.clip(level.counts, min_bins, max_bins), 1).astype(np.int64)
+    first_slot = np.concatenate([[0], np.cumsum(bins)])
+    slot_count = int(first_slot[-1])
+    first_slot = first_slot[:-1]
+    slot_node = np.repeat(np.arange(node_count), bins)
+    local = np.arange(slot_count) - first_slot[slot_node]
+    frac = ((local + 1) / bins[slot_node]).astype(np.float32)  # plane position in node extents
+    is_far_face = local == bins[slot_node] - 1
+
+    extent = level.hi - level.lo
+    half_area = _half_area(extent)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv_area = np.where(half_area > 0, 1 / half_area, 0).astype(np.float32)
+
+    # Per reference: its node's first slot and last bin, shared by the three axes.
+    ref_first = first_slot[refs.node]
+    ref_last_bin = (bins - 1).astype(np.float32)[refs.node]
+    ref_count = level.counts.astype(np.float32)[slot_node]
+
+    best_cost = np.full(slot_count, np.inf, np.float32)
+    best_axis = np.zeros(slot_count, np.int8)
+    for axis in range(3):
+        with np.errstate(divide="ignore"):
+            bins_per_unit = np.where(extent[axis] > 0, bins / extent[axis], 0).astype(np.float32)
+        ref_origin = level.lo[axis][refs.node]
+        ref_scale = bins_per_unit[refs.node]
+        starts = _bin_histogram(refs.lo[axis], ref_origin, ref_scale, ref_last_bin, ref_first, slot_count)
+        ends = _bin_histogram(refs.hi[axis], ref_origin, ref_scale, ref_last_bin, ref_first, slot_count)
+        # A reference is below the plane after bin b if it starts in a bin <= b, above if it ends in a
+        # bin > b: segmented prefix sums over each node's slots.
+        n_below = _segmented_cumsum(starts, first_slot, slot_node)
+        n_above = ref_count - _segmented_cumsum(ends, first_slot, slot_node)
+
+        # Child areas relative to the node: with e the extent on the split axis and u, v the others,
+        # half area = e (u + v) + u v, and the below child has e scaled by frac.
+        u, v = extent[(axis + 1) % 3], extent[(axis + 2) % 3]
+        side = ((u * v) * inv_area)[slot_node]
+        spread = ((extent[axis] * (u + v)) * inv_area)[slot_node]
+        p_below = side + frac * spread
+        p_above = np.float32(1) - frac * spread
+        weight = np.where(
+            (n_below == 0) | (n_above == 0), np.float32(1 - costs.empty_bonus), np.float32(1)
+        )
+        cost = costs.traversal + costs.intersection * weight * (p_below * n_below + p_above * n_above)
+        cost[is_far_face | (extent[axis] <= 0)[slot_node]] = np.inf
+        better = cost < best_cost
+        best_cost = np.where(better, cost, best_cost)
+        best_axis[better] = axis
+
+    node_best = np.minimum.reduceat(best_cost, first_slot) if slot_count else best_cost
+    candidate = np.where(best_cost <= node_best[slot_node], np.arange(slot_count), slot_count)
+    slot = np.minimum.reduceat(candidate, first_slot)
+    axis = best_axis[slot]
+    nodes = np.arange(node_count)
+    lo, ext = level.lo[axis, nodes], extent[axis, nodes]
+    split = (lo + ((local[slot] + 1) * (ext / bins)).astype(np.float32)).astype(np.float32)
+    # Rounding can put the plane of a tiny node on its face; such a split would be useless.
+    inside = (split > lo) & (split < level.hi[axis, nodes]) & has_refs
+    return np.where(inside, node_best, np.inf), axis, split
+
+
+def _bin_histogram(coord, origin, scale, last_bin, first_slot, slot_count) -> np.ndarray:
+    """Count references per (node, bin) slot for one bound (min or max) on one axis."""
+    t = coord - origin
+    t *= scale
+    np.minimum(t, last_bin, out=t)  # the far face falls in the last bin; t >= 0 by clipping
+    key = t.astype(np.int32) + first_slot
+    return np.bincount(key, minlength=slot_count)
+
+
+def _segmented_cumsum(counts, first_slot, slot_node) -> np.ndarray:
+    """Inclusive prefix sums that restart at every node's first slot, as float32."""
+    total = np.cumsum(counts)
+    before = (total - counts)[first_slot]
+    return (total - before[slot_node]).astype(np.float32)
+
+
+def _half_area(extent: np.ndarray) -> np.ndarray:
+    """Half the surface area of boxes with extents (3, K)."""
+    x, y, z = extent
+    return x * y + y * z + z * x
+
+
+# --------------------------------------------------------------------------------------------------
+# Partitioning the references of one level into the next
+
+
+def _split_level(refs: _Refs, level: _Level, triangles: np.ndarray | None):
+    """Send every reference of an interior node to the child (or children) it overlaps.
+
+    Returns the references and the node boxes of the next level.
+    """
+    interior = ~level.is_leaf
+    child = (np.cumsum(interior) - 1).astype(np.int32)  # below child's index; above is S + child
+    split_count = int(interior.sum())
+
+    ref_count = len(refs)
+    axis = level.axis[refs.node].astype(np.intp)
+    split = level.split[refs.node]
+    flat = axis * ref_count + np.arange(ref_count)
+    lo = refs.lo.reshape(-1).take(flat)
+    hi = refs.hi.reshape(-1).take(flat)
+    below = lo < split
+    above = (hi > split) | ~below
+    straddle = np.flatnonzero(below & (hi > split))
+
+    clipped = _clip_straddlers(refs, straddle, axis[straddle], split[straddle], triangles)
+    below_lo, below_hi, below_ok, above_lo, above_hi, above_ok = clipped
+    below[straddle[~below_ok]] = False
+    above[straddle[~above_ok]] = False
+
+    to_below = np.flatnonzero(below)
+    to_above = np.flatnonzero(above)
+    node = np.concatenate([child[refs.node[to_below]], split_count + child[refs.node[to_above]]])
+    take = np.concatenate([to_below, to_above])
+    nxt = _Refs(node, refs.prim[take], refs.lo[:, take], refs.hi[:, take])
+    # Overwrite the straddlers' bounds with their clipped ones, at their new positions.
+    at_below = np.searchsorted(to_below, straddle[below_ok])
+    at_above = len(to_below) + np.searchsorted(to_above, straddle[above_ok])
+    nxt.lo[:, at_below], nxt.hi[:, at_below] = below_lo[:, below_ok], below_hi[:, below_ok]
+    nxt.lo[:, at_above], nxt.hi[:, at_above] = above_lo[:, above_ok], above_hi[:, above_ok]
+
+    # Children's boxes: the parent's, cut at the plane.
+    s_axis = level.axis[interior].astype(np.intp)
+    s_pos = level.split[interior]
+    columns = np.arange(split_count)
+    node_lo = np.concatenate([level.lo[:, interior], level.lo[:, interior]], axis=1)
+    node_hi = np.concatenate([level.hi[:, interior], level.hi[:, interior]], axis=1)
+    node_hi[s_axis, columns] = s_pos
+    node_lo[s_axis, split_count + columns] = s_pos
+    return nxt, node_lo, node_hi
+
+
+def _clip_straddlers(refs: _Refs, index, axis, split, triangles):
+    """Bounds of the below and above parts of the references ``index`` that straddle their plane.
+
+    Boxes are simply cut at the plane. Triangles are cut exactly (see ``_triangle_half_bounds``) and
+    the result intersected with the box they had, which may leave one side empty: the triangle's box
+    crossed the plane but the triangle, inside this node, does not.
+    Returns (below_lo, below_hi, below_ok, above_lo, above_hi, above_ok), bounds as (3, S).
+    """
+    columns = np.arange(len(index))
+    below_lo, below_hi = refs.lo[:, index], refs.hi[:, index]
+    above_lo, above_hi = below_lo.copy(), below_hi.copy()
+    below_hi[axis, columns] = split
+    above_lo[axis, columns] = split
+    if triangles is not None and len(index):
+        prim = refs.prim[index]
+        tri = np.flatnonzero(prim < len(triangles))
+        if len(tri):
+            b_lo, b_hi, a_lo, a_hi = _triangle_half_bounds(triangles[prim[tri]], axis[tri], split[tri])
+            below_lo[:, tri] = np.maximum(below_lo[:, tri], b_lo)
+            below_hi[:, tri] = np.minimum(below_hi[:, tri], b_hi)
+            above_lo[:, tri] = np.maximum(above_lo[:, tri], a_lo)
+            above_hi[:, tri] = np.minimum(above_hi[:, tri], a_hi)
+    below_ok = (below_lo <= below_hi).all(axis=0)
+    above_ok = (above_lo <= above_hi).all(axis=0)
+    return below_lo, below_hi, below_ok, above_lo, above_hi, above_ok
+
+
+def _triangle_half_bounds(vertices, axis, split):
+    """Bounds (3, m) of the parts of m triangles below and above their planes ``p[axis] = split``.
+
+    The part of a triangle on one side is the polygon made of its vertices on that side and the points
+    where its edges cross the plane; its bounds are those points' bounds. The below part is empty
+    unless a vertex lies strictly below; the above part is empty unless a vertex lies strictly above,
+    or the triangle lies in the plane (which belongs to the above region). Empty bounds are
+    (+inf, -inf). Crossing points are computed in float32, so all bounds are padded by a few ulps to
+    stay conservative.
+    """
+    m = len(vertices)
+    dist = vertices[np.arange(m), :, axis] - split[:, None]  # (m, 3): signed, exact in sign
+    nxt_vertices, nxt_dist = np.roll(vertices, -1, axis=1), np.roll(dist, -1, axis=1)
+    crosses = ((dist < 0) & (nxt_dist > 0)) | ((dist > 0) & (nxt_dist < 0))  # edge i -> i + 1
+    t = dist / np.where(crosses, dist - nxt_dist, 1)
+    crossing = vertices + t[..., None] * (nxt_vertices - vertices)
+    points = np.concatenate([vertices, crossing], axis=1)  # (m, 6, 3)
+
+    has_below = (dist < 0).any(axis=1, keepdims=True)
+    in_plane = (dist == 0).all(axis=1, keepdims=True)
+    has_above = (dist > 0).any(axis=1, keepdims=True) | in_plane
+    use_below = np.concatenate([(dist <= 0) & has_below, crosses], axis=1)
+    use_above = np.concatenate([(dist >= 0) & has_above, crosses], axis=1)
+
+    pad = np.abs(vertices).max(axis=1) * np.float32(2.0**-20)  # (m, 3), about 8 ulps
+
+    def bounds(use):
+        lo = np.where(use[..., None], points, np.inf).min(axis=1) - pad
+        hi = np.where(use[..., None], points, -np.inf).max(axis=1) + pad
+        return lo.T.astype(np.float32), hi.T.astype(np.float32)
+
+    return (*bounds(use_below), *bounds(use_above))
+
+
+# --------------------------------------------------------------------------------------------------
+# Flattening
+
+
+def _flatten(levels: list[_Level]):
+    """Renumber the level-order tree depth first and write the node and reference arrays."""
+    # Subtree sizes, bottom up: an interior node is itself plus its two children's subtrees.
+    sizes = [None] * len(levels)
+    below_size = [None] * len(levels)
+    next_size = np.zeros(0, np.int64)
+    for d in range(len(levels) - 1, -1, -1):
+        lv = levels[d]
+        size = np.ones(len(lv.counts), np.int64)
+        split_count = int((~lv.is_leaf).sum())
+        if split_count:
+            below_size[d] = next_size[:split_count]
+            size[~lv.is_leaf] += next_size[:split_count] + next_size[split_count:]
+        sizes[d] = next_size = size
+    node_total = int(sizes[0][0])
+
+    # Depth-first indices, top down: below child right after its parent, above child after the
+    # below child's whole subtree.
+    dfs = [np.zeros(1, np.int64)]
+    for d, lv in enumerate(levels[:-1]):
+        parent = dfs[d][~lv.is_leaf]
+        dfs.append(np.concatenate([parent + 1, parent + 1 + below_size[d]]))
+
+    nodes = np.zeros((node_total, 2), np.uint32)
+    for d, lv in enumerate(levels):
+        interior = ~lv.is_leaf
+        if interior.any():
+            above = dfs[d + 1][int(interior.sum()) :]
+            at = dfs[d][interior]
+            nodes[at, 0] = lv.split[interior].view(np.uint32)
+            nodes[at, 1] = (above.astype(np.uint32) << 2) | lv.axis[interior].astype(np.uint32)
+
+    # Leaves: reference runs laid out in depth-first order.
+    leaf_at = np.concatenate([dfs[d][lv.is_leaf] for d, lv in enumerate(levels)])
+    leaf_count = np.concatenate([lv.counts[lv.is_leaf] for lv in levels]).astype(np.int64)
+    order = np.argsort(leaf_at)
+    offset_of_node = np.zeros(node_total, np.int64)
+    offsets = np.cumsum(leaf_count[order]) - leaf_count[order]
+    offset_of_node[leaf_at[order]] = offsets
+    if leaf_count.sum() >= 2**30 or node_total >= 2**30:
+        raise ValueError("tree too large for 30-bit child indices and counts")
+    nodes[leaf_at, 0] = offset_of_node[leaf_at].astype(np.uint32)
+    nodes[leaf_at, 1] = (leaf_count.astype(np.uint32) << 2) | LEAF
+
+    prim_refs = np.empty(int(leaf_count.sum()), np.int32)
+    for d, lv in enumerate(levels):
+        for node, prim in lv.leaf_chunks:
+            prim_refs[offset_of_node[dfs[d][node]] + _rank_in_group(node)] = prim
+    return nodes, prim_refs
+
+
+def _rank_in_group(sorted_keys: np.ndarray) -> np.ndarray:
+    """For a non-decreasing array, the position of each element within its run of equal keys."""
+    n = len(sorted_keys)
+    if n == 0:
+        return np.zeros(0, np.int64)
+    starts = np.flatnonzero(np.concatenate([[True], sorted_keys[1:] != sorted_keys[:-1]]))
+    lengths = np.diff(np.concatenate([starts, [n]]))
+    return np.arange(n) - np.repeat(starts, lengths)
+
+
+def _tree_sah_cost(levels: list[_Level], root: np.ndarray, costs: _Costs) -> float:
+    """SAH cost of the finished tree relative to its root area (what a random ray is expected to pay)."""
+    root_area = float(_half_area((root[1] - root[0])[:, None].astype(np.float64))[0])
+    total = 0.0
+    for lv in levels:
+        area = _half_area((lv.hi - lv.lo).astype(np.float64))
+        per_node = np.where(lv.is_leaf, costs.intersection * lv.counts, costs.traversal)
+        total += float((area * per_node).sum())
+    return total / root_area if root_area > 0 else 0.0
