@@ -13,6 +13,7 @@ was split.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass
 
@@ -36,14 +37,18 @@ class Renderer:
         self.limits = gl.device_limits(self.ctx)
         self._programs: dict[tuple, object] = {}
 
-    def program(self, stack_size: int, sampler: str):
-        key = (stack_size, sampler)
+    def program(self, shader: str, **defines):
+        """The compute shader glsl/<shader> compiled with these #defines (compiled once, then cached)."""
+        key = (shader, tuple(sorted(defines.items())))
         if key not in self._programs:
-            defines = {"LOCAL_SIZE_X": LOCAL_SIZE_X, "KD_STACK_SIZE": stack_size, "SOBOL_DIRECTIONS": glsl_array_literal()}
-            if sampler == "independent":
-                defines["SAMPLER_INDEPENDENT"] = 1
-            self._programs[key] = self.ctx.compute_shader(gl.load_shader_source("trace.comp", defines))
+            self._programs[key] = self.ctx.compute_shader(gl.load_shader_source(shader, defines))
         return self._programs[key]
+
+    def trace_program(self, stack_size: int, sampler: str):
+        defines = {"LOCAL_SIZE_X": LOCAL_SIZE_X, "KD_STACK_SIZE": stack_size, "SOBOL_DIRECTIONS": glsl_array_literal()}
+        if sampler == "independent":
+            defines["SAMPLER_INDEPENDENT"] = 1
+        return self.program("trace.comp", **defines)
 
     def describe(self) -> dict[str, str]:
         return gl.describe_device(self.ctx)
@@ -67,6 +72,14 @@ def camera_uniforms(camera: ThinLensCamera, width: int, height: int) -> dict[str
         "cam_blade_rotation": float(np.radians(camera.blade_rotation_deg)),
         "image_size": (width, height),
     }
+
+
+@dataclass(frozen=True)
+class Pick:
+    point: np.ndarray  # world position of the hit
+    depth: float  # distance along the view axis: what focus_distance_m must be for this point to be sharp
+    prim: int
+    node: object  # the scene Node that owns the primitive
 
 
 @dataclass(frozen=True)
@@ -95,14 +108,15 @@ class RenderSession:
         """Upload a (new or edited) scene and restart accumulation."""
         self.scene = scene
         self.settings = settings or scene.render
-        packed = pack_scene(scene.flatten(), scene.environment)
+        self.flat_scene = scene.flatten()
+        packed = pack_scene(self.flat_scene, scene.environment)
         gpu_scene = GpuScene(self.ctx, packed, self.renderer.limits.max_storage_block_bytes)
         if self._gpu_scene is not None:
             self._gpu_scene.release()
         self._gpu_scene = gpu_scene
         self.width = int(width or scene.camera.resolution[0])
         self.height = int(height or scene.camera.resolution[1])
-        self.program = self.renderer.program(self.program_stack_size, self.settings.sampler)
+        self.program = self.renderer.trace_program(self.program_stack_size, self.settings.sampler)
         self.set_camera(scene.camera)
 
     def set_camera(self, camera: ThinLensCamera) -> None:
@@ -113,7 +127,7 @@ class RenderSession:
 
     def set_settings(self, settings: RenderSettings) -> None:
         if settings.sampler != self.settings.sampler:
-            self.program = self.renderer.program(self.program_stack_size, settings.sampler)
+            self.program = self.renderer.trace_program(self.program_stack_size, settings.sampler)
         self.settings = settings
         self.reset()
 
@@ -206,6 +220,25 @@ class RenderSession:
     def progress(self, target_spp: int | None = None) -> Progress:
         rate = self._samples_traced / self.elapsed_seconds if self.elapsed_seconds > 0 else 0.0
         return Progress(self.samples_per_pixel, target_spp, self.elapsed_seconds, rate)
+
+    # -- ray queries --------------------------------------------------------------------------------------
+    def pick(self, x: float, y: float) -> "Pick | None":
+        """The surface seen through the lens centre at image position (x, y) in pixels, (0, 0) top left."""
+        from lenslab.render.raycast import cast_rays
+
+        ndc_x = 2.0 * x / self.width - 1.0
+        ndc_y = 1.0 - 2.0 * y / self.height
+        camera = dataclasses.replace(self.camera, resolution=(self.width, self.height))
+        direction = camera.primary_ray_direction(ndc_x, ndc_y)
+        origin = np.asarray(camera.position, float)
+        hits = cast_rays(self.renderer, self._gpu_scene, origin[None], direction[None])
+        prim = int(hits.prim[0])
+        if prim < 0:
+            return None
+        point = origin + float(hits.t[0]) * direction
+        forward = -camera.basis()[2]
+        node = self.flat_scene.nodes[int(self.flat_scene.prim_node[prim])]
+        return Pick(point=point, depth=float(np.dot(point - origin, forward)), prim=prim, node=node)
 
     # -- reading the image --------------------------------------------------------------------------------
     def accumulation(self) -> np.ndarray:

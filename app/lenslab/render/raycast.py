@@ -1,0 +1,56 @@
+"""Nearest-hit ray queries on the GPU, through the renderer's own kd-tree traversal (glsl/bsp.glsl).
+
+Click-to-focus asks "how far along the view axis is the surface under this pixel?"; the viewport asks
+"which node is under this pixel?". Both are one ray here, traced by the same code as every rendered sample.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from lenslab.render.buffers import GpuScene
+
+LOCAL_SIZE_X = 64
+
+
+@dataclass(frozen=True)
+class RayHits:
+    t: np.ndarray  # (N,) float32, inf where nothing was hit
+    prim: np.ndarray  # (N,) int32, -1 where nothing was hit
+    barycentrics: np.ndarray  # (N, 2) float32 (triangles)
+
+
+def cast_rays(renderer, gpu_scene: GpuScene, origins: np.ndarray, directions: np.ndarray,
+              t_min: float = 0.0, t_max: float = np.inf) -> RayHits:
+    """Nearest hit for each ray (origins and directions: (N, 3)); directions need not be unit length."""
+    origins = np.asarray(origins, np.float32).reshape(-1, 3)
+    directions = np.asarray(directions, np.float32).reshape(-1, 3)
+    n = len(origins)
+    if n == 0:
+        return RayHits(np.zeros(0, np.float32), np.zeros(0, np.int32), np.zeros((0, 2), np.float32))
+    ctx = renderer.ctx
+    stack = max(1, gpu_scene.packed.kdtree.max_depth)
+    program = renderer.program("raycast.comp", LOCAL_SIZE_X=LOCAL_SIZE_X, KD_STACK_SIZE=stack)
+    packed = np.zeros((n, 2, 4), np.float32)
+    packed[:, 0, :3], packed[:, 0, 3] = origins, t_min
+    packed[:, 1, :3], packed[:, 1, 3] = directions, np.float32(min(t_max, np.finfo(np.float32).max))
+    rays = ctx.buffer(packed.tobytes())
+    hits = ctx.buffer(reserve=n * 16)
+    try:
+        gpu_scene.bind()
+        rays.bind_to_storage_buffer(6)
+        hits.bind_to_storage_buffer(7)
+        for name, value in gpu_scene.packed.uniforms.items():
+            if name in program:
+                program[name].value = value
+        program["ray_count"].value = n
+        program.run((n + LOCAL_SIZE_X - 1) // LOCAL_SIZE_X, 1, 1)
+        out = np.frombuffer(hits.read(), np.float32).reshape(n, 4).copy()
+    finally:
+        rays.release()
+        hits.release()
+    prim = out[:, 1].view(np.int32).copy()
+    t = np.where(prim >= 0, out[:, 0], np.inf).astype(np.float32)
+    return RayHits(t, prim, out[:, 2:4].copy())
