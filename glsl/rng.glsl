@@ -18,12 +18,16 @@ uint hash_combine(uint seed, uint v) { return seed ^ (v + (seed << 6) + (seed >>
 
 float u32_to_unit_float(uint x) { return min(float(x >> 8) * (1.0 / 16777216.0), 0.99999994); }
 
-uint sobol_u32(uint index, uint dim) {
-    uint x = 0u;
-    for (uint bit = 0u; index != 0u; bit++, index >>= 1) {
-        if ((index & 1u) != 0u) x ^= sobol_directions[dim * 32u + bit];
+// All four dimensions of point `index` at once: dimension 1 is the bit-reversed index (van der Corput);
+// the others XOR together the direction numbers of the index's set bits, in one pass over the bits.
+uvec4 sobol4_u32(uint index) {
+    uvec3 x = uvec3(0u);
+    for (uint bit = 0u, rest = index; rest != 0u; bit++, rest >>= 1) {
+        if ((rest & 1u) != 0u) {
+            x ^= uvec3(sobol_directions[32u + bit], sobol_directions[64u + bit], sobol_directions[96u + bit]);
+        }
     }
-    return x;
+    return uvec4(bitfieldReverse(index), x);
 }
 
 uint laine_karras_permutation(uint x, uint seed) {
@@ -58,10 +62,10 @@ vec4 sample4(inout Sampler s) {
     return vec4(u32_to_unit_float(hash_u32(base)), u32_to_unit_float(hash_u32(base + 1u)),
                 u32_to_unit_float(hash_u32(base + 2u)), u32_to_unit_float(hash_u32(base + 3u)));
 #else
-    uint index = nested_uniform_scramble(s.index, seed);
+    uvec4 x = sobol4_u32(nested_uniform_scramble(s.index, seed));
     vec4 u;
     for (uint dim = 0u; dim < 4u; dim++) {
-        u[dim] = u32_to_unit_float(nested_uniform_scramble(sobol_u32(index, dim), hash_combine(seed, dim)));
+        u[dim] = u32_to_unit_float(nested_uniform_scramble(x[dim], hash_combine(seed, dim)));
     }
     return u;
 #endif
