@@ -29,6 +29,10 @@ class SceneTooLarge(RuntimeError):
     """The scene's buffers exceed what the GL device allows in one storage block."""
 
 
+def _size(nbytes: int) -> str:
+    return f"{nbytes / 2**20:.1f} MiB" if nbytes >= 2**20 else f"{nbytes / 2**10:.0f} KiB"
+
+
 def _luminance(rgb) -> float:
     r, g, b = rgb
     return 0.2126 * r + 0.7152 * g + 0.0722 * b
@@ -162,8 +166,8 @@ class GpuScene:
         if too_big:
             name, size = max(too_big.items(), key=lambda item: item[1])
             raise SceneTooLarge(
-                f"the scene needs {size / 2**20:.0f} MiB of {name.replace('_', ' ')} in one storage buffer, "
-                f"more than this GL device allows ({max_block_bytes / 2**20:.0f} MiB); "
+                f"the scene needs {_size(size)} of {name.replace('_', ' ')} in one storage buffer, "
+                f"more than this GL device allows ({_size(max_block_bytes)}); "
                 f"simplify the meshes ({packed.uniforms['triangle_count']:,} triangles now)"
             )
         self.packed = packed
