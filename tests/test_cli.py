@@ -1,0 +1,153 @@
+"""The headless command line: renders, metadata, and every error path (one line on stderr, no traceback)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from lenslab.cli import main
+from lenslab.render.film import read_image
+
+SMALL = ["--spp", "2", "--width", "32", "--height", "24"]
+
+
+def run_cli(capsys, *argv):
+    status = main([str(a) for a in argv])
+    captured = capsys.readouterr()
+    return status, captured.out, captured.err
+
+
+def test_headless_exr_is_linear_float_with_camera_metadata(renderer, tmp_path, capsys):
+    out = tmp_path / "shot.exr"
+    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", out, *SMALL, "--f-stop", "2.8",
+                             "--focal-length", "35", "--focus-distance", "1.5", "--seed", "7")
+    assert status == 0, err
+    pixels, meta = read_image(out)
+    assert pixels.shape == (24, 32, 3) and pixels.dtype == np.float32
+    assert pixels.max() > 1.0  # linear radiance: the light is brighter than display white
+    assert meta["Exif:FNumber"] == pytest.approx(2.8)
+    assert meta["Exif:FocalLength"] == pytest.approx(35.0)
+    assert meta["Exif:SubjectDistance"] == pytest.approx(1.5)
+    assert meta["lenslab:SensorWidthMM"] == pytest.approx(36.0) and meta["lenslab:SensorHeightMM"] == pytest.approx(24.0)
+    assert meta["lenslab:SamplesPerPixel"] == 2 and meta["lenslab:Seed"] == 7
+    assert meta["Software"].startswith("LensLab ")
+    assert "wrote" in err and "\n" == err[-1]
+
+
+def test_headless_png_is_display_referred(renderer, tmp_path, capsys):
+    out = tmp_path / "shot.png"
+    status, _, err = run_cli(capsys, "dof_chart", "--headless", "-o", out, *SMALL)
+    assert status == 0, err
+    pixels, _ = read_image(out)
+    assert pixels.shape == (24, 32, 3) and 0.0 <= pixels.min() and pixels.max() <= 1.0
+
+
+def test_time_limit_alone_renders_what_fits(renderer, tmp_path, capsys):
+    out = tmp_path / "quick.exr"
+    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", out, "--width", "16", "--height", "16",
+                             "--time-limit", "0.5")
+    assert status == 0, err
+    _, meta = read_image(out)
+    assert meta["lenslab:SamplesPerPixel"] >= 1
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["cornell_box", "--headless", "-o", "x.png", "--f-stop", "0"], r"--f-stop 0 is out of range \[0\.5, 128\]"),
+        (["cornell_box", "--headless", "-o", "x.png", "--spp", "many"], r"--spp must be a number, not 'many'"),
+        (["cornell_box", "--headless", "-o", "x.png", "--focus-distance", "-2"], r"--focus-distance -2 is out of range"),
+        (["cornell_box", "--headless", "-o", "x.png", "--width", "0"], r"--width 0 is out of range"),
+        (["cornell_box", "--headless", "-o", "x.png", "--bokeh"], r"unrecognized arguments: --bokeh"),
+        (["cornell_box", "--headless"], r"--headless needs an output file"),
+        (["--headless", "-o", "x.png"], r"--headless needs a scene"),
+        (["cornell_box", "--headless", "-o", "x.tiff"], r"x\.tiff: unsupported output type '\.tiff' \(use \.exr or \.png\)"),
+        (["cornell_box", "--headless", "-o", "no/such/dir/x.png"], r"folder 'no/such/dir' does not exist"),
+        (["no_such_scene", "--headless", "-o", "x.png"], r"no_such_scene: no such scene file \(or a shipped scene: cornell_box"),
+    ],
+)
+def test_bad_arguments_exit_non_zero_with_one_line(tmp_path, monkeypatch, capsys, argv, message):
+    import re
+
+    monkeypatch.chdir(tmp_path)
+    status, _, err = run_cli(capsys, *argv)
+    assert status != 0
+    assert err.count("\n") == 1 and err.startswith("lenslab: error: ")
+    assert re.search(message, err), err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_broken_scene_exits_with_file_and_key(tmp_path, capsys):
+    scene = tmp_path / "broken.json"
+    scene.write_text(json.dumps({"lenslab_scene": 1, "camera": {"f_number": "wide"}}))
+    status, _, err = run_cli(capsys, scene, "--headless", "-o", tmp_path / "x.png")
+    assert status == 1
+    assert err.strip() == f'lenslab: error: {scene}: camera.f_number: expected a number, got "wide"'
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_missing_gl_driver_is_one_line_with_the_packages_to_install(tmp_path, monkeypatch, capsys):
+    import moderngl
+
+    def no_egl(**kwargs):
+        raise Exception("libEGL.so.1: cannot open shared object file: No such file or directory")
+
+    monkeypatch.setattr(moderngl, "create_context", no_egl)
+    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.png")
+    assert status == 1
+    assert err.count("\n") == 1
+    assert "no EGL library" in err and "apt-get install libegl1 libgl1-mesa-dri libegl-mesa0" in err
+    status, _, err = run_cli(capsys, "--info")
+    assert status == 1 and "apt-get install" in err
+
+
+def test_interrupted_render_writes_nothing(renderer, tmp_path, monkeypatch, capsys):
+    from lenslab.render.tracer import RenderSession
+
+    calls = []
+    real_step = RenderSession.step
+
+    def step_then_interrupt(self, *args, **kwargs):
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt  # what Ctrl-C raises in the main thread
+        return real_step(self, *args, **kwargs)
+
+    monkeypatch.setattr(RenderSession, "step", step_then_interrupt)
+    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.exr", "--spp", "1000",
+                             "--width", "16", "--height", "16")
+    assert status == 130
+    assert err.strip() == "lenslab: interrupted; nothing was written"
+    assert list(tmp_path.iterdir()) == []  # neither the image nor a temporary file
+
+
+def test_info_prints_the_gl_renderer_and_limits(renderer, capsys):
+    status, out, _ = run_cli(capsys, "--info")
+    assert status == 0
+    assert "renderer" in out and renderer.ctx.info["GL_RENDERER"] in out
+    assert "max storage block" in out and "MiB" in out
+
+
+def test_help_speaks_photography(capsys):
+    with pytest.raises(SystemExit) as info:
+        main(["--help"])
+    assert info.value.code == 0
+    text = capsys.readouterr().out
+    for phrase in ("--f-stop", "f-number", "--focus-distance", "plane of focus", "--focal-length", "millimetres"):
+        assert phrase in text
+
+
+def test_headless_in_a_real_process_never_imports_qt(renderer, tmp_path):
+    code = (
+        "import sys; from lenslab.cli import main; "
+        f"status = main(['cornell_box', '--headless', '-o', {str(tmp_path / 'x.png')!r}, '--spp', '1', '--width', '8', '--height', '8']); "
+        "assert 'PySide6' not in sys.modules, 'Qt was imported'; sys.exit(status)"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert "Traceback" not in result.stderr
+    assert (tmp_path / "x.png").is_file()
