@@ -1,0 +1,264 @@
+"""Values of the Mitsuba 3 scene format, as plain numbers: transforms, colours and spectra.
+
+The XML reader (:mod:`lenslab.scene.io.mitsuba_xml`) turns elements into calls to these functions; nothing
+here knows about XML, files or warnings, so each conversion can be tested on its own.
+
+Transforms follow Mitsuba's ``Transform4f`` (``include/mitsuba/core/transform.h``): a ``<transform>`` starts
+at the identity and every operation inside it is multiplied on the **left** (``M = op @ M``), so the first
+operation listed is the first applied to a point. ``lookat`` builds the frame (left, up, dir, origin) as
+columns, ``matrix`` is given row by row.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+import numpy as np
+
+from lenslab.scene.transform import Transform
+
+RGB = tuple[float, float, float]
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Transforms
+# ---------------------------------------------------------------------------------------------------------
+def translate_matrix(v) -> np.ndarray:
+    m = np.eye(4)
+    m[:3, 3] = v
+    return m
+
+
+def scale_matrix(v) -> np.ndarray:
+    return np.diag([float(v[0]), float(v[1]), float(v[2]), 1.0])
+
+
+def rotate_matrix(axis, angle_deg: float) -> np.ndarray:
+    """Rotation by ``angle_deg`` counter-clockwise about ``axis`` (right-handed), as Mitsuba's ``rotate``."""
+    a = np.asarray(axis, dtype=float)
+    norm = np.linalg.norm(a)
+    if norm == 0:
+        raise ValueError("rotation axis cannot be zero")
+    x, y, z = a / norm
+    t = math.radians(angle_deg)
+    c, s = math.cos(t), math.sin(t)
+    m = np.eye(4)
+    m[:3, :3] = [
+        [x * x + (1 - x * x) * c, x * y * (1 - c) - z * s, x * z * (1 - c) + y * s],
+        [x * y * (1 - c) + z * s, y * y + (1 - y * y) * c, y * z * (1 - c) - x * s],
+        [x * z * (1 - c) - y * s, y * z * (1 - c) + x * s, z * z + (1 - z * z) * c],
+    ]
+    return m
+
+
+def coordinate_system(n) -> np.ndarray:
+    """A unit vector perpendicular to unit ``n`` (Duff et al. 2017), Mitsuba's choice of an absent ``up``."""
+    x, y, z = n
+    sign = math.copysign(1.0, z)
+    a = -1.0 / (sign + z)
+    b = x * y * a
+    return np.array([1.0 + sign * x * x * a, sign * b, -sign * x])
+
+
+def lookat_matrix(origin, target, up=None) -> np.ndarray:
+    """Mitsuba's ``look_at``: local +Z towards ``target``, +Y up, +X to the *left* of the image."""
+    origin = np.asarray(origin, dtype=float)
+    direction = np.asarray(target, dtype=float) - origin
+    if np.linalg.norm(direction) == 0:
+        raise ValueError("lookat origin and target coincide")
+    direction /= np.linalg.norm(direction)
+    up = np.zeros(3) if up is None else np.asarray(up, dtype=float)
+    if not np.any(up):
+        up = coordinate_system(direction)
+    left = np.cross(up, direction)
+    if np.linalg.norm(left) < 1e-12:
+        raise ValueError("lookat up is parallel to the view direction")
+    left /= np.linalg.norm(left)
+    new_up = np.cross(direction, left)
+    m = np.eye(4)
+    m[:3, 0], m[:3, 1], m[:3, 2], m[:3, 3] = left, new_up, direction, origin
+    return m
+
+
+def matrix_from_values(values: list[float]) -> np.ndarray:
+    """``<matrix value="...">``: 16 numbers (4x4) or 9 (the linear part), row by row."""
+    m = np.eye(4)
+    if len(values) == 16:
+        m[:, :] = np.reshape(values, (4, 4))
+    elif len(values) == 9:
+        m[:3, :3] = np.reshape(values, (3, 3))
+    else:
+        raise ValueError(f"matrix must have 9 or 16 values, got {len(values)}")
+    return m
+
+
+def euler_xyz_deg(r: np.ndarray) -> tuple[float, float, float]:
+    """Angles (degrees) of :class:`Transform`'s rotation ``Rz @ Ry @ Rx`` equal to the proper rotation ``r``."""
+    cy = math.hypot(r[0, 0], r[1, 0])
+    ay = math.atan2(-r[2, 0], cy)
+    if cy > 1e-12:
+        ax = math.atan2(r[2, 1], r[2, 2])
+        az = math.atan2(r[1, 0], r[0, 0])
+    else:  # gimbal lock (y = +-90 degrees): only x -+ z is defined; put it all in x
+        ax = math.atan2(-r[1, 2], r[1, 1])
+        az = 0.0
+    return math.degrees(ax), math.degrees(ay), math.degrees(az)
+
+
+def _clean(values) -> tuple[float, float, float]:
+    """Plain floats, with -0.0 and 1e-17-size rounding noise tidied so saved scenes read well."""
+    out = []
+    for v in values:
+        v = float(v)
+        r = round(v, 12)
+        out.append(0.0 if r == 0 else (r if abs(r - v) < 1e-12 else v))
+    return tuple(out)  # type: ignore[return-value]
+
+
+def _trs(translate, rotation: np.ndarray, scale) -> Transform:
+    return Transform(translate=_clean(translate), rotate_deg=_clean(euler_xyz_deg(rotation)), scale=_clean(scale))
+
+
+def decompose_affine(m: np.ndarray, tolerance: float = 1e-9) -> list[Transform]:
+    """Node transforms (outermost first) whose product is the affine matrix ``m``, exactly.
+
+    A matrix without shear (rotation, axis scale, mirror, translation: columns of the linear part orthogonal)
+    becomes one ``T @ R @ S``. Any other invertible matrix becomes two, through the singular value
+    decomposition ``A = U diag(s) V^T``: an outer ``T @ U @ diag(s)`` and an inner rotation ``V^T``.
+    Raises ValueError for a singular matrix (a scale of zero flattens the shape to nothing).
+    """
+    m = np.asarray(m, dtype=float)
+    if not np.allclose(m[3], [0, 0, 0, 1], atol=1e-12):
+        raise ValueError("a projective matrix (last row not 0 0 0 1) is not a placement")
+    a = m[:3, :3]
+    t = m[:3, 3]
+    scale = np.linalg.norm(a, axis=0)
+    if scale.min() <= 1e-12 * max(scale.max(), 1.0) or abs(np.linalg.det(a)) < 1e-30:
+        raise ValueError("singular transform (a scale of zero)")
+    r = a / scale
+    if np.linalg.det(r) < 0:  # a mirror: carry it as a negative scale along x
+        scale[0] = -scale[0]
+        r[:, 0] = -r[:, 0]
+    single = _trs(t, r, scale)
+    if np.allclose(single.matrix(), m, rtol=0, atol=tolerance * max(1.0, np.abs(m).max())):
+        return [single]
+    u, s, vt = np.linalg.svd(a)
+    if np.linalg.det(u) < 0:
+        u[:, 2], s[2] = -u[:, 2], -s[2]
+    if np.linalg.det(vt) < 0:
+        vt[2, :], s[2] = -vt[2, :], -s[2]
+    return [_trs(t, u, s), _trs((0, 0, 0), vt, (1, 1, 1))]
+
+
+def compose(transforms: list[Transform]) -> np.ndarray:
+    m = np.eye(4)
+    for t in transforms:
+        m = m @ t.matrix()
+    return m
+
+
+def nearest_similarity(m: np.ndarray) -> np.ndarray:
+    """The rotation-plus-uniform-scale matrix closest to ``m`` (polar decomposition), same translation."""
+    a = m[:3, :3]
+    u, s, vt = np.linalg.svd(a)
+    r = u @ vt
+    out = np.eye(4)
+    out[:3, :3] = r * abs(np.linalg.det(a)) ** (1 / 3)
+    out[:3, 3] = m[:3, 3]
+    return out
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Numbers, colours and spectra
+# ---------------------------------------------------------------------------------------------------------
+_SPLIT = re.compile(r"[\s,]+")
+
+
+def split_numbers(text: str) -> list[float]:
+    """Numbers separated by commas and/or white space, as Mitsuba's ``string::tokenize``."""
+    tokens = [t for t in _SPLIT.split(text.strip()) if t]
+    return [float(t) for t in tokens]
+
+
+def _lobe(lam: np.ndarray, mu: float, s1: float, s2: float) -> np.ndarray:
+    s = np.where(lam < mu, s1, s2)
+    return np.exp(-0.5 * ((lam - mu) / s) ** 2)
+
+
+def cie1931_xyz(lam: np.ndarray) -> np.ndarray:
+    """CIE 1931 2-degree colour matching functions, (N, 3), from the multi-lobe fit of Wyman, Sloan and
+    Shirley (JCGT 2013); within about 1% of the tables, which is plenty for turning a spectrum into a colour."""
+    lam = np.asarray(lam, dtype=float)
+    x = 1.056 * _lobe(lam, 599.8, 37.9, 31.0) + 0.362 * _lobe(lam, 442.0, 16.0, 26.7) - 0.065 * _lobe(lam, 501.1, 20.4, 26.2)
+    y = 0.821 * _lobe(lam, 568.8, 46.9, 40.5) + 0.286 * _lobe(lam, 530.9, 16.3, 31.1)
+    z = 1.217 * _lobe(lam, 437.0, 11.8, 36.0) + 0.681 * _lobe(lam, 459.0, 26.0, 13.8)
+    return np.stack([x, y, z], axis=-1)
+
+
+XYZ_TO_LINEAR_SRGB = np.array(
+    [[3.2404542, -1.5371385, -0.4985314], [-0.9692660, 1.8760108, 0.0415560], [0.0556434, -0.2040259, 1.0572252]]
+)
+CIE_MIN_NM, CIE_MAX_NM = 360.0, 830.0
+_LAMBDA = np.arange(CIE_MIN_NM, CIE_MAX_NM + 0.5, 1.0)
+_CMF = cie1931_xyz(_LAMBDA)
+_WHITE_RGB = XYZ_TO_LINEAR_SRGB @ _CMF.sum(axis=0)
+
+
+def parse_spectrum(text: str) -> list[tuple[float, float]] | float:
+    """A ``<spectrum value>``: one number (a uniform spectrum) or ``wavelength:value`` pairs."""
+    text = text.strip()
+    if ":" not in text:
+        values = split_numbers(text)
+        if len(values) != 1:
+            raise ValueError(f"expected one value or wavelength:value pairs, got '{text}'")
+        return values[0]
+    pairs = []
+    for item in (t for t in re.split(r"[,\s]+", text) if t):
+        if item.count(":") != 1:
+            raise ValueError(f"'{item}' is not a wavelength:value pair")
+        w, v = item.split(":")
+        pairs.append((float(w), float(v)))
+    pairs.sort()
+    if len(pairs) < 2:
+        raise ValueError("a sampled spectrum needs at least two wavelength:value pairs")
+    return pairs
+
+
+def spectrum_to_rgb(spectrum: list[tuple[float, float]] | float) -> RGB:
+    """Linear sRGB of a spectrum: a uniform one is grey with that value; a sampled one (linear between its
+    samples, zero outside them) is integrated against the CIE 1931 curves and white-balanced so that a
+    flat spectrum of value v gives (v, v, v)."""
+    if isinstance(spectrum, (int, float)):
+        v = float(spectrum)
+        return (v, v, v)
+    w = np.array([p[0] for p in spectrum])
+    v = np.array([p[1] for p in spectrum])
+    samples = np.interp(_LAMBDA, w, v, left=0.0, right=0.0)
+    rgb = (XYZ_TO_LINEAR_SRGB @ (samples @ _CMF)) / _WHITE_RGB
+    return tuple(float(c) for c in rgb)  # type: ignore[return-value]
+
+
+def conductor_f0(eta: RGB, k: RGB) -> RGB:
+    """Reflectance at normal incidence of a conductor with complex index ``eta + i k`` (per channel)."""
+    return tuple(((n - 1) ** 2 + kk * kk) / ((n + 1) ** 2 + kk * kk) for n, kk in zip(eta, k))  # type: ignore[return-value]
+
+
+# Normal-incidence reflectance (linear sRGB) of Mitsuba's named conductors, for the interim conductor
+# approximation. Values from measured indices of refraction (refractiveindex.info) at ~630/532/465 nm.
+CONDUCTOR_F0: dict[str, RGB] = {
+    "none": (1.0, 1.0, 1.0),  # Mitsuba's default: a perfect mirror
+    "Ag": (0.972, 0.960, 0.915),
+    "Al": (0.913, 0.922, 0.924),
+    "Au": (1.000, 0.766, 0.336),
+    "Cr": (0.550, 0.556, 0.554),
+    "Cu": (0.955, 0.638, 0.538),
+    "CuZn": (0.910, 0.780, 0.470),
+    "Fe": (0.562, 0.565, 0.578),
+    "Hg": (0.781, 0.779, 0.779),
+    "Ni": (0.660, 0.609, 0.526),
+    "Pt": (0.673, 0.637, 0.585),
+    "Ti": (0.542, 0.497, 0.449),
+    "W": (0.510, 0.500, 0.470),
+    "Zn": (0.664, 0.824, 0.850),
+}

@@ -1,0 +1,1200 @@
+"""Read Mitsuba 3 XML scenes into LensLab's scene model (docs/mitsuba-import.md).
+
+Two passes, as in Mitsuba's own parser (``src/core/parser.cpp``):
+
+1. **Expand** the XML: parse each file with expat (so that every element knows its file and line), apply
+   ``<default>`` and ``$param`` substitution (``defines`` win over ``<default>``, as ``mitsuba -D`` does),
+   splice ``<include>`` files in (relative to the including file), and register every ``id``.
+2. **Convert** the expanded tree: integrator, sensor/film/sampler, shapes with their BSDFs and area lights,
+   the constant emitter. Each plugin is a small function; BSDFs go through :data:`BSDF_MAPPINGS`, one entry
+   per Mitsuba plugin name, so that a real mapping replaces an approximation by replacing one entry.
+
+Whatever LensLab cannot render yet gives one warning naming the element and its line, and the rest of the
+scene still loads. A file that is not well-formed XML, or that Mitsuba itself would reject (an undefined
+``$param``, a ``<ref>`` to an unknown id, a missing mesh or included file), raises one :class:`SceneError`
+naming the file and line.
+
+Conventions converted here (checked in ``tests/test_mitsuba_import.py``):
+
+* Mitsuba's camera looks down its local +Z with +X to the image's *left* and +Y up (``perspective_projection``
+  in ``include/mitsuba/render/sensor.h``); ours looks down -Z with +X right. Both are right-handed frames, one
+  the other turned half a turn about Y, so position, view direction and up carry over unchanged.
+* ``fov`` with any ``fov_axis``, or a 35 mm-equivalent ``focal_length`` (a diagonal field of view on a
+  36 x 24 mm frame), becomes Mitsuba's horizontal field of view (``parse_fov``), then our focal length on a
+  36 mm wide sensor. ``aperture_radius`` r becomes ``f_number = f / 2r`` so that our lens radius is r.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import logging
+import math
+import os
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+from xml.parsers import expat
+
+import numpy as np
+
+from lenslab.optics.thinlens import MM_PER_M, focal_length_for_fov
+from lenslab.scene.camera import ThinLensCamera
+from lenslab.scene.materials import Diffuse, Emissive, Material
+from lenslab.scene.scene import ConstantEnvironment, Node, RenderSettings, Scene, SceneError
+from lenslab.scene.shapes import Box, MeshFile, Rectangle, Sphere
+from lenslab.scene.transform import Transform, transform_points
+
+from . import mitsuba_values as mv
+
+__all__ = ["load_mitsuba_scene", "load_mitsuba_string", "BSDF_MAPPINGS", "WarnCallback"]
+
+log = logging.getLogger("lenslab.import")
+
+WarnCallback = Callable[[str], None]
+RGB = tuple[float, float, float]
+
+SENSOR_WIDTH_MM = 36.0  # imported cameras get a full-frame-wide sensor; the focal length carries the fov
+MAX_INCLUDE_DEPTH = 15
+DISK_SEGMENTS = 128
+
+# Element names of Mitsuba's format (interpret_tag in parser.cpp).
+OBJECT_TAGS = {"scene", "integrator", "sensor", "film", "rfilter", "sampler", "shape", "bsdf", "emitter",
+               "texture", "medium", "phase", "volume", "field"}
+VALUE_TAGS = {"float", "integer", "boolean", "string", "point", "vector", "rgb", "spectrum", "transform"}
+TRANSFORM_OPS = {"translate", "rotate", "scale", "lookat", "matrix"}
+
+# Properties that change nothing in a LensLab image: read and dropped without a word.
+SILENT = {
+    "film": {"pixel_format", "component_format", "file_format", "banner", "compensate", "sample_border"},
+    "sensor": {"near_clip", "far_clip", "shutter_open", "shutter_close", "srf"},
+    "integrator": {"emitter_samples", "bsdf_samples"},
+    "sampler": {"jitter", "scramble_seed", "seed_offset"},
+    "shape": {"flip_tex_coords", "flip_normals", "mesh_attributes"},
+    "rfilter": {"radius"},
+}
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Pass 1: the XML tree, with lines, substitutions, includes and ids
+# ---------------------------------------------------------------------------------------------------------
+@dataclass(eq=False)
+class XNode:
+    tag: str
+    attrs: dict[str, str]
+    line: int
+    file: str  # as shown in messages
+    folder: Path  # where relative paths in this element's file start
+    version: tuple[int, ...] = (3, 0, 0)
+    children: list["XNode"] = field(default_factory=list)
+
+    @property
+    def type(self) -> str:
+        return self.attrs.get("type", "")
+
+    def label(self) -> str:
+        text = f"<{self.tag}"
+        if self.type:
+            text += f' type="{self.type}"'
+        if "id" in self.attrs:
+            text += f' id="{self.attrs["id"]}"'
+        elif "name" in self.attrs:
+            text += f' name="{self.attrs["name"]}"'
+        return text + ">"
+
+    def where(self) -> str:
+        return f"{self.file}:{self.line}"
+
+    def error(self, message: str) -> SceneError:
+        return SceneError(f"{self.file}: line {self.line}: {self.label()}: {message}")
+
+
+def _parse_xml(data: bytes, display: str, folder: Path) -> XNode:
+    parser = expat.ParserCreate()
+    parser.buffer_text = True
+    stack: list[XNode] = []
+    roots: list[XNode] = []
+
+    def start(tag: str, attrs: dict[str, str]) -> None:
+        node = XNode(tag, dict(attrs), parser.CurrentLineNumber, display, folder)
+        (stack[-1].children if stack else roots).append(node)
+        stack.append(node)
+
+    def end(_tag: str) -> None:
+        stack.pop()
+
+    parser.StartElementHandler = start
+    parser.EndElementHandler = end
+    try:
+        parser.Parse(data, True)
+    except expat.ExpatError as exc:
+        raise SceneError(
+            f"{display}: line {exc.lineno} column {exc.offset + 1}: not well-formed XML ({expat.ErrorString(exc.code)})"
+        ) from None
+    root = roots[0]
+    version_text = root.attrs.get("version")
+    if version_text is None:
+        raise SceneError(f"{display}: line {root.line}: <{root.tag}> has no version attribute (not a Mitsuba scene?)")
+    try:
+        version = tuple(int(p) for p in version_text.strip().split("."))
+    except ValueError:
+        raise SceneError(f"{display}: line {root.line}: invalid version number '{version_text}'") from None
+
+    def stamp(node: XNode) -> None:
+        node.version = version
+        for child in node.children:
+            stamp(child)
+
+    stamp(root)
+    return root
+
+
+def _camel_to_underscore(name: str) -> str:
+    return re.sub(r"(?<=[a-z])([A-Z]+)", lambda m: "_" + m.group(1).lower(), name)
+
+
+class _Expander:
+    """Substitution, defaults, includes and ids, in document order, as Mitsuba's parser does."""
+
+    def __init__(self, defines: dict[str, str]):
+        self.params: dict[str, str] = dict(defines)
+        self.used: set[str] = set()
+        self.ids: dict[str, XNode] = {}
+        self.files: list[Path] = []
+
+    def substitute(self, node: XNode) -> None:
+        keys = sorted(self.params, key=len, reverse=True)
+        for attr, value in node.attrs.items():
+            if "$" not in value:
+                continue
+            for key in keys:
+                token = "$" + key
+                pos = value.find(token)
+                while pos >= 0:
+                    if pos > 0 and value[pos - 1] == "\\":
+                        pos = value.find(token, pos + len(token))
+                        continue
+                    value = value[:pos] + self.params[key] + value[pos + len(token):]
+                    self.used.add(key)
+                    pos = value.find(token, pos + len(self.params[key]))
+            match = re.search(r"(?<!\\)\$(\w*)", value)
+            if match:
+                raise SceneError(f"{node.file}: line {node.line}: <{node.tag}>: undefined parameter ${match.group(1)}")
+            node.attrs[attr] = value.replace("\\$", "$")
+
+    def expand(self, node: XNode, depth: int) -> list[XNode]:
+        """The node as it stands after expansion: [] for a <default>, an included file's elements for an
+        <include>, otherwise the node itself with its children expanded."""
+        self.substitute(node)
+        if node.tag == "default":
+            name, value = node.attrs.get("name"), node.attrs.get("value")
+            if not name or value is None:
+                raise node.error("needs a name and a value")
+            self.params.setdefault(name, value)
+            return []
+        if node.tag == "include":
+            return self.include(node, depth)
+        if node.tag in OBJECT_TAGS or (node.tag == "spectrum" and "type" in node.attrs):
+            ident = node.attrs.get("id")
+            if ident:
+                if ident in self.ids:
+                    raise node.error(f'duplicate id "{ident}" (first at {self.ids[ident].where()})')
+                self.ids[ident] = node
+        children = []
+        for child in node.children:
+            children.extend(self.expand(child, depth))
+        node.children = children
+        return [node]
+
+    def include(self, node: XNode, depth: int) -> list[XNode]:
+        filename = node.attrs.get("filename")
+        if not filename:
+            raise node.error("needs a filename")
+        path = Path(filename) if Path(filename).is_absolute() else node.folder / filename
+        if not path.is_file():
+            raise node.error(f"included file not found: {path}")
+        if depth + 1 >= MAX_INCLUDE_DEPTH:
+            raise node.error(f"includes nested deeper than {MAX_INCLUDE_DEPTH} (an include cycle?)")
+        root = self.parse_file(path)
+        expanded = self.expand(root, depth + 1)
+        if root.tag == "scene":
+            return expanded[0].children if expanded else []
+        return expanded
+
+    def parse_file(self, path: Path) -> XNode:
+        try:
+            data = path.read_bytes()
+        except OSError as exc:
+            raise SceneError(f"{path}: cannot read ({exc.strerror})") from None
+        self.files.append(path)
+        return _parse_xml(data, str(path), path.resolve().parent)
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Pass 2: properties of one element
+# ---------------------------------------------------------------------------------------------------------
+class Props:
+    """The named properties and nested objects of one plugin element, each read at most once.
+
+    Reading marks a property used; :meth:`finish` warns once for each one nobody read (what LensLab does not
+    support), except those in :data:`SILENT`. Nested objects without a name are kept in order in ``objects``.
+    """
+
+    def __init__(self, importer: "_Importer", node: XNode):
+        self.importer = importer
+        self.node = node
+        self.values: dict[str, XNode] = {}
+        self.objects: list[XNode] = []
+        self.used: set[str] = set()
+        upgrade = node.version < (2, 0, 0)
+        for child in node.children:
+            tag = child.tag
+            if tag == "ref":
+                target = importer.resolve_ref(child)
+                name = child.attrs.get("name")
+                if name:
+                    self.values[self._name(name, upgrade)] = target
+                else:
+                    self.objects.append(target)
+            elif tag in VALUE_TAGS and not (tag == "spectrum" and "type" in child.attrs):
+                name = child.attrs.get("name")
+                if not name:
+                    raise child.error("a property needs a name")
+                self.values[self._name(name, upgrade)] = child
+            elif tag in OBJECT_TAGS or tag == "spectrum":
+                name = child.attrs.get("name")
+                if name:
+                    self.values[self._name(name, upgrade)] = child
+                else:
+                    self.objects.append(child)
+            elif tag in TRANSFORM_OPS:
+                importer.warn(child, "a transform operation outside <transform>: ignored")
+            else:
+                importer.warn(child, "unknown element: ignored")
+
+    def _name(self, name: str, upgrade: bool) -> str:
+        if upgrade:  # Mitsuba 0.x scenes: camelCase names, as Mitsuba's own upgrade pass renames them
+            name = _camel_to_underscore(name)
+            if self.node.tag == "bsdf" and self.node.type == "diffuse" and name == "diffuse_reflectance":
+                name = "reflectance"
+        return name
+
+    def has(self, name: str) -> bool:
+        return name in self.values
+
+    def take(self, name: str) -> XNode | None:
+        node = self.values.get(name)
+        if node is not None:
+            self.used.add(name)
+        return node
+
+    def _attr(self, node: XNode, key: str = "value") -> str:
+        if key not in node.attrs:
+            raise node.error(f'missing attribute "{key}"')
+        return node.attrs[key]
+
+    def _expect(self, node: XNode, tags: tuple[str, ...]) -> None:
+        if node.tag not in tags:
+            raise node.error(f"expected <{'> or <'.join(tags)}>")
+
+    def float(self, name: str, default: float | None = None) -> float | None:
+        node = self.take(name)
+        if node is None:
+            return default
+        self._expect(node, ("float", "integer"))
+        try:
+            return float(self._attr(node))
+        except ValueError:
+            raise node.error(f"could not parse floating point value \"{node.attrs['value']}\"") from None
+
+    def int(self, name: str, default: int | None = None) -> int | None:
+        node = self.take(name)
+        if node is None:
+            return default
+        self._expect(node, ("integer",))
+        try:
+            return int(self._attr(node).strip())
+        except ValueError:
+            raise node.error(f"could not parse integer value \"{node.attrs['value']}\"") from None
+
+    def bool(self, name: str, default: bool) -> bool:
+        node = self.take(name)
+        if node is None:
+            return default
+        self._expect(node, ("boolean",))
+        text = self._attr(node).strip().lower()
+        if text not in ("true", "false"):
+            raise node.error(f'could not parse boolean value "{text}" -- must be "true" or "false"')
+        return text == "true"
+
+    def string(self, name: str, default: str | None = None) -> str | None:
+        node = self.take(name)
+        if node is None:
+            return default
+        self._expect(node, ("string",))
+        return self._attr(node)
+
+    def vector(self, name: str, default=None) -> np.ndarray | None:
+        node = self.take(name)
+        if node is None:
+            return None if default is None else np.asarray(default, dtype=float)
+        self._expect(node, ("point", "vector"))
+        return _xyz(node, 0.0)
+
+    def transform(self, name: str = "to_world") -> np.ndarray:
+        node = self.take(name)
+        if node is None:
+            return np.eye(4)
+        self._expect(node, ("transform",))
+        return _transform_matrix(node, self.importer)
+
+    def color(self, name: str, default: float | RGB) -> RGB:
+        node = self.take(name)
+        if node is None:
+            return (float(default),) * 3 if isinstance(default, (int, float)) else tuple(default)  # type: ignore[return-value]
+        return self.importer.color_of(node)
+
+    def finish(self, silent: set[str] = frozenset()) -> None:
+        silent = set(silent) | SILENT.get(self.node.tag, set())
+        for name, node in self.values.items():
+            if name not in self.used and name not in silent:
+                self.importer.warn(node, f'{self.node.label()} property "{name}" is not supported: ignored')
+
+
+def _xyz(node: XNode, default: float) -> np.ndarray:
+    try:
+        if "value" in node.attrs:
+            values = mv.split_numbers(node.attrs["value"])
+            if len(values) == 1:
+                values = values * 3
+            if len(values) != 3:
+                raise node.error('"value" must have exactly 1 or 3 elements')
+            return np.array(values, dtype=float)
+        return np.array([float(node.attrs.get(k, default)) for k in "xyz"])
+    except ValueError:
+        raise node.error("could not parse a number") from None
+
+
+def _transform_matrix(node: XNode, importer: "_Importer") -> np.ndarray:
+    """A <transform>: every operation multiplied on the left, in document order (first listed, first applied)."""
+    m = np.eye(4)
+    for op in node.children:
+        try:
+            if op.tag == "translate":
+                step = mv.translate_matrix(_xyz(op, 0.0))
+            elif op.tag == "scale":
+                step = mv.scale_matrix(_xyz(op, 1.0))
+            elif op.tag == "rotate":
+                if "angle" not in op.attrs:
+                    raise op.error('missing attribute "angle"')
+                step = mv.rotate_matrix(_xyz(op, 0.0), float(op.attrs["angle"]))
+            elif op.tag == "lookat":
+                if "origin" not in op.attrs or "target" not in op.attrs:
+                    raise op.error('needs "origin" and "target"')
+                origin = _three(op, "origin")
+                target = _three(op, "target")
+                up = _three(op, "up") if op.attrs.get("up", "").strip() else None
+                step = mv.lookat_matrix(origin, target, up)
+            elif op.tag == "matrix":
+                step = mv.matrix_from_values(mv.split_numbers(op.attrs.get("value", "")))
+            else:
+                importer.warn(op, "unexpected element inside <transform>: ignored")
+                continue
+        except ValueError as exc:
+            raise op.error(str(exc)) from None
+        m = step @ m
+    return m
+
+
+def _three(node: XNode, key: str) -> np.ndarray:
+    try:
+        values = mv.split_numbers(node.attrs[key])
+    except ValueError:
+        raise node.error(f'could not parse "{key}"') from None
+    if len(values) != 3:
+        raise node.error(f'"{key}" needs 3 values, got {len(values)}')
+    return np.array(values)
+
+
+# ---------------------------------------------------------------------------------------------------------
+# BSDFs: one mapping per Mitsuba plugin name
+# ---------------------------------------------------------------------------------------------------------
+@dataclass
+class Mapped:
+    """What a BSDF became; ``note`` (if any) says how it was approximated, and is reported as a warning."""
+
+    material: Material
+    note: str | None = None
+
+
+BsdfMapping = Callable[[Props, "_Importer"], Mapped]
+
+
+def _clip_albedo(rgb) -> RGB:
+    return tuple(float(min(max(c, 0.0), 1.0)) for c in rgb)  # type: ignore[return-value]
+
+
+def _grey_note(kind: str, what: str) -> str:
+    return f"{kind} is not renderable yet: approximated by a diffuse surface with {what}"
+
+
+def _map_diffuse(p: Props, imp: "_Importer") -> Mapped:
+    return Mapped(Diffuse(_clip_albedo(p.color("reflectance", 0.5))))
+
+
+def _map_roughdiffuse(p: Props, imp: "_Importer") -> Mapped:
+    p.float("alpha")
+    return Mapped(Diffuse(_clip_albedo(p.color("reflectance", 0.5))), "rough diffuse (Oren-Nayar) is rendered as Lambertian")
+
+
+def _map_conductor(p: Props, imp: "_Importer") -> Mapped:
+    for key in ("alpha", "alpha_u", "alpha_v", "distribution", "sample_visible"):
+        p.take(key)
+    if p.has("eta") or p.has("k"):
+        eta, k = p.color("eta", 0.0), p.color("k", 1.0)
+        f0, what = mv.conductor_f0(eta, k), "its normal-incidence reflectance (from eta, k)"
+    else:
+        name = p.string("material", "none")
+        f0, what = mv.CONDUCTOR_F0.get(name, (0.9, 0.9, 0.9)), f'the normal-incidence reflectance of "{name}"'
+    tint = p.color("specular_reflectance", 1.0)
+    albedo = _clip_albedo(a * b for a, b in zip(f0, tint))
+    return Mapped(Diffuse(albedo), _grey_note(p.node.type, what))
+
+
+def _map_plastic(p: Props, imp: "_Importer") -> Mapped:
+    for key in ("int_ior", "ext_ior", "alpha", "distribution", "nonlinear", "sample_visible", "specular_reflectance"):
+        p.take(key)
+    albedo = _clip_albedo(p.color("diffuse_reflectance", 0.5))
+    return Mapped(Diffuse(albedo), _grey_note(p.node.type, "its diffuse reflectance (no specular coat)"))
+
+
+def _map_dielectric(p: Props, imp: "_Importer") -> Mapped:
+    for key in ("int_ior", "ext_ior", "alpha", "alpha_u", "alpha_v", "distribution", "sample_visible",
+                "specular_reflectance"):
+        p.take(key)
+    tint = p.color("specular_transmittance", 1.0)
+    albedo = _clip_albedo(0.8 * c for c in tint)
+    return Mapped(Diffuse(albedo), _grey_note(p.node.type, "80% of its transmittance (no refraction)"))
+
+
+def _map_principled(p: Props, imp: "_Importer") -> Mapped:
+    for key in list(p.values):
+        if key != "base_color":
+            p.take(key)
+    albedo = _clip_albedo(p.color("base_color", 0.5))
+    return Mapped(Diffuse(albedo), _grey_note(p.node.type, "its base colour"))
+
+
+def _map_wrapper(p: Props, imp: "_Importer") -> Mapped:
+    """twosided, mask, bumpmap, normalmap, blendbsdf: the (first) nested BSDF, unwrapped."""
+    kind = p.node.type
+    for key in list(p.values):
+        if p.values[key].tag != "bsdf":
+            p.take(key)
+    inner = [n for n in p.objects if n.tag == "bsdf"] + [p.take(k) for k in list(p.values) if p.values[k].tag == "bsdf"]
+    if not inner:
+        return Mapped(Diffuse((0.5, 0.5, 0.5)), f"{kind} holds no BSDF: Mitsuba's default diffuse used")
+    mapped = imp.map_bsdf(inner[0])
+    notes = [mapped.note] if mapped.note else []
+    if kind == "twosided":
+        if len(inner) > 1:
+            notes.append("its back-side BSDF is dropped (LensLab surfaces look the same from both sides)")
+    elif kind == "mask":
+        notes.append("the opacity mask is ignored")
+    elif kind in ("bumpmap", "normalmap"):
+        notes.append(f"the {kind} is ignored")
+    elif kind == "blendbsdf":
+        notes.append("only its first BSDF is used")
+    return Mapped(mapped.material, "; ".join(notes) or None)
+
+
+BSDF_MAPPINGS: dict[str, BsdfMapping] = {
+    "diffuse": _map_diffuse,
+    "roughdiffuse": _map_roughdiffuse,
+    "conductor": _map_conductor,
+    "roughconductor": _map_conductor,
+    "plastic": _map_plastic,
+    "roughplastic": _map_plastic,
+    "dielectric": _map_dielectric,
+    "roughdielectric": _map_dielectric,
+    "thindielectric": _map_dielectric,
+    "principled": _map_principled,
+    "principledthin": _map_principled,
+    "twosided": _map_wrapper,
+    "mask": _map_wrapper,
+    "bumpmap": _map_wrapper,
+    "normalmap": _map_wrapper,
+    "blendbsdf": _map_wrapper,
+}
+"""Mitsuba BSDF plugin name -> mapping onto a LensLab material. Approximations return a ``note``."""
+
+MITSUBA_DEFAULT_MATERIAL = "mitsuba_default"  # a shape without a BSDF: Mitsuba's diffuse, reflectance 0.5
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Pass 2: the scene
+# ---------------------------------------------------------------------------------------------------------
+@dataclass
+class _Camera:
+    node: XNode | None
+    to_world: np.ndarray
+    fov_x_deg: float
+    aperture_radius: float | None  # None: a pinhole (perspective)
+    focus_distance: float
+
+
+class _Importer:
+    def __init__(self, root: XNode, ids: dict[str, XNode], root_folder: Path, warn: WarnCallback):
+        self.root = root
+        self.ids = ids
+        self.root_folder = root_folder
+        self._warn = warn
+        self.materials: dict[str, Material] = {}
+        self._material_of: dict[int, str] = {}
+        self.nodes: list[Node] = []
+        self._names: set[str] = set()
+        self._groups: dict[int, list[Node]] = {}
+        self.environment = ConstantEnvironment()
+        self.render = RenderSettings(spp=4, max_depth=1024, rr_depth=5, seed=0, sampler="independent")
+        self.resolution = (768, 576)
+        self.camera: _Camera | None = None
+        self.search_dirs: list[Path] = []
+
+    # -- reporting ----------------------------------------------------------------------------------------
+    def warn(self, node: XNode, message: str) -> None:
+        self._warn(f"{node.where()}: {node.label()}: {message}")
+
+    def resolve_ref(self, ref: XNode) -> XNode:
+        ident = ref.attrs.get("id")
+        if not ident:
+            raise ref.error('a <ref> needs an "id"')
+        if ident not in self.ids:
+            raise ref.error(f'unresolved reference to "{ident}": no object has id="{ident}"')
+        return self.ids[ident]
+
+    def resolve_file(self, node: XNode, filename: str) -> Path:
+        """A file named in ``node``: relative to its own file's folder, then the scene's, then <path> folders."""
+        path = Path(filename)
+        if path.is_absolute():
+            return path
+        for folder in [node.folder, self.root_folder, *self.search_dirs]:
+            if (folder / path).exists():
+                return folder / path
+        return node.folder / path
+
+    def unique_name(self, base: str) -> str:
+        name, n = base, 1
+        while name in self._names:
+            n += 1
+            name = f"{base}_{n}"
+        self._names.add(name)
+        return name
+
+    def unique_material(self, base: str) -> str:
+        name, n = base, 1
+        while name in self.materials:
+            n += 1
+            name = f"{base}_{n}"
+        return name
+
+    # -- values -------------------------------------------------------------------------------------------
+    def color_of(self, node: XNode) -> RGB:
+        """An RGB from <rgb>, <spectrum>, <float> or a texture (textures are averaged, with a warning)."""
+        try:
+            if node.tag == "rgb":
+                values = mv.split_numbers(node.attrs.get("value", ""))
+                if len(values) == 1:
+                    values = values * 3
+                if len(values) != 3:
+                    raise node.error(f"<rgb> needs one or three values (got {len(values)})")
+                return tuple(values)  # type: ignore[return-value]
+            if node.tag == "float":
+                v = float(node.attrs.get("value", ""))
+                return (v, v, v)
+            if node.tag == "spectrum" and "type" not in node.attrs:
+                if "filename" in node.attrs:
+                    self.warn(node, "spectra from files are not supported: white used")
+                    return (1.0, 1.0, 1.0)
+                return mv.spectrum_to_rgb(mv.parse_spectrum(node.attrs.get("value", "")))
+        except ValueError as exc:
+            raise node.error(str(exc)) from None
+        if node.tag in ("texture", "spectrum"):
+            return self.texture_color(node)
+        raise node.error("expected a colour (<rgb>, <spectrum>, <float> or a texture)")
+
+    def texture_color(self, node: XNode) -> RGB:
+        p = Props(self, node)
+        kind = node.type
+        if kind in ("srgb", "d65", "uniform"):
+            value = p.take("color") or p.take("value")
+            rgb = self.color_of(value) if value is not None else (1.0, 1.0, 1.0)
+            if kind == "d65" and p.has("scale"):
+                s = p.float("scale", 1.0)
+                rgb = tuple(c * s for c in rgb)
+            p.finish()
+            return rgb  # type: ignore[return-value]
+        if kind == "checkerboard":
+            c0, c1 = p.color("color0", 0.4), p.color("color1", 0.2)
+            p.take("to_uv")
+            p.finish()
+            rgb = tuple((a + b) / 2 for a, b in zip(c0, c1))
+            self.warn(node, f"textures are not supported yet: the checkerboard's mean colour {_fmt(rgb)} used")
+            return rgb  # type: ignore[return-value]
+        self.warn(node, "textures are not supported yet: grey 0.5 used")
+        return (0.5, 0.5, 0.5)
+
+    # -- BSDFs --------------------------------------------------------------------------------------------
+    def map_bsdf(self, node: XNode) -> Mapped:
+        if node.tag != "bsdf":
+            raise node.error("expected a <bsdf>")
+        mapping = BSDF_MAPPINGS.get(node.type)
+        if mapping is None:
+            return Mapped(Diffuse((0.5, 0.5, 0.5)), f'BSDF "{node.type}" is not supported: grey diffuse 0.5 used')
+        p = Props(self, node)
+        mapped = mapping(p, self)
+        p.finish()
+        return mapped
+
+    def material_for(self, bsdf: XNode | None, owner: str) -> str:
+        """The material name for a BSDF element (converted once, however many shapes use it)."""
+        if bsdf is None:
+            if MITSUBA_DEFAULT_MATERIAL not in self.materials:
+                self.materials[MITSUBA_DEFAULT_MATERIAL] = Diffuse((0.5, 0.5, 0.5))
+            return MITSUBA_DEFAULT_MATERIAL
+        key = id(bsdf)
+        if key not in self._material_of:
+            mapped = self.map_bsdf(bsdf)
+            if mapped.note:
+                self.warn(bsdf, mapped.note)
+            name = self.unique_material(bsdf.attrs.get("id") or f"{owner}.bsdf")
+            self.materials[name] = mapped.material
+            self._material_of[key] = name
+        return self._material_of[key]
+
+    # -- the scene ----------------------------------------------------------------------------------------
+    def run(self) -> None:
+        root = self.root
+        if root.tag != "scene":
+            raise root.error("the root element must be <scene>")
+        sensors = []
+        for child in root.children:
+            tag = child.tag
+            if tag == "integrator":
+                self.integrator(child)
+            elif tag == "sensor":
+                sensors.append(child)
+            elif tag == "shape":
+                self.nodes.extend(self.shape(child))
+            elif tag == "emitter":
+                self.emitter(child)
+            elif tag in ("bsdf", "texture", "spectrum"):
+                pass  # converted where a shape refers to them
+            elif tag == "path":
+                folder = self.resolve_file(child, child.attrs.get("value", ""))
+                if not folder.is_dir():
+                    raise child.error(f"folder not found: {folder}")
+                self.search_dirs.insert(0, folder)
+            elif tag in ("medium", "phase", "volume", "field"):
+                self.warn(child, "participating media are not supported: ignored")
+            elif tag == "ref":
+                self.resolve_ref(child)
+                self.warn(child, "a top-level <ref> adds nothing: ignored")
+            elif tag in OBJECT_TAGS or tag in VALUE_TAGS:
+                self.warn(child, "not expected in <scene>: ignored")
+            else:
+                self.warn(child, "unknown element: ignored")
+        if sensors:
+            self.sensor(sensors[0])
+            for extra in sensors[1:]:
+                self.warn(extra, "only the first sensor is used: ignored")
+
+    def integrator(self, node: XNode) -> None:
+        p = Props(self, node)
+        kind = node.type
+        if kind in ("path", "volpath", "volpathmis", "prb", "prbvolpath"):
+            max_depth = p.int("max_depth", -1)
+            rr_depth = p.int("rr_depth", 5)
+            if p.bool("hide_emitters", False):
+                self.warn(node, "hide_emitters is not supported: emitters stay visible")
+        elif kind == "direct":
+            max_depth, rr_depth = 2, 1024
+        else:
+            inner = [n for n in p.objects if n.tag == "integrator"]
+            if inner:  # aov, moment, ...: wrappers around the integrator that makes the image
+                self.warn(node, f'integrator "{kind}" is not supported: its nested integrator is used')
+                self.integrator(inner[0])
+            else:
+                self.warn(node, f'integrator "{kind}" is not supported: a path tracer is used')
+            return
+        p.finish()
+        if max_depth is not None and max_depth < 0:
+            max_depth = 1024  # Mitsuba's -1: unbounded; Russian roulette ends paths long before this
+        if max_depth == 0:
+            self.warn(node, "max_depth 0 (an empty image) is not supported: 1 used")
+            max_depth = 1
+        self.render.max_depth = int(min(max_depth, 1024))
+        self.render.rr_depth = int(min(max(rr_depth, 1), 1024))
+
+    def emitter(self, node: XNode) -> None:
+        p = Props(self, node)
+        kind = node.type
+        if kind == "constant":
+            rgb = p.color("radiance", 1.0)
+            scale = p.float("scale", 1.0)
+            p.finish()
+            old = self.environment.radiance
+            self.environment = ConstantEnvironment(tuple(float(a + b * scale) for a, b in zip(old, rgb)))  # type: ignore[arg-type]
+        elif kind == "area":
+            self.warn(node, "an area emitter must sit inside a <shape>: ignored")
+        else:
+            self.warn(node, f'emitter "{kind}" is not supported yet: ignored (the scene lacks this light)')
+
+    # -- shapes -------------------------------------------------------------------------------------------
+    def shape(self, node: XNode) -> list[Node]:
+        kind = node.type
+        p = Props(self, node)
+        name = self.unique_name(node.attrs.get("id") or kind or "shape")
+        if kind == "shapegroup":
+            return []  # instanced where an <shape type="instance"> refers to it
+        if kind == "instance":
+            return self.instance(node, p, name)
+        to_world = p.transform("to_world")
+        local = np.eye(4)
+        flip = p.bool("flip_normals", False)
+        shape = None
+        if kind == "sphere":
+            center = p.vector("center", (0, 0, 0))
+            radius = p.float("radius", 1.0)
+            local = mv.translate_matrix(center)
+            shape = Sphere(radius=abs(radius))
+        elif kind == "rectangle":
+            shape = Rectangle(size=(2.0, 2.0))
+            if flip:  # the same square seen from behind: turn it half a turn about its x axis
+                local = mv.rotate_matrix((1, 0, 0), 180.0)
+                flip = False
+        elif kind == "cube":
+            shape = Box(size=(2.0, 2.0, 2.0))
+        elif kind == "disk":
+            shape = MeshFile(file=str(_disk_mesh_file()), smooth=False)
+            if flip:
+                local = mv.rotate_matrix((1, 0, 0), 180.0)
+                flip = False
+            self.warn(node, f"disks are not a LensLab shape yet: a {DISK_SEGMENTS}-sided polygon of equal area used")
+        elif kind in ("obj", "ply", "stl"):
+            filename = p.string("filename")
+            if not filename:
+                raise node.error('needs a "filename"')
+            path = self.resolve_file(node, filename)
+            if not path.is_file():
+                raise node.error(f"mesh file not found: {path}")
+            smooth = not p.bool("face_normals", False)
+            shape = MeshFile(file=self._scene_relative(path), smooth=smooth)
+        else:
+            p.finish()
+            if kind == "serialized":
+                self.warn(node, "Mitsuba .serialized meshes are not readable yet: shape skipped (convert it to PLY)")
+            else:
+                self.warn(node, f'shape "{kind}" is not supported: skipped')
+            return []
+
+        emitters = [n for n in p.objects if n.tag == "emitter"] + [p.take(k) for k in list(p.values) if p.values[k].tag == "emitter"]
+        bsdfs = [n for n in p.objects if n.tag == "bsdf"] + [p.take(k) for k in list(p.values) if p.values[k].tag == "bsdf"]
+        for key in ("interior", "exterior"):
+            if p.take(key) is not None:
+                self.warn(node, f"the {key} medium is ignored (participating media are not supported)")
+        for other in p.objects:
+            if other.tag not in ("emitter", "bsdf"):
+                self.warn(other, f"not supported inside {node.label()}: ignored")
+        p.finish()
+
+        if len(bsdfs) > 1:
+            self.warn(bsdfs[1], "a shape takes one BSDF: the first is used")
+        material = None
+        if emitters:
+            material = self.area_light(emitters[0], node, name, flip, bool(bsdfs))
+            for extra in emitters[1:]:
+                self.warn(extra, "a shape takes one emitter: the first is used")
+        if material is None:
+            bsdf = bsdfs[0] if bsdfs else None
+            if bsdf is not None and bsdf.type == "null":
+                self.warn(bsdf, "an invisible (null BSDF) shape without a light: skipped")
+                return []
+            material = self.material_for(bsdf, name)
+
+        matrix = to_world @ local
+        if isinstance(shape, Sphere):
+            matrix = self._similarity(node, matrix)
+        return self.place(node, name, matrix, shape, material)
+
+    def area_light(self, emitter: XNode, shape_node: XNode, name: str, flip: bool, has_bsdf: bool) -> str | None:
+        if emitter.type != "area":
+            self.warn(emitter, f'emitter "{emitter.type}" cannot be attached to a shape: ignored')
+            return None
+        p = Props(self, emitter)
+        radiance = p.color("radiance", 1.0)
+        p.finish()
+        if flip:
+            self.warn(shape_node, "flip_normals on an emitting "
+                      f"{shape_node.type} is not supported: it emits from its outside")
+        if has_bsdf:
+            self.warn(emitter, "the light's own BSDF is dropped: a LensLab emitter reflects nothing")
+        material = self.unique_material(f"{name}.emitter")
+        clipped = tuple(float(min(max(c, 0.0), 1e6)) for c in radiance)
+        self.materials[material] = Emissive(radiance=clipped, two_sided=False)  # type: ignore[arg-type]
+        return material
+
+    def instance(self, node: XNode, p: Props, name: str) -> list[Node]:
+        to_world = p.transform("to_world")
+        groups = [n for n in p.objects if n.tag == "shape" and n.type == "shapegroup"]
+        p.finish()
+        if not groups:
+            self.warn(node, "an instance needs a <ref> to a shapegroup: skipped")
+            return []
+        group = groups[0]
+        key = id(group)
+        if key not in self._groups:
+            gp = Props(self, group)
+            members = []
+            for child in gp.objects:
+                if child.tag == "shape":
+                    members.extend(self.shape(child))
+                else:
+                    self.warn(child, "a shapegroup holds only shapes: ignored")
+            gp.finish()
+            self._groups[key] = members
+        children = copy.deepcopy(self._groups[key])
+        try:
+            transforms = mv.decompose_affine(to_world)
+        except ValueError as exc:
+            self.warn(node, f"{exc}: skipped")
+            return []
+        outer = Node(name=name, transform=transforms[0], children=children)
+        if len(transforms) == 2:
+            outer.children = [Node(name=f"{name}.shear", transform=transforms[1], children=children)]
+        return [outer]
+
+    def place(self, node: XNode, name: str, matrix: np.ndarray, shape, material: str) -> list[Node]:
+        """A node (or, for a sheared matrix, a node holding a node) that puts ``shape`` at ``matrix``."""
+        try:
+            transforms = mv.decompose_affine(matrix)
+        except ValueError as exc:
+            self.warn(node, f"{exc}: shape skipped")
+            return []
+        if len(transforms) == 1:
+            return [Node(name=name, transform=transforms[0], shape=shape, material=material)]
+        inner = Node(name=f"{name}.shear", transform=transforms[1], shape=shape, material=material)
+        return [Node(name=name, transform=transforms[0], children=[inner])]
+
+    def _similarity(self, node: XNode, matrix: np.ndarray) -> np.ndarray:
+        scale = np.linalg.norm(matrix[:3, :3], axis=0)
+        gram = matrix[:3, :3].T @ matrix[:3, :3]
+        if np.ptp(scale) <= 1e-9 * scale.max() and np.allclose(gram, np.diag(np.diag(gram)), atol=1e-9 * scale.max() ** 2):
+            return matrix
+        self.warn(node, "a sphere takes no non-uniform scale or shear (Mitsuba forbids it too): "
+                  "the nearest uniform scale used")
+        return mv.nearest_similarity(matrix)
+
+    def _scene_relative(self, path: Path) -> str:
+        try:
+            return os.path.relpath(path.resolve(), self.root_folder.resolve())
+        except ValueError:  # another drive on Windows
+            return str(path.resolve())
+
+    # -- sensor, film, sampler ----------------------------------------------------------------------------
+    def sensor(self, node: XNode) -> None:
+        p = Props(self, node)
+        kind = node.type
+        films = [n for n in p.objects if n.tag == "film"] + [p.take(k) for k in list(p.values) if p.values[k].tag == "film"]
+        samplers = [n for n in p.objects if n.tag == "sampler"] + [p.take(k) for k in list(p.values) if p.values[k].tag == "sampler"]
+        if films:
+            self.film(films[0])
+        else:
+            self.warn(node, "no <film>: Mitsuba's default hdrfilm 768 x 576 with a gaussian filter; LensLab "
+                      "filters with a box")
+        if samplers:
+            self.sampler(samplers[0])
+        if kind not in ("perspective", "thinlens"):
+            p.finish(silent=set(p.values))
+            self.warn(node, f'sensor "{kind}" is not supported: a default camera is used')
+            return
+        to_world = p.transform("to_world")
+        width, height = self.resolution
+        aspect = width / height
+        try:
+            fov_x = _parse_fov(p, aspect)
+        except ValueError as exc:
+            raise node.error(str(exc)) from None
+        focus = p.float("focus_distance", 1e4)  # Mitsuba: the far clip plane
+        radius = None
+        if kind == "thinlens":
+            radius = p.float("aperture_radius")
+            if radius is None:
+                self.warn(node, "thinlens without aperture_radius (Mitsuba requires one): a pinhole is used")
+        for key in ("principal_point_offset_x", "principal_point_offset_y"):
+            if p.float(key, 0.0) != 0.0:
+                self.warn(node, f"{key} (an off-centre image) is not supported: centred")
+        p.finish()
+        self.camera = _Camera(node, to_world, fov_x, radius, focus)
+
+    def film(self, node: XNode) -> None:
+        p = Props(self, node)
+        if node.type not in ("hdrfilm", "specfilm"):
+            self.warn(node, f'film "{node.type}" is not supported: read as an hdrfilm')
+        width, height = p.int("width", 768), p.int("height", 576)
+        if not (1 <= width <= 16384 and 1 <= height <= 16384):
+            raise node.error(f"film size {width} x {height} is out of range [1, 16384]")
+        self.resolution = (width, height)
+        for key in ("crop_offset_x", "crop_offset_y", "crop_width", "crop_height"):
+            if p.take(key) is not None:
+                self.warn(node, f"{key}: cropped films are not supported: the whole frame is rendered")
+        filters = [n for n in p.objects if n.tag == "rfilter"] + [p.take(k) for k in list(p.values) if p.values[k].tag == "rfilter"]
+        p.finish()
+        if not filters:
+            self.warn(node, "Mitsuba's default reconstruction filter is a gaussian; LensLab filters with a box "
+                      "(add <rfilter type=\"box\"/> to match)")
+            return
+        rfilter = filters[0]
+        rp = Props(self, rfilter)
+        rp.finish(silent=set(rp.values))
+        if rfilter.type != "box":
+            self.warn(rfilter, f'reconstruction filter "{rfilter.type}" is not supported: a box filter is used')
+
+    def sampler(self, node: XNode) -> None:
+        p = Props(self, node)
+        spp = p.int("sample_count", 4)
+        seed = p.int("seed", 0)
+        p.finish()
+        if not 1 <= spp <= 1 << 24:
+            raise node.error(f"sample_count {spp} is out of range [1, {1 << 24}]")
+        self.render.spp = spp
+        self.render.seed = int(seed) % (2**31)
+        # independent stays independent; every stratified or low-discrepancy sampler maps onto our Sobol.
+        self.render.sampler = "independent" if node.type == "independent" else "sobol"
+
+    # -- the camera, last: a pinhole needs the scene's extent ---------------------------------------------
+    def make_camera(self) -> ThinLensCamera:
+        width, height = self.resolution
+        cam = self.camera
+        if cam is None:
+            cam = self._default_camera()
+        m = cam.to_world
+        linear = m[:3, :3]
+        position = m[:3, 3]
+        forward = linear @ (0.0, 0.0, 1.0)
+        up = linear @ (0.0, 1.0, 0.0)
+        left = linear @ (1.0, 0.0, 0.0)
+        norms = np.linalg.norm([left, up, forward], axis=1)
+        where = cam.node if cam.node is not None else self.root
+        if np.any(np.abs(norms - 1) > 1e-6) or abs(np.dot(forward, up)) > 1e-6 * norms[1] * norms[2]:
+            self.warn(where, "the camera's to_world scales or shears (Mitsuba forbids it): its rotation is used")
+        if np.linalg.det(linear) < 0:
+            self.warn(where, "the camera's to_world mirrors the image: not supported, the image is unmirrored")
+        forward = forward / np.linalg.norm(forward)
+        up = up - np.dot(up, forward) * forward
+        up = up / np.linalg.norm(up)
+
+        fov_x = math.radians(cam.fov_x_deg)
+        focal_mm = focal_length_for_fov(fov_x, SENSOR_WIDTH_MM)
+        if not 1.0 <= focal_mm <= 2000.0:
+            self.warn(where, f"a field of view of {cam.fov_x_deg:.4g} degrees needs a {focal_mm:.4g} mm lens, "
+                      "outside LensLab's 1-2000 mm: clamped")
+            focal_mm = min(max(focal_mm, 1.0), 2000.0)
+        focus = cam.focus_distance
+        if cam.aperture_radius is None:
+            f_number, focus = self._pinhole(cam, position, forward, focal_mm, width)
+        else:
+            r = cam.aperture_radius
+            f_number = focal_mm / MM_PER_M / (2.0 * r) if r > 0 else math.inf
+            if not 0.5 <= f_number <= 128.0:
+                self.warn(where, f"aperture_radius {r:g} gives f/{f_number:.4g}, outside LensLab's f/0.5-f/128: clamped")
+                f_number = min(max(f_number, 0.5), 128.0)
+        if not 0.01 <= focus <= 1e6:
+            self.warn(where, f"focus_distance {focus:g} is outside 0.01-1e6: clamped")
+            focus = min(max(focus, 0.01), 1e6)
+        return ThinLensCamera(
+            position=tuple(float(v) for v in position),
+            look_at=tuple(float(v) for v in position + forward),
+            up=tuple(float(v) for v in up),
+            focal_length_mm=float(focal_mm),
+            f_number=float(f_number),
+            focus_distance_m=float(focus),
+            sensor_mm=(SENSOR_WIDTH_MM, SENSOR_WIDTH_MM * height / width),
+            resolution=(width, height),
+        )
+
+    def _pinhole(self, cam: _Camera, position, forward, focal_mm: float, width: int) -> tuple[float, float]:
+        """A pinhole as our smallest aperture, f/128, focused where the scene's depth range blurs least."""
+        f_number = 128.0
+        corners = self._bounds_corners()
+        depths = (corners - position) @ forward if len(corners) else np.zeros(0)
+        depths = depths[depths > 0]
+        if len(depths) == 0:
+            return f_number, cam.focus_distance
+        far = float(depths.max())
+        near = max(float(depths.min()), 1e-3 * far, 1e-3)
+        # blur diameter on the sensor is A f |1/s - 1/d|: the harmonic mean of near and far halves the worst.
+        inv_s = 0.5 * (1 / near + 1 / far)
+        aperture_mm = focal_mm / f_number
+        blur_mm = aperture_mm * focal_mm * (1 / near - inv_s) / MM_PER_M
+        blur_px = blur_mm / SENSOR_WIDTH_MM * width
+        if blur_px > 0.5:
+            self.warn(cam.node or self.root, f"a pinhole is rendered at f/128 focused at {1 / inv_s:.4g}: "
+                      f"up to {blur_px:.2g} pixels of blur between depths {near:.3g} and {far:.3g}")
+        return f_number, 1 / inv_s
+
+    def _bounds_corners(self) -> np.ndarray:
+        from lenslab.scene.io.meshes import MeshLoadError, load_mesh
+
+        points = []
+        for root in self.nodes:
+            for node, matrix in root.walk():
+                shape = node.shape
+                if shape is None:
+                    continue
+                if isinstance(shape, Sphere):
+                    r = shape.radius
+                    local = np.array([[x, y, z] for x in (-r, r) for y in (-r, r) for z in (-r, r)])
+                elif isinstance(shape, (Rectangle, Box)):
+                    local = shape.mesh().vertices
+                else:
+                    path = Path(shape.file)
+                    path = path if path.is_absolute() else self.root_folder / path
+                    try:
+                        v = load_mesh(path, shape.smooth).vertices
+                    except MeshLoadError as exc:
+                        raise SceneError(f"{exc}") from None
+                    lo, hi = v.min(axis=0), v.max(axis=0)
+                    local = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+                points.append(transform_points(matrix, local))
+        return np.concatenate(points) if points else np.zeros((0, 3))
+
+    def _default_camera(self) -> _Camera:
+        """Mitsuba's camera for a scene without a sensor: 45 degrees, looking down +Z at the whole scene."""
+        self.warn(self.root, "no sensor: Mitsuba's default camera (45 degrees, looking down +Z at the scene) is used")
+        corners = self._bounds_corners()
+        if len(corners) == 0:
+            return _Camera(None, np.eye(4), 45.0, None, 1e4)
+        lo, hi = corners.min(axis=0), corners.max(axis=0)
+        center, extents = (lo + hi) / 2, hi - lo
+        distance = extents.max() / (2 * math.tan(math.radians(45 / 2)))
+        origin = (center[0], center[1], lo[2] - distance)
+        return _Camera(None, mv.translate_matrix(origin), 45.0, None, distance + extents[2] / 2)
+
+
+def _parse_fov(p: Props, aspect: float) -> float:
+    """Mitsuba's ``parse_fov``: the horizontal field of view in degrees."""
+    if p.has("fov") and p.has("focal_length"):
+        raise ValueError("give either a focal length ('focal_length') or a field of view ('fov'), not both")
+    if p.has("fov"):
+        fov = p.float("fov")
+        axis = (p.string("fov_axis", "x") or "x").lower()
+        if axis == "smaller":
+            axis = "y" if aspect > 1 else "x"
+        elif axis == "larger":
+            axis = "x" if aspect > 1 else "y"
+    else:
+        text = p.string("focal_length", "50mm").strip()
+        if text.endswith("mm"):
+            text = text[:-2]
+        try:
+            value = float(text)
+        except ValueError:
+            raise ValueError(f"could not parse the focal length '{text}' (expected <x>mm)") from None
+        fov = 2 * math.degrees(math.atan(math.hypot(36.0, 24.0) / (2 * value)))
+        axis = "diagonal"
+    half = math.radians(fov) / 2
+    if axis == "x":
+        result = fov
+    elif axis == "y":
+        result = math.degrees(2 * math.atan(math.tan(half) * aspect))
+    elif axis == "diagonal":
+        width = 2 * math.tan(half) / math.sqrt(1 + 1 / (aspect * aspect))
+        result = math.degrees(2 * math.atan(width / 2))
+    else:
+        raise ValueError("fov_axis must be one of 'x', 'y', 'diagonal', 'smaller' or 'larger'")
+    if not 0 < result < 180:
+        raise ValueError(f"the horizontal field of view ({result:g} degrees) must lie between 0 and 180")
+    return result
+
+
+def _fmt(rgb) -> str:
+    return "(" + ", ".join(f"{c:.3g}" for c in rgb) + ")"
+
+
+def _cache_dir() -> Path:
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "lenslab" / "generated-meshes"
+
+
+def _disk_mesh_file() -> Path:
+    """A unit disk (z = 0, facing +Z) as a polygon of the same area, written once to the cache folder."""
+    n = DISK_SEGMENTS
+    r = math.sqrt(2 * math.pi / (n * math.sin(2 * math.pi / n)))  # polygon area = pi
+    lines = ["# unit disk for LensLab's Mitsuba importer", "v 0 0 0"]
+    for i in range(n):
+        a = 2 * math.pi * i / n
+        lines.append(f"v {r * math.cos(a):.12f} {r * math.sin(a):.12f} 0")
+    lines += [f"f 1 {i + 2} {(i + 1) % n + 2}" for i in range(n)]
+    text = "\n".join(lines) + "\n"
+    digest = hashlib.sha1(text.encode()).hexdigest()[:10]
+    path = _cache_dir() / f"disk-{n}-{digest}.obj"
+    if not path.is_file():
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_suffix(f".{os.getpid()}.tmp")
+        tmp.write_text(text)
+        os.replace(tmp, path)
+    return path
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Entry points
+# ---------------------------------------------------------------------------------------------------------
+def _default_warn(message: str) -> None:
+    log.warning("%s", message)
+
+
+def _load(root_loader, display: str, folder: Path, source_path: Path | None,
+          defines: dict[str, str] | None, warn: WarnCallback | None) -> Scene:
+    warn = warn or _default_warn
+    expander = _Expander({k: str(v) for k, v in (defines or {}).items()})
+    root = root_loader(expander)
+    expanded = expander.expand(root, 0)[0]
+    for name in sorted(set(defines or {}) - expander.used):
+        warn(f"{display}: -D {name}={defines[name]} is not used by the scene")
+    importer = _Importer(expanded, expander.ids, folder, warn)
+    importer.run()
+    camera = importer.make_camera()
+    return Scene(
+        camera=camera,
+        environment=importer.environment,
+        render=importer.render,
+        materials=importer.materials,
+        nodes=importer.nodes,
+        source_path=source_path,
+    )
+
+
+def load_mitsuba_scene(path: str | os.PathLike, defines: dict[str, str] | None = None,
+                       warn: WarnCallback | None = None) -> Scene:
+    """Read a Mitsuba 3 XML scene.
+
+    ``defines``: ``$name`` values, as ``mitsuba -D name=value`` (they win over ``<default>``).
+    ``warn``: called with one line per thing LensLab approximates or leaves out (``file:line: <element>:
+    what was done``); by default they go to the ``lenslab.import`` logger as warnings.
+    Raises :class:`SceneError` (file and line in its message) for a file Mitsuba would reject too.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise SceneError(f"{path}: no such scene file")
+    folder = path.resolve().parent
+    return _load(lambda ex: ex.parse_file(path), str(path), folder, path.resolve(), defines, warn)
+
+
+def load_mitsuba_string(text: str, base_dir: str | os.PathLike | None = None, defines: dict[str, str] | None = None,
+                        warn: WarnCallback | None = None, name: str = "<string>") -> Scene:
+    """Read a Mitsuba scene held in a string; relative files resolve against ``base_dir`` (default: cwd).
+    The scene's ``source_path`` is a (not existing) file in ``base_dir`` so that mesh paths resolve."""
+    folder = Path(base_dir or Path.cwd()).resolve()
+    source = folder / "scene.xml"
+    return _load(lambda ex: _parse_xml(text.encode("utf-8"), name, folder), name, folder, source, defines, warn)
