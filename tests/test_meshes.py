@@ -1,0 +1,46 @@
+"""Triangle meshes come in through trimesh in every format the scene format promises."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import trimesh
+
+from lenslab.scene.camera import ThinLensCamera
+from lenslab.scene.scene import Node, Scene
+from lenslab.scene.shapes import MeshFile
+from lenslab.scene.transform import Transform
+
+
+@pytest.mark.parametrize("suffix", [".obj", ".ply", ".stl", ".glb", ".gltf", ".off"])
+def test_mesh_formats_load_with_their_triangles(tmp_path, suffix):
+    source = trimesh.creation.icosphere(subdivisions=2, radius=0.5)
+    path = tmp_path / f"ball{suffix}"
+    source.export(path)
+    scene = Scene(camera=ThinLensCamera(), nodes=[Node("ball", Transform(translate=(0, 1, 0)), MeshFile(path.name))],
+                  source_path=tmp_path / "scene.json")
+    flat = scene.flatten()
+    assert flat.triangle_count == len(source.faces)
+    centre = flat.triangles.reshape(-1, 3).mean(axis=0)
+    assert np.allclose(centre, (0, 1, 0), atol=1e-3)
+    radii = np.linalg.norm(flat.triangles.reshape(-1, 3) - (0, 1, 0), axis=1)
+    assert np.allclose(radii, 0.5, atol=1e-4)
+    # Smooth shading normals point outwards, along the radius.
+    normals = flat.triangle_normals.reshape(-1, 3)
+    outward = (flat.triangles.reshape(-1, 3) - (0, 1, 0)) / 0.5
+    assert np.einsum("ij,ij->i", normals, outward).min() > 0.95
+
+
+def test_mirroring_transform_keeps_front_faces_in_front(tmp_path):
+    from lenslab.scene.shapes import Box
+
+    plain = Scene(nodes=[Node("box", shape=Box())]).flatten()
+    mirrored = Scene(nodes=[Node("box", Transform(scale=(-1, 1, 1)), Box())]).flatten()
+
+    def outward_fraction(flat):
+        tri = flat.triangles
+        n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        return np.mean(np.einsum("ij,ij->i", n, tri.mean(axis=1)) > 0)
+
+    assert outward_fraction(plain) == 1.0
+    assert outward_fraction(mirrored) == 1.0
