@@ -349,11 +349,12 @@ class Props:
         self._expect(node, ("transform",))
         return _transform_matrix(node, self.importer)
 
-    def color(self, name: str, default: float | RGB) -> RGB:
+    def color(self, name: str, default: float | RGB, emission: bool = False) -> RGB:
+        """A colour property; ``emission`` reads spectra as Mitsuba reads an emitter's (absolute)."""
         node = self.take(name)
         if node is None:
             return (float(default),) * 3 if isinstance(default, (int, float)) else tuple(default)  # type: ignore[return-value]
-        return self.importer.color_of(node)
+        return self.importer.color_of(node, emission)
 
     def finish(self, silent: set[str] = frozenset()) -> None:
         silent = set(silent) | SILENT.get(self.node.tag, set())
@@ -388,7 +389,11 @@ def _transform_matrix(node: XNode, importer: "_Importer") -> np.ndarray:
             elif op.tag == "rotate":
                 if "angle" not in op.attrs:
                     raise op.error('missing attribute "angle"')
-                step = mv.rotate_matrix(_xyz(op, 0.0), float(op.attrs["angle"]))
+                axis = _xyz(op, 0.0)
+                step = mv.rotate_matrix(axis, float(op.attrs["angle"]))
+                if abs(np.linalg.norm(axis) - 1.0) > 1e-6:
+                    importer.warn(op, "the rotation axis is not of unit length: Mitsuba 3 does not normalise it, "
+                                  "so this rotation also scales (kept, to match Mitsuba)")
             elif op.tag == "lookat":
                 if "origin" not in op.attrs or "target" not in op.attrs:
                     raise op.error('needs "origin" and "target"')
@@ -559,6 +564,7 @@ class _Importer:
         self.render = RenderSettings(spp=4, max_depth=1024, rr_depth=5, seed=0, sampler="independent")
         self.resolution = (768, 576)
         self.camera: _Camera | None = None
+        self._unsupported_sensor = False
         self.search_dirs: list[Path] = []
 
     # -- reporting ----------------------------------------------------------------------------------------
@@ -599,7 +605,7 @@ class _Importer:
         return name
 
     # -- values -------------------------------------------------------------------------------------------
-    def color_of(self, node: XNode) -> RGB:
+    def color_of(self, node: XNode, emission: bool = False) -> RGB:
         """An RGB from <rgb>, <spectrum>, <float> or a texture (textures are averaged, with a warning)."""
         try:
             if node.tag == "rgb":
@@ -616,19 +622,19 @@ class _Importer:
                 if "filename" in node.attrs:
                     self.warn(node, "spectra from files are not supported: white used")
                     return (1.0, 1.0, 1.0)
-                return mv.spectrum_to_rgb(mv.parse_spectrum(node.attrs.get("value", "")))
+                return mv.spectrum_to_rgb(mv.parse_spectrum(node.attrs.get("value", "")), emission)
         except ValueError as exc:
             raise node.error(str(exc)) from None
         if node.tag in ("texture", "spectrum"):
-            return self.texture_color(node)
+            return self.texture_color(node, emission)
         raise node.error("expected a colour (<rgb>, <spectrum>, <float> or a texture)")
 
-    def texture_color(self, node: XNode) -> RGB:
+    def texture_color(self, node: XNode, emission: bool = False) -> RGB:
         p = Props(self, node)
         kind = node.type
         if kind in ("srgb", "d65", "uniform"):
             value = p.take("color") or p.take("value")
-            rgb = self.color_of(value) if value is not None else (1.0, 1.0, 1.0)
+            rgb = self.color_of(value, emission) if value is not None else (1.0, 1.0, 1.0)
             if kind == "d65" and p.has("scale"):
                 s = p.float("scale", 1.0)
                 rgb = tuple(c * s for c in rgb)
@@ -740,7 +746,7 @@ class _Importer:
         p = Props(self, node)
         kind = node.type
         if kind == "constant":
-            rgb = p.color("radiance", 1.0)
+            rgb = p.color("radiance", 1.0, emission=True)
             scale = p.float("scale", 1.0)
             p.finish()
             old = self.environment.radiance
@@ -832,7 +838,7 @@ class _Importer:
             self.warn(emitter, f'emitter "{emitter.type}" cannot be attached to a shape: ignored')
             return None
         p = Props(self, emitter)
-        radiance = p.color("radiance", 1.0)
+        radiance = p.color("radiance", 1.0, emission=True)
         p.finish()
         if flip:
             self.warn(shape_node, "flip_normals on an emitting "
@@ -916,7 +922,9 @@ class _Importer:
             self.sampler(samplers[0])
         if kind not in ("perspective", "thinlens"):
             p.finish(silent=set(p.values))
-            self.warn(node, f'sensor "{kind}" is not supported: a default camera is used')
+            self.warn(node, f'sensor "{kind}" is not supported: a 45-degree camera looking down +Z at the whole '
+                      "scene is used")
+            self._unsupported_sensor = True
             return
         to_world = p.transform("to_world")
         width, height = self.resolution
@@ -930,7 +938,7 @@ class _Importer:
         if kind == "thinlens":
             radius = p.float("aperture_radius")
             if radius is None:
-                self.warn(node, "thinlens without aperture_radius (Mitsuba requires one): a pinhole is used")
+                raise node.error('needs an "aperture_radius" (Mitsuba has no default either)')
         for key in ("principal_point_offset_x", "principal_point_offset_y"):
             if p.float(key, 0.0) != 0.0:
                 self.warn(node, f"{key} (an off-centre image) is not supported: centred")
@@ -1070,8 +1078,10 @@ class _Importer:
         return np.concatenate(points) if points else np.zeros((0, 3))
 
     def _default_camera(self) -> _Camera:
-        """Mitsuba's camera for a scene without a sensor: 45 degrees, looking down +Z at the whole scene."""
-        self.warn(self.root, "no sensor: Mitsuba's default camera (45 degrees, looking down +Z at the scene) is used")
+        """A camera for a scene without a (supported) sensor, placed as Mitsuba 2 placed its default one:
+        45 degrees, looking down +Z at the whole scene. (Mitsuba 3.9 itself renders nothing without one.)"""
+        if not self._unsupported_sensor:
+            self.warn(self.root, "no sensor: a 45-degree camera looking down +Z at the whole scene is used")
         corners = self._bounds_corners()
         if len(corners) == 0:
             return _Camera(None, np.eye(4), 45.0, None, 1e4)
