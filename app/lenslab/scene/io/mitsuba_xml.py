@@ -44,9 +44,10 @@ from lenslab.scene.camera import ThinLensCamera
 from lenslab.scene.materials import Diffuse, Emissive, Material
 from lenslab.scene.scene import ConstantEnvironment, Node, RenderSettings, Scene, SceneError
 from lenslab.scene.shapes import Box, MeshFile, Rectangle, Sphere
-from lenslab.scene.transform import Transform, transform_points
+from lenslab.scene.transform import transform_points
 
 from . import mitsuba_values as mv
+from .mitsuba_bsdfs import BSDF_MAPPINGS, Mapped
 
 __all__ = ["load_mitsuba_scene", "load_mitsuba_string", "BSDF_MAPPINGS", "WarnCallback"]
 
@@ -373,6 +374,8 @@ def _xyz(node: XNode, default: float) -> np.ndarray:
                 raise node.error('"value" must have exactly 1 or 3 elements')
             return np.array(values, dtype=float)
         return np.array([float(node.attrs.get(k, default)) for k in "xyz"])
+    except SceneError:
+        raise
     except ValueError:
         raise node.error("could not parse a number") from None
 
@@ -406,6 +409,8 @@ def _transform_matrix(node: XNode, importer: "_Importer") -> np.ndarray:
             else:
                 importer.warn(op, "unexpected element inside <transform>: ignored")
                 continue
+        except SceneError:
+            raise
         except ValueError as exc:
             raise op.error(str(exc)) from None
         m = step @ m
@@ -421,118 +426,6 @@ def _three(node: XNode, key: str) -> np.ndarray:
         raise node.error(f'"{key}" needs 3 values, got {len(values)}')
     return np.array(values)
 
-
-# ---------------------------------------------------------------------------------------------------------
-# BSDFs: one mapping per Mitsuba plugin name
-# ---------------------------------------------------------------------------------------------------------
-@dataclass
-class Mapped:
-    """What a BSDF became; ``note`` (if any) says how it was approximated, and is reported as a warning."""
-
-    material: Material
-    note: str | None = None
-
-
-BsdfMapping = Callable[[Props, "_Importer"], Mapped]
-
-
-def _clip_albedo(rgb) -> RGB:
-    return tuple(float(min(max(c, 0.0), 1.0)) for c in rgb)  # type: ignore[return-value]
-
-
-def _grey_note(kind: str, what: str) -> str:
-    return f"{kind} is not renderable yet: approximated by a diffuse surface with {what}"
-
-
-def _map_diffuse(p: Props, imp: "_Importer") -> Mapped:
-    return Mapped(Diffuse(_clip_albedo(p.color("reflectance", 0.5))))
-
-
-def _map_roughdiffuse(p: Props, imp: "_Importer") -> Mapped:
-    p.float("alpha")
-    return Mapped(Diffuse(_clip_albedo(p.color("reflectance", 0.5))), "rough diffuse (Oren-Nayar) is rendered as Lambertian")
-
-
-def _map_conductor(p: Props, imp: "_Importer") -> Mapped:
-    for key in ("alpha", "alpha_u", "alpha_v", "distribution", "sample_visible"):
-        p.take(key)
-    if p.has("eta") or p.has("k"):
-        eta, k = p.color("eta", 0.0), p.color("k", 1.0)
-        f0, what = mv.conductor_f0(eta, k), "its normal-incidence reflectance (from eta, k)"
-    else:
-        name = p.string("material", "none")
-        f0, what = mv.CONDUCTOR_F0.get(name, (0.9, 0.9, 0.9)), f'the normal-incidence reflectance of "{name}"'
-    tint = p.color("specular_reflectance", 1.0)
-    albedo = _clip_albedo(a * b for a, b in zip(f0, tint))
-    return Mapped(Diffuse(albedo), _grey_note(p.node.type, what))
-
-
-def _map_plastic(p: Props, imp: "_Importer") -> Mapped:
-    for key in ("int_ior", "ext_ior", "alpha", "distribution", "nonlinear", "sample_visible", "specular_reflectance"):
-        p.take(key)
-    albedo = _clip_albedo(p.color("diffuse_reflectance", 0.5))
-    return Mapped(Diffuse(albedo), _grey_note(p.node.type, "its diffuse reflectance (no specular coat)"))
-
-
-def _map_dielectric(p: Props, imp: "_Importer") -> Mapped:
-    for key in ("int_ior", "ext_ior", "alpha", "alpha_u", "alpha_v", "distribution", "sample_visible",
-                "specular_reflectance"):
-        p.take(key)
-    tint = p.color("specular_transmittance", 1.0)
-    albedo = _clip_albedo(0.8 * c for c in tint)
-    return Mapped(Diffuse(albedo), _grey_note(p.node.type, "80% of its transmittance (no refraction)"))
-
-
-def _map_principled(p: Props, imp: "_Importer") -> Mapped:
-    for key in list(p.values):
-        if key != "base_color":
-            p.take(key)
-    albedo = _clip_albedo(p.color("base_color", 0.5))
-    return Mapped(Diffuse(albedo), _grey_note(p.node.type, "its base colour"))
-
-
-def _map_wrapper(p: Props, imp: "_Importer") -> Mapped:
-    """twosided, mask, bumpmap, normalmap, blendbsdf: the (first) nested BSDF, unwrapped."""
-    kind = p.node.type
-    for key in list(p.values):
-        if p.values[key].tag != "bsdf":
-            p.take(key)
-    inner = [n for n in p.objects if n.tag == "bsdf"] + [p.take(k) for k in list(p.values) if p.values[k].tag == "bsdf"]
-    if not inner:
-        return Mapped(Diffuse((0.5, 0.5, 0.5)), f"{kind} holds no BSDF: Mitsuba's default diffuse used")
-    mapped = imp.map_bsdf(inner[0])
-    notes = [mapped.note] if mapped.note else []
-    if kind == "twosided":
-        if len(inner) > 1:
-            notes.append("its back-side BSDF is dropped (LensLab surfaces look the same from both sides)")
-    elif kind == "mask":
-        notes.append("the opacity mask is ignored")
-    elif kind in ("bumpmap", "normalmap"):
-        notes.append(f"the {kind} is ignored")
-    elif kind == "blendbsdf":
-        notes.append("only its first BSDF is used")
-    return Mapped(mapped.material, "; ".join(notes) or None)
-
-
-BSDF_MAPPINGS: dict[str, BsdfMapping] = {
-    "diffuse": _map_diffuse,
-    "roughdiffuse": _map_roughdiffuse,
-    "conductor": _map_conductor,
-    "roughconductor": _map_conductor,
-    "plastic": _map_plastic,
-    "roughplastic": _map_plastic,
-    "dielectric": _map_dielectric,
-    "roughdielectric": _map_dielectric,
-    "thindielectric": _map_dielectric,
-    "principled": _map_principled,
-    "principledthin": _map_principled,
-    "twosided": _map_wrapper,
-    "mask": _map_wrapper,
-    "bumpmap": _map_wrapper,
-    "normalmap": _map_wrapper,
-    "blendbsdf": _map_wrapper,
-}
-"""Mitsuba BSDF plugin name -> mapping onto a LensLab material. Approximations return a ``note``."""
 
 MITSUBA_DEFAULT_MATERIAL = "mitsuba_default"  # a shape without a BSDF: Mitsuba's diffuse, reflectance 0.5
 
@@ -623,6 +516,8 @@ class _Importer:
                     self.warn(node, "spectra from files are not supported: white used")
                     return (1.0, 1.0, 1.0)
                 return mv.spectrum_to_rgb(mv.parse_spectrum(node.attrs.get("value", "")), emission)
+        except SceneError:
+            raise
         except ValueError as exc:
             raise node.error(str(exc)) from None
         if node.tag in ("texture", "spectrum"):
@@ -797,7 +692,7 @@ class _Importer:
             smooth = not p.bool("face_normals", False)
             shape = MeshFile(file=self._scene_relative(path), smooth=smooth)
         else:
-            p.finish()
+            p.finish(silent=set(p.values))
             if kind == "serialized":
                 self.warn(node, "Mitsuba .serialized meshes are not readable yet: shape skipped (convert it to PLY)")
             else:
