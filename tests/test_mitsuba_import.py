@@ -374,6 +374,10 @@ def test_include_is_relative_to_the_including_file(tmp_path):
     assert len(scene.flatten().triangles) == 1
     with pytest.raises(SceneError, match=r"scene\.xml: line 3: <include>: included file not found"):
         load(tmp_path, '<include filename="nope.xml"/>')
+    # <path> adds a folder to search
+    scene, _ = load(tmp_path, camera_xml() + '<path value="parts/meshes"/><shape type="obj">'
+                    '<string name="filename" value="tri.obj"/></shape>')
+    assert scene.nodes[0].shape.file == "parts/meshes/tri.obj"
 
 
 # ---------------------------------------------------------------------------------------------------------
