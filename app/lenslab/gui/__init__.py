@@ -1,0 +1,15 @@
+"""The studio: LensLab's PySide6 desktop application. The only layer of LensLab that imports Qt.
+
+Modules, one job each:
+
+* :mod:`.app`          - ``run_studio``: the QApplication, theme, and the window from the command line
+* :mod:`.main_window`  - docks, menus, status bar, files, export, drag and drop
+* :mod:`.document`     - the open scene, its undo stack, selection and lens; targets that address its parts
+* :mod:`.commands`     - every edit as a QUndoCommand
+* :mod:`.worker`       - the render thread with its own GL context; :mod:`.controller` feeds it from the GUI
+* :mod:`.viewport`     - the converging picture, display transform, selection outline, plane-of-focus overlay
+* :mod:`.scene_tree`   - the outliner (a Qt item model over the scene)
+* :mod:`.properties`   - the property editor, generic over the scene's dataclass fields
+* :mod:`.camera_panel` - lens, aperture, focal length, focus, sensor, iris and depth-of-field readout
+* :mod:`.export_dialog`, :mod:`.widgets`, :mod:`.theme`, :mod:`.defaults`
+"""

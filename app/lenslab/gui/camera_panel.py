@@ -1,0 +1,625 @@
+"""The camera panel: the lens, aperture, focal length, focus, sensor and iris in photographers' terms, with a
+depth-of-field readout and diagram. Everything here edits ``scene.camera`` through undo commands (a slider drag
+is one undo step) and follows the document when something else changes it (undo, click-to-focus)."""
+
+from __future__ import annotations
+
+import math
+
+from PySide6.QtCore import QPointF, QRectF, QSize, Qt, Signal
+from PySide6.QtGui import QAction, QColor, QFont, QPainter, QPainterPath, QPen, QPolygonF
+from PySide6.QtWidgets import (
+    QComboBox,
+    QGridLayout,
+    QHBoxLayout,
+    QLabel,
+    QPushButton,
+    QSizePolicy,
+    QSlider,
+    QToolButton,
+    QVBoxLayout,
+    QWidget,
+)
+
+from lenslab.gui import theme
+from lenslab.gui.commands import LensCommand
+from lenslab.gui.widgets import IntEdit, NumberEdit, Section, hint, log_to_slider, readout, slider_to_log
+from lenslab.optics import (
+    THIRD_STOPS,
+    LensPreset,
+    PresetError,
+    SensorPreset,
+    circle_of_confusion_mm,
+    depth_of_field,
+    format_f_number,
+    load_lens_presets,
+    load_sensor_presets,
+    parse_f_number,
+    step_stop,
+)
+
+FULL_STOPS = (1.4, 2, 2.8, 4, 5.6, 8, 11, 16, 22)
+COMMON_FOCAL_LENGTHS = (14, 24, 35, 50, 85, 135, 200)
+FOCAL_RANGE = (8.0, 800.0)
+FOCUS_RANGE = (0.05, 200.0)
+
+
+def lens_short_name(lens: LensPreset) -> str:
+    focal = (f"{lens.focal_range_mm[0]:g}-{lens.focal_range_mm[1]:g}" if lens.is_zoom else f"{lens.focal_length_mm:g}")
+    return f"{focal} f/{lens.widest_f_number:g}"
+
+
+def format_distance(metres: float) -> str:
+    if math.isinf(metres):
+        return "∞"
+    if metres >= 100:
+        return f"{metres:.0f} m"
+    if metres >= 10:
+        return f"{metres:.1f} m"
+    if metres >= 1:
+        return f"{metres:.2f} m"
+    return f"{metres * 100:.1f} cm"
+
+
+class IrisGlyph(QWidget):
+    """The aperture as seen looking into the lens: a disc or a polygon of blades, its size following the f-number."""
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.setFixedSize(QSize(46, 46))
+        self.f_number = 2.8
+        self.blades = 0
+        self.rotation = 0.0
+
+    def set_state(self, f_number: float, blades: int, rotation_deg: float) -> None:
+        self.f_number, self.blades, self.rotation = f_number, blades, rotation_deg
+        self.update()
+
+    def paintEvent(self, event) -> None:
+        p = QPainter(self)
+        p.setRenderHint(QPainter.Antialiasing)
+        c = QPointF(self.width() / 2, self.height() / 2)
+        outer = min(self.width(), self.height()) / 2 - 2
+        p.setPen(QPen(QColor("#55575c"), 1.5))
+        p.setBrush(QColor("#141517"))
+        p.drawEllipse(c, outer, outer)
+        # Opening radius relative to f/1.0, on an area (stop) scale that stays visible at f/22.
+        r = outer * max(0.12, min(1.0, 1.2 / self.f_number ** 0.75))
+        p.setPen(Qt.NoPen)
+        p.setBrush(QColor(theme.ACCENT))
+        if self.blades >= 3:
+            poly = QPolygonF()
+            for i in range(self.blades):
+                a = math.radians(self.rotation) + 2 * math.pi * i / self.blades
+                poly.append(QPointF(c.x() + r * math.cos(a), c.y() - r * math.sin(a)))
+            p.drawPolygon(poly)
+        else:
+            p.drawEllipse(c, r, r)
+        p.end()
+
+
+class DofDiagram(QWidget):
+    """Distance on a log scale from the camera: the zone of acceptable sharpness, the plane of focus and the
+    hyperfocal distance."""
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.setMinimumHeight(64)
+        self.setSizePolicy(QSizePolicy.Expanding, QSizePolicy.Fixed)
+        self.focus = 1.0
+        self.near = 0.9
+        self.far = 1.1
+        self.hyperfocal = 10.0
+
+    def set_state(self, focus: float, near: float, far: float, hyperfocal: float) -> None:
+        self.focus, self.near, self.far, self.hyperfocal = focus, near, far, hyperfocal
+        self.update()
+
+    def paintEvent(self, event) -> None:
+        p = QPainter(self)
+        p.setRenderHint(QPainter.Antialiasing)
+        w, h = self.width(), self.height()
+        left, right = 22.0, w - 16.0
+        axis_y = h * 0.48
+        lo, hi = self.focus / 10.0, self.focus * 10.0
+
+        def x_of(d: float) -> float:
+            if math.isinf(d) or d >= hi:
+                return right
+            d = max(d, lo)
+            return left + (math.log(d) - math.log(lo)) / (math.log(hi) - math.log(lo)) * (right - left)
+
+        # Axis and the camera at its left end.
+        p.setPen(QPen(QColor("#55575c"), 1))
+        p.drawLine(QPointF(left, axis_y), QPointF(right, axis_y))
+        cam = QPainterPath()
+        cam.addRoundedRect(QRectF(4, axis_y - 6, 11, 12), 2, 2)
+        p.fillPath(cam, QColor("#8c8f94"))
+        # Decade ticks.
+        font = QFont(self.font())
+        font.setPointSizeF(max(7.0, font.pointSizeF() - 2))
+        p.setFont(font)
+        decade = 10 ** math.floor(math.log10(lo))
+        while decade <= hi:
+            for m in (1, 2, 5):
+                d = decade * m
+                if lo <= d <= hi:
+                    x = x_of(d)
+                    p.setPen(QPen(QColor("#45474b"), 1))
+                    p.drawLine(QPointF(x, axis_y - 3), QPointF(x, axis_y + 3))
+                    if m == 1:
+                        p.setPen(QColor("#6c6f74"))
+                        p.drawText(QRectF(x - 20, h - 14, 40, 12), Qt.AlignCenter, format_distance(d))
+            decade *= 10
+        # Zone of acceptable sharpness.
+        x0, x1 = x_of(self.near), x_of(self.far)
+        zone = QColor(theme.FOCUS)
+        zone.setAlpha(70)
+        p.fillRect(QRectF(x0, axis_y - 12, max(1.5, x1 - x0), 24), zone)
+        p.setPen(QPen(QColor(theme.FOCUS), 1.2))
+        p.drawLine(QPointF(x0, axis_y - 12), QPointF(x0, axis_y + 12))
+        if not math.isinf(self.far) and self.far < hi:
+            p.drawLine(QPointF(x1, axis_y - 12), QPointF(x1, axis_y + 12))
+        else:
+            p.drawText(QRectF(right - 2, axis_y - 8, 14, 16), Qt.AlignCenter, "∞")
+        # Plane of focus.
+        xf = x_of(self.focus)
+        p.setPen(QPen(QColor(theme.ACCENT), 2))
+        p.drawLine(QPointF(xf, axis_y - 16), QPointF(xf, axis_y + 16))
+        # Hyperfocal distance.
+        if lo <= self.hyperfocal <= hi:
+            xh = x_of(self.hyperfocal)
+            p.setPen(QPen(QColor("#8c8f94"), 1, Qt.DashLine))
+            p.drawLine(QPointF(xh, 4), QPointF(xh, axis_y + 12))
+            p.setPen(QColor("#8c8f94"))
+            p.drawText(QRectF(xh + 2, 0, 14, 12), Qt.AlignLeft, "H")
+        p.end()
+
+
+class StopSlider(QWidget):
+    """A slider over a list of f-stops (indices), with the full stops marked underneath."""
+
+    moved = Signal(float, bool)  # f-number, merge
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.slider = QSlider(Qt.Horizontal)
+        self.slider.setFocusPolicy(Qt.StrongFocus)
+        self.labels = QWidget()
+        self.labels.setFixedHeight(14)
+        self.labels.paintEvent = self._paint_labels
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(0, 0, 0, 0)
+        layout.setSpacing(0)
+        layout.addWidget(self.slider)
+        layout.addWidget(self.labels)
+        self.scale: tuple[float, ...] = THIRD_STOPS
+        self.slider.valueChanged.connect(self._changed)
+        self._quiet = False
+        self.set_scale(THIRD_STOPS)
+
+    def set_scale(self, scale) -> None:
+        self.scale = tuple(scale)
+        self._quiet = True
+        self.slider.setRange(0, len(self.scale) - 1)
+        self.slider.setPageStep(3)
+        self._quiet = False
+        self.labels.update()
+
+    def set_f_number(self, n: float) -> None:
+        index = min(range(len(self.scale)), key=lambda i: abs(math.log(self.scale[i] / n)))
+        self._quiet = True
+        self.slider.setValue(index)
+        self._quiet = False
+
+    def _changed(self, index: int) -> None:
+        if not self._quiet:
+            self.moved.emit(float(self.scale[index]), True)
+
+    def _paint_labels(self, event) -> None:
+        p = QPainter(self.labels)
+        font = QFont(self.font())
+        font.setPointSizeF(max(7.0, font.pointSizeF() - 2))
+        p.setFont(font)
+        p.setPen(QColor("#8c8f94"))
+        n = len(self.scale)
+        handle = 12
+        span = self.labels.width() - handle
+        for i, stop in enumerate(self.scale):
+            if any(math.isclose(stop, s, rel_tol=1e-3) for s in FULL_STOPS) or i in (0, n - 1):
+                x = handle / 2 + (span * i / max(1, n - 1))
+                p.drawText(QRectF(x - 14, 0, 28, 14), Qt.AlignCenter, f"{stop:g}")
+        p.end()
+
+
+class CameraPanel(QWidget):
+    status_message = Signal(str)
+
+    def __init__(self, doc, focus_action: QAction | None = None, parent=None):
+        super().__init__(parent)
+        self.doc = doc
+        try:
+            self.lenses = load_lens_presets()
+        except PresetError as exc:
+            self.lenses = []
+            self.status_message.emit(f"Lens presets not loaded: {exc}")
+        try:
+            self.sensors: list[SensorPreset] = load_sensor_presets()
+        except PresetError:
+            self.sensors = [SensorPreset("Full frame", 36.0, 24.0)]
+        self._updating = False
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(10, 6, 10, 6)
+        layout.setSpacing(2)
+        layout.addWidget(self._lens_section())
+        layout.addWidget(self._aperture_section())
+        layout.addWidget(self._focal_section())
+        layout.addWidget(self._focus_section(focus_action))
+        layout.addWidget(self._dof_section())
+        layout.addWidget(self._sensor_section())
+        layout.addStretch(1)
+        doc.changed.connect(self._on_change)
+        doc.lens_changed.connect(self.refresh)
+        self.refresh()
+
+    # -- sections ----------------------------------------------------------------------------------------------
+    def _lens_section(self) -> Section:
+        section = Section("Lens")
+        grid = QGridLayout()
+        grid.setSpacing(4)
+        self.lens_buttons: list[QPushButton] = []
+        free = QPushButton("Free")
+        free.setObjectName("lensButton")
+        free.setCheckable(True)
+        free.setToolTip("No lens limits: any focal length and aperture (Alt+0)")
+        free.clicked.connect(lambda: self.choose_lens(None))
+        self.lens_buttons.append(free)
+        for i, lens in enumerate(self.lenses):
+            button = QPushButton(lens_short_name(lens))
+            button.setObjectName("lensButton")
+            button.setCheckable(True)
+            shortcut = f" (Alt+{i + 1})" if i < 9 else ""
+            button.setToolTip(f"<b>{lens.name}</b>{shortcut}<br>{lens.description}")
+            button.clicked.connect(lambda _checked=False, lens=lens: self.choose_lens(lens))
+            self.lens_buttons.append(button)
+        for i, button in enumerate(self.lens_buttons):
+            grid.addWidget(button, i // 3, i % 3)
+        section.add(grid)
+        self.lens_info = hint("")
+        section.add(self.lens_info)
+        return section
+
+    def _aperture_section(self) -> Section:
+        section = Section("Aperture")
+        row = QHBoxLayout()
+        self.iris = IrisGlyph()
+        row.addWidget(self.iris)
+        self.open_up = QToolButton()
+        self.open_up.setText("−")
+        self.open_up.setToolTip("Open up a third of a stop ([)")
+        self.open_up.clicked.connect(lambda: self.step_aperture(-1))
+        self.aperture_combo = QComboBox()
+        self.aperture_combo.setObjectName("apertureCombo")
+        self.aperture_combo.setEditable(True)
+        self.aperture_combo.setInsertPolicy(QComboBox.NoInsert)
+        self.aperture_combo.setMinimumWidth(90)
+        font = self.aperture_combo.font()
+        font.setPointSizeF(font.pointSizeF() * 1.35)
+        font.setBold(True)
+        self.aperture_combo.setFont(font)
+        self.aperture_combo.setToolTip("f-number: choose a stop or type any value (2.8, f/3, 1:2.8)")
+        self.aperture_combo.currentIndexChanged.connect(self._aperture_chosen)
+        self.aperture_combo.lineEdit().editingFinished.connect(self._aperture_typed)
+        self.stop_down = QToolButton()
+        self.stop_down.setText("+")
+        self.stop_down.setToolTip("Stop down a third of a stop (])")
+        self.stop_down.clicked.connect(lambda: self.step_aperture(+1))
+        row.addWidget(self.open_up)
+        row.addWidget(self.aperture_combo, 1)
+        row.addWidget(self.stop_down)
+        section.add(row)
+        self.stop_slider = StopSlider()
+        self.stop_slider.moved.connect(lambda n, merge: self.set_f_number(n, merge))
+        section.add(self.stop_slider)
+        self.aperture_info = hint("")
+        section.add(self.aperture_info)
+        # Iris.
+        grid = QGridLayout()
+        grid.setHorizontalSpacing(6)
+        self.blades = IntEdit(0, 32)
+        self.blades.setSpecialValueText("round")
+        self.blades.setToolTip("Number of aperture blades: round (0) or 3 to 32. Shapes the bokeh.")
+        self.blades.edited.connect(self._blades_edited)
+        self.rotation = NumberEdit(-360, 360, decimals=1, step=1.0, suffix=" °")
+        self.rotation.setToolTip("Rotation of the blade polygon")
+        self.rotation.edited.connect(lambda v, merge: self.doc.set_camera("Blade rotation", merge, blade_rotation_deg=v))
+        grid.addWidget(QLabel("Blades"), 0, 0)
+        grid.addWidget(self.blades, 0, 1)
+        grid.addWidget(QLabel("Rotation"), 0, 2)
+        grid.addWidget(self.rotation, 0, 3)
+        section.add(grid)
+        return section
+
+    def _focal_section(self) -> Section:
+        section = Section("Focal length")
+        row = QHBoxLayout()
+        self.focal = NumberEdit(1, 2000, decimals=1, step=1.0, suffix=" mm")
+        self.focal.setObjectName("focalLength")
+        self.focal.edited.connect(lambda v, merge: self.set_focal_length(v, merge))
+        self.focal_slider = QSlider(Qt.Horizontal)
+        self.focal_slider.setRange(0, 1000)
+        self.focal_slider.setFocusPolicy(Qt.StrongFocus)
+        self.focal_slider.valueChanged.connect(self._focal_slid)
+        row.addWidget(self.focal_slider, 1)
+        row.addWidget(self.focal)
+        self.focal.setFixedWidth(86)
+        section.add(row)
+        stops = QHBoxLayout()
+        stops.setSpacing(2)
+        self.focal_buttons = []
+        for mm in COMMON_FOCAL_LENGTHS:
+            b = QPushButton(str(mm))
+            b.setObjectName("lensButton")
+            b.setToolTip(f"{mm} mm")
+            b.clicked.connect(lambda _c=False, mm=mm: self.set_focal_length(float(mm), False))
+            stops.addWidget(b)
+            self.focal_buttons.append(b)
+        section.add(stops)
+        self.fov_info = hint("")
+        section.add(self.fov_info)
+        return section
+
+    def _focus_section(self, focus_action: QAction | None) -> Section:
+        section = Section("Focus")
+        row = QHBoxLayout()
+        self.focus_slider = QSlider(Qt.Horizontal)
+        self.focus_slider.setRange(0, 1000)
+        self.focus_slider.setFocusPolicy(Qt.StrongFocus)
+        self.focus_slider.valueChanged.connect(self._focus_slid)
+        self.focus = NumberEdit(0.01, 1e6, decimals=3, step=0.01, suffix=" m")
+        self.focus.setObjectName("focusDistance")
+        self.focus.setFixedWidth(86)
+        self.focus.edited.connect(lambda v, merge: self.doc.set_camera("Focus distance", merge, focus_distance_m=v))
+        row.addWidget(self.focus_slider, 1)
+        row.addWidget(self.focus)
+        section.add(row)
+        buttons = QHBoxLayout()
+        if focus_action is not None:
+            tool = QToolButton()
+            tool.setDefaultAction(focus_action)
+            tool.setToolButtonStyle(Qt.ToolButtonTextBesideIcon)
+            buttons.addWidget(tool)
+        self.focus_selection_button = QPushButton("Focus on selection")
+        self.focus_selection_button.setToolTip("Set the focus distance to the selected object's centre")
+        buttons.addWidget(self.focus_selection_button)
+        buttons.addStretch(1)
+        section.add(buttons)
+        return section
+
+    def _dof_section(self) -> Section:
+        section = Section("Depth of field")
+        grid = QGridLayout()
+        grid.setHorizontalSpacing(10)
+        grid.setVerticalSpacing(2)
+        self.dof_near = readout()
+        self.dof_far = readout()
+        self.dof_total = readout()
+        self.dof_hyper = readout()
+        for i, (label, value) in enumerate((("Near", self.dof_near), ("Far", self.dof_far),
+                                            ("Total", self.dof_total), ("Hyperfocal", self.dof_hyper))):
+            grid.addWidget(QLabel(label), i // 2, (i % 2) * 2)
+            grid.addWidget(value, i // 2, (i % 2) * 2 + 1)
+        section.add(grid)
+        self.dof_diagram = DofDiagram()
+        section.add(self.dof_diagram)
+        self.dof_info = hint("")
+        section.add(self.dof_info)
+        return section
+
+    def _sensor_section(self) -> Section:
+        section = Section("Sensor")
+        self.sensor_combo = QComboBox()
+        for sensor in self.sensors:
+            self.sensor_combo.addItem(f"{sensor.name}  ({sensor.width_mm:g} × {sensor.height_mm:g})", sensor)
+        self.sensor_combo.addItem("Custom", None)
+        self.sensor_combo.currentIndexChanged.connect(self._sensor_chosen)
+        section.add(self.sensor_combo)
+        row = QHBoxLayout()
+        self.sensor_w = NumberEdit(1, 500, decimals=2, step=0.1, suffix=" mm")
+        self.sensor_h = NumberEdit(1, 500, decimals=2, step=0.1, suffix=" mm")
+        self.sensor_w.edited.connect(lambda v, merge: self._sensor_edited(merge))
+        self.sensor_h.edited.connect(lambda v, merge: self._sensor_edited(merge))
+        row.addWidget(QLabel("W"))
+        row.addWidget(self.sensor_w)
+        row.addWidget(QLabel("H"))
+        row.addWidget(self.sensor_h)
+        section.add(row)
+        self.sensor_info = hint("")
+        section.add(self.sensor_info)
+        return section
+
+    # -- edits ----------------------------------------------------------------------------------------------------
+    def stop_scale(self) -> tuple[float, ...]:
+        lens = self.doc.lens
+        return lens.available_stops() if lens is not None else THIRD_STOPS
+
+    def choose_lens(self, lens: LensPreset | None) -> None:
+        if lens == self.doc.lens:
+            self.refresh()
+            return
+        self.doc.push(LensCommand(self.doc, lens))
+        if lens is not None:
+            cam = self.doc.scene.camera
+            self.status_message.emit(f"{lens.name}: {cam.focal_length_mm:g} mm, {format_f_number(cam.f_number)}")
+
+    def set_f_number(self, n: float, merge: bool = False) -> None:
+        lens = self.doc.lens
+        if lens is not None:
+            clamped = lens.clamp_f_number(n)
+            if not math.isclose(clamped, n, rel_tol=1e-9):
+                self.status_message.emit(f"The {lens.name} goes from f/{lens.widest_f_number:g} to "
+                                         f"f/{lens.narrowest_f_number:g}")
+            n = clamped
+        self.doc.set_camera(f"Aperture {format_f_number(n)}", merge, f_number=float(n))
+        self.refresh()  # the clamp may leave the camera as it was; show the truth either way
+
+    def step_aperture(self, steps: int) -> None:
+        self.set_f_number(step_stop(self.doc.scene.camera.f_number, steps, self.stop_scale()), merge=True)
+
+    def _aperture_chosen(self, index: int) -> None:
+        if self._updating or index < 0:
+            return
+        value = self.aperture_combo.itemData(index)
+        if value is not None:
+            self.set_f_number(float(value))
+
+    def _aperture_typed(self) -> None:
+        if self._updating:
+            return
+        text = self.aperture_combo.lineEdit().text()
+        try:
+            n = parse_f_number(text)
+        except ValueError as exc:
+            self.status_message.emit(str(exc))
+            self.refresh()
+            return
+        if not math.isclose(n, self.doc.scene.camera.f_number, rel_tol=1e-9):
+            self.set_f_number(n)
+
+    def set_focal_length(self, mm: float, merge: bool) -> None:
+        lens = self.doc.lens
+        if lens is not None:
+            if not lens.is_zoom and not math.isclose(mm, lens.focal_length_mm):
+                self.status_message.emit(f"The {lens.name} is a prime: choose Free or a zoom to change focal length")
+                self.refresh()
+                return
+            mm = lens.clamp_focal_length(mm)
+        self.doc.set_camera(f"Focal length {mm:g} mm", merge, focal_length_mm=float(mm))
+        self.refresh()
+
+    def _focal_slid(self, position: int) -> None:
+        if self._updating:
+            return
+        lo, hi = self._focal_limits()
+        mm = round(slider_to_log(position, lo, hi), 1)
+        self.set_focal_length(mm, True)
+
+    def _focal_limits(self) -> tuple[float, float]:
+        lens = self.doc.lens
+        if lens is not None and lens.is_zoom:
+            return lens.focal_range_mm
+        return FOCAL_RANGE
+
+    def _focus_slid(self, position: int) -> None:
+        if self._updating:
+            return
+        metres = slider_to_log(position, *FOCUS_RANGE)
+        metres = float(f"{metres:.3g}")
+        self.doc.set_camera("Focus distance", True, focus_distance_m=metres)
+
+    def _blades_edited(self, value: int, merge: bool) -> None:
+        current = self.doc.scene.camera.aperture_blades
+        if value in (1, 2):  # not a polygon: jump over, in the direction of travel
+            value = 3 if current < value else 0
+            self.blades.set_quietly(value)
+        self.doc.set_camera("Aperture blades", merge, aperture_blades=int(value))
+
+    def _sensor_chosen(self, index: int) -> None:
+        if self._updating:
+            return
+        sensor = self.sensor_combo.itemData(index)
+        if sensor is None:
+            self.refresh()
+            return
+        self.doc.set_camera(f"Sensor {sensor.name}", False, sensor_mm=(sensor.width_mm, sensor.height_mm))
+
+    def _sensor_edited(self, merge: bool) -> None:
+        if self._updating:
+            return
+        self.doc.set_camera("Sensor size", merge, sensor_mm=(self.sensor_w.value(), self.sensor_h.value()))
+
+    # -- following the document ---------------------------------------------------------------------------------
+    def _on_change(self, change) -> None:
+        if change.kind in ("camera", "scene"):
+            self.refresh()
+
+    def refresh(self) -> None:
+        cam = self.doc.scene.camera
+        lens = self.doc.lens
+        self._updating = True
+        try:
+            # Lens.
+            for i, button in enumerate(self.lens_buttons):
+                button.setChecked((i == 0 and lens is None) or (i > 0 and self.lenses[i - 1] == lens))
+            if lens is None:
+                self.lens_info.setText("Free: any focal length and aperture.")
+            else:
+                self.lens_info.setText(f"{lens.name} · f/{lens.widest_f_number:g}–f/{lens.narrowest_f_number:g}"
+                                       + (f" · {lens.aperture_blades} blades" if lens.aperture_blades else ""))
+            # Aperture.
+            scale = self.stop_scale()
+            if [self.aperture_combo.itemData(i) for i in range(self.aperture_combo.count())] != list(scale):
+                self.aperture_combo.clear()
+                for stop in scale:
+                    self.aperture_combo.addItem(format_f_number(stop), float(stop))
+            index = next((i for i, s in enumerate(scale) if math.isclose(s, cam.f_number, rel_tol=1e-3)), -1)
+            self.aperture_combo.setCurrentIndex(index)
+            self.aperture_combo.setEditText(format_f_number(cam.f_number))
+            self.stop_slider.set_scale(scale)
+            self.stop_slider.set_f_number(cam.f_number)
+            self.open_up.setEnabled(cam.f_number > scale[0] * 1.0001)
+            self.stop_down.setEnabled(cam.f_number < scale[-1] * 0.9999)
+            diameter = cam.focal_length_mm / cam.f_number
+            self.aperture_info.setText(f"Entrance pupil {diameter:.1f} mm. Brightness stays the same at every "
+                                       "aperture (exposure is compensated).")
+            self.iris.set_state(cam.f_number, cam.aperture_blades, cam.blade_rotation_deg)
+            self.blades.set_quietly(cam.aperture_blades)
+            self.rotation.set_quietly(cam.blade_rotation_deg)
+            self.rotation.setEnabled(cam.aperture_blades >= 3)
+            # Focal length.
+            lo, hi = self._focal_limits()
+            prime = lens is not None and not lens.is_zoom
+            self.focal.set_quietly(cam.focal_length_mm)
+            self.focal_slider.setValue(log_to_slider(cam.focal_length_mm, lo, hi))
+            for widget in [self.focal, self.focal_slider] + self.focal_buttons:
+                widget.setEnabled(not prime)
+            for b, mm in zip(self.focal_buttons, COMMON_FOCAL_LENGTHS):
+                b.setEnabled(not prime and (lens is None or lens.min_focal_length_mm <= mm <= lens.max_focal_length_mm))
+            fov_x = math.degrees(cam.fov_x)
+            w, h = cam.resolution
+            tan_y = math.tan(cam.fov_x / 2) * h / w
+            self.fov_info.setText(f"Field of view {fov_x:.1f}° × {math.degrees(2 * math.atan(tan_y)):.1f}°"
+                                  + (" · fixed by the prime" if prime else ""))
+            # Focus.
+            self.focus.set_quietly(cam.focus_distance_m)
+            self.focus_slider.setValue(log_to_slider(cam.focus_distance_m, *FOCUS_RANGE))
+            # Sensor.
+            sw, sh = cam.sensor_mm
+            index = next((i for i, s in enumerate(self.sensors)
+                          if math.isclose(s.width_mm, sw, rel_tol=1e-4) and math.isclose(s.height_mm, sh, rel_tol=1e-4)),
+                         len(self.sensors))
+            self.sensor_combo.setCurrentIndex(index)
+            self.sensor_w.set_quietly(sw)
+            self.sensor_h.set_quietly(sh)
+            crop = math.hypot(36, 24) / math.hypot(sw, sh)
+            coc = circle_of_confusion_mm(sw, sh)
+            self.sensor_info.setText(f"Crop factor {crop:.2f} · circle of confusion {coc * 1000:.0f} µm · "
+                                     f"{cam.focal_length_mm * crop:.0f} mm full-frame equivalent")
+            # Depth of field (the renderer's planar model: these numbers describe the picture on screen).
+            dof = depth_of_field(cam.focal_length_mm, cam.f_number, cam.focus_distance_m, coc, model="planar")
+            self.dof_near.setText(format_distance(dof.near_m))
+            self.dof_far.setText(format_distance(dof.far_m))
+            self.dof_total.setText(format_distance(dof.total_m) if not math.isinf(dof.total_m) else "∞")
+            self.dof_hyper.setText(format_distance(dof.hyperfocal_m))
+            self.dof_diagram.set_state(cam.focus_distance_m, dof.near_m, dof.far_m, dof.hyperfocal_m)
+            self.dof_info.setText(f"Sharp from {format_distance(dof.near_m)} to {format_distance(dof.far_m)} for a "
+                                  f"{coc * 1000:.0f} µm circle of confusion. Focus at the hyperfocal distance to "
+                                  "keep everything from half of it to infinity sharp.")
+        finally:
+            self._updating = False
+
+    def dof_limits(self) -> tuple[float, float]:
+        cam = self.doc.scene.camera
+        coc = circle_of_confusion_mm(*cam.sensor_mm)
+        dof = depth_of_field(cam.focal_length_mm, cam.f_number, cam.focus_distance_m, coc, model="planar")
+        return dof.near_m, dof.far_m

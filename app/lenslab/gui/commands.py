@@ -1,0 +1,277 @@
+"""Undo commands: every edit the studio makes to a scene is one of these, pushed on the document's QUndoStack.
+
+Commands address what they change by target and field (see ``lenslab.gui.document``), never by holding on to
+objects, so that any order of undo and redo finds the right thing. Values are deep-copied in and out.
+
+Consecutive edits of the same fields from a slider or a spin box drag merge into one step (``mergeWith``) when
+they arrive within :data:`MERGE_SECONDS` of each other, so one Ctrl+Z undoes one gesture.
+"""
+
+from __future__ import annotations
+
+import copy
+import time
+from typing import Any
+
+from PySide6.QtGui import QUndoCommand
+
+from lenslab.optics import LensPreset
+from lenslab.scene.events import SceneChange
+from lenslab.scene.scene import Node
+
+MERGE_SECONDS = 1.5
+_SET_VALUES_ID = 1001
+
+_FIELD_LABELS = {
+    "f_number": "Aperture", "focal_length_mm": "Focal length", "focus_distance_m": "Focus distance",
+    "sensor_mm": "Sensor", "aperture_blades": "Aperture blades", "blade_rotation_deg": "Blade rotation",
+    "translate": "Move", "rotate_deg": "Rotate", "scale": "Scale", "name": "Rename",
+}
+
+
+def _label(target: tuple, changes: dict) -> str:
+    fields = list(changes)
+    if len(fields) == 1:
+        leaf = fields[0][-1] if fields[0] else target[0]
+        return _FIELD_LABELS.get(leaf, "Set " + leaf.replace("_", " "))
+    return "Edit " + target[0]
+
+
+class SetValuesCommand(QUndoCommand):
+    """Set one or more fields of one target."""
+
+    def __init__(self, doc, target: tuple, changes: dict[tuple, Any], text: str | None = None, merge: bool = False):
+        super().__init__(text or _label(target, changes))
+        self.doc = doc
+        self.target = tuple(target)
+        self.new = {tuple(k): copy.deepcopy(v) for k, v in changes.items()}
+        self.old = {k: copy.deepcopy(doc.get_value(self.target, k)) for k in self.new}
+        self.merge = merge
+        self.stamp = time.monotonic()
+
+    def redo(self) -> None:
+        self._apply(self.new)
+
+    def undo(self) -> None:
+        self._apply(self.old)
+
+    def _apply(self, values: dict) -> None:
+        for field, value in values.items():
+            self.doc.apply_value(self.target, field, value, notify=False)
+        for field in values:
+            self.doc.notify_target(self.target, field)
+
+    def id(self) -> int:
+        return _SET_VALUES_ID
+
+    def mergeWith(self, other: QUndoCommand) -> bool:
+        if not isinstance(other, SetValuesCommand) or not (self.merge and other.merge):
+            return False
+        if other.target != self.target or set(other.new) != set(self.new):
+            return False
+        if other.stamp - self.stamp > MERGE_SECONDS:
+            return False
+        self.new = other.new
+        self.stamp = other.stamp
+        if self.new == self.old:
+            self.setObsolete(True)
+        return True
+
+
+class LensCommand(QUndoCommand):
+    """Mount a lens preset (or none): it sets the focal length, clamps the aperture and sets the iris."""
+
+    def __init__(self, doc, lens: LensPreset | None):
+        super().__init__(f"Lens {lens.name}" if lens else "No lens limits")
+        self.doc = doc
+        self.old_lens, self.new_lens = doc.lens, lens
+        cam = doc.scene.camera
+        self.old = {k: getattr(cam, k) for k in ("focal_length_mm", "f_number", "aperture_blades", "blade_rotation_deg")}
+        self.new = dict(self.old)
+        if lens is not None:
+            self.new["focal_length_mm"] = lens.clamp_focal_length(cam.focal_length_mm)
+            self.new["f_number"] = lens.clamp_f_number(cam.f_number)
+            self.new["aperture_blades"] = lens.aperture_blades
+            self.new["blade_rotation_deg"] = lens.blade_rotation_deg
+
+    def _apply(self, lens, values) -> None:
+        for key, value in values.items():
+            self.doc.apply_value(("camera",), (key,), value, notify=False)
+        self.doc.set_lens_state(lens)
+        self.doc.notify(SceneChange("camera", ("camera",), ("focal_length_mm",)))
+
+    def redo(self) -> None:
+        self._apply(self.new_lens, self.new)
+
+    def undo(self) -> None:
+        self._apply(self.old_lens, self.old)
+
+
+class AddNodeCommand(QUndoCommand):
+    def __init__(self, doc, node: Node, parent_path: tuple = (), index: int | None = None, text: str | None = None):
+        super().__init__(text or f"Add {node.name}")
+        self.doc = doc
+        self.node = copy.deepcopy(node)
+        self.parent_path = tuple(parent_path)
+        self.index = len(doc.children_of(self.parent_path)) if index is None else index
+        self.old_selection = list(doc.selection)
+
+    @property
+    def path(self) -> tuple:
+        return self.parent_path + (self.index,)
+
+    def redo(self) -> None:
+        self.doc.children_of(self.parent_path).insert(self.index, copy.deepcopy(self.node))
+        self.doc.notify(SceneChange("structure", ("node", self.path)))
+        self.doc.set_selection([("node", self.path)])
+
+    def undo(self) -> None:
+        del self.doc.children_of(self.parent_path)[self.index]
+        self.doc.set_selection([t for t in self.old_selection if self.doc.exists(t)])
+        self.doc.notify(SceneChange("structure", ("node", self.parent_path)))
+
+
+class RemoveNodesCommand(QUndoCommand):
+    def __init__(self, doc, paths: list[tuple]):
+        paths = _outermost(sorted({tuple(p) for p in paths}))
+        names = [doc.node(p).name for p in paths]
+        super().__init__("Delete " + (names[0] if len(names) == 1 else f"{len(names)} nodes"))
+        self.doc = doc
+        self.removed = [(p, copy.deepcopy(doc.node(p))) for p in paths]
+        self.old_selection = list(doc.selection)
+
+    def redo(self) -> None:
+        for path, _node in sorted(self.removed, reverse=True):  # deepest and last first: paths stay valid
+            del self.doc.children_of(path[:-1])[path[-1]]
+        self.doc.set_selection([])
+        self.doc.notify(SceneChange("structure"))
+
+    def undo(self) -> None:
+        for path, node in sorted(self.removed):
+            self.doc.children_of(path[:-1]).insert(path[-1], copy.deepcopy(node))
+        self.doc.set_selection(self.old_selection)
+        self.doc.notify(SceneChange("structure"))
+
+
+def _outermost(paths: list[tuple]) -> list[tuple]:
+    """Drop paths inside another path of the list (deleting a group deletes its children)."""
+    out: list[tuple] = []
+    for p in paths:
+        if not any(p[: len(q)] == q for q in out):
+            out.append(p)
+    return out
+
+
+class MoveNodeCommand(QUndoCommand):
+    """Re-parent or re-order a node (outliner drag and drop), optionally with a new local transform that keeps
+    it where it was in the world."""
+
+    def __init__(self, doc, src: tuple, dst_parent: tuple, dst_index: int, transform=None):
+        node = doc.node(src)
+        super().__init__(f"Move {node.name}")
+        self.doc = doc
+        self.src = tuple(src)
+        self.dst_parent = tuple(dst_parent)
+        self.dst_index = dst_index
+        self.old_transform = copy.deepcopy(node.transform)
+        self.new_transform = copy.deepcopy(transform) if transform is not None else self.old_transform
+        # Where the node ends up, once it has left its old place (which may shift the destination's index).
+        parent = self.dst_parent
+        index = dst_index
+        src_parent, src_index = self.src[:-1], self.src[-1]
+        if parent[: len(src_parent) + 1][:-1] == src_parent and len(parent) > len(src_parent) and \
+                parent[len(src_parent)] > src_index:
+            parent = parent[: len(src_parent)] + (parent[len(src_parent)] - 1,) + parent[len(src_parent) + 1:]
+        if parent == src_parent and index > src_index:
+            index -= 1
+        self.final = parent + (index,)
+
+    def redo(self) -> None:
+        node = self.doc.children_of(self.src[:-1]).pop(self.src[-1])
+        node.transform = copy.deepcopy(self.new_transform)
+        self.doc.children_of(self.final[:-1]).insert(self.final[-1], node)
+        self.doc.notify(SceneChange("structure", ("node", self.final)))
+        self.doc.set_selection([("node", self.final)])
+
+    def undo(self) -> None:
+        node = self.doc.children_of(self.final[:-1]).pop(self.final[-1])
+        node.transform = copy.deepcopy(self.old_transform)
+        self.doc.children_of(self.src[:-1]).insert(self.src[-1], node)
+        self.doc.notify(SceneChange("structure", ("node", self.src)))
+        self.doc.set_selection([("node", self.src)])
+
+
+class AddMaterialCommand(QUndoCommand):
+    def __init__(self, doc, name: str, material, assign_to: list[tuple] = ()):
+        super().__init__(f"Add material {name}")
+        self.doc = doc
+        self.name = name
+        self.material = copy.deepcopy(material)
+        self.assign = [(tuple(p), doc.node(p).material) for p in assign_to]
+
+    def redo(self) -> None:
+        self.doc.scene.materials[self.name] = copy.deepcopy(self.material)
+        for path, _old in self.assign:
+            self.doc.node(path).material = self.name
+        self.doc.notify(SceneChange("structure", ("material", self.name)))
+
+    def undo(self) -> None:
+        for path, old in self.assign:
+            self.doc.node(path).material = old
+        del self.doc.scene.materials[self.name]
+        self.doc.set_selection([t for t in self.doc.selection if self.doc.exists(t)])
+        self.doc.notify(SceneChange("structure"))
+
+
+class RemoveMaterialCommand(QUndoCommand):
+    """Delete a material; nodes that used it fall back to the default grey (and get it back on undo)."""
+
+    def __init__(self, doc, name: str):
+        super().__init__(f"Delete material {name}")
+        self.doc = doc
+        self.name = name
+        self.material = copy.deepcopy(doc.scene.materials[name])
+        self.position = list(doc.scene.materials).index(name)
+        self.users = doc.material_users(name)
+
+    def redo(self) -> None:
+        del self.doc.scene.materials[self.name]
+        for path in self.users:
+            self.doc.node(path).material = ""
+        self.doc.set_selection([t for t in self.doc.selection if self.doc.exists(t)])
+        self.doc.notify(SceneChange("structure"))
+
+    def undo(self) -> None:
+        items = list(self.doc.scene.materials.items())
+        items.insert(self.position, (self.name, copy.deepcopy(self.material)))
+        self.doc.scene.materials.clear()
+        self.doc.scene.materials.update(items)
+        for path in self.users:
+            self.doc.node(path).material = self.name
+        self.doc.notify(SceneChange("structure", ("material", self.name)))
+
+
+class RenameMaterialCommand(QUndoCommand):
+    """Rename a material, keeping its place in the library and every node that refers to it."""
+
+    def __init__(self, doc, old: str, new: str):
+        super().__init__(f"Rename material {old} to {new}")
+        self.doc = doc
+        self.old, self.new = old, new
+        self.users = doc.material_users(old)
+
+    def _rename(self, a: str, b: str) -> None:
+        items = [(b if k == a else k, v) for k, v in self.doc.scene.materials.items()]
+        self.doc.scene.materials.clear()
+        self.doc.scene.materials.update(items)
+        for path in self.users:
+            self.doc.node(path).material = b
+        self.doc.selection = [("material", b) if t == ("material", a) else t for t in self.doc.selection]
+        self.doc.notify(SceneChange("structure", ("material", b)))
+        self.doc.selection_changed.emit()
+
+    def redo(self) -> None:
+        self._rename(self.old, self.new)
+
+    def undo(self) -> None:
+        self._rename(self.new, self.old)

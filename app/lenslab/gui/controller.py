@@ -1,0 +1,212 @@
+"""The link between the open document and the render worker, on the GUI thread.
+
+It listens to the document's scene events and sends the worker the cheapest message that brings it up to date
+(a camera, the render settings, or a copy of the whole scene), numbering each edit (its *generation*) so that the
+GUI can tell which frames already show it. It also decides the viewport's render size from the camera's
+resolution and the chosen viewport quality, routes pick answers to whoever asked, and runs exports.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import math
+from typing import Callable
+
+from PySide6.QtCore import QObject, Signal
+
+from lenslab.gui.document import copy_scene
+from lenslab.gui.worker import ExportRequest, Frame, RenderWorker
+
+#: Viewport quality: a fraction of the camera's resolution, or "auto" (at most AUTO_LONG_EDGE pixels wide).
+QUALITIES = {"auto": None, "full": 1.0, "half": 0.5, "quarter": 0.25}
+AUTO_LONG_EDGE = 800
+SAMPLE_LIMITS = (16, 64, 256, 1024, 4096, None)
+
+
+def viewport_size(resolution: tuple[int, int], quality: str) -> tuple[int, int]:
+    w, h = resolution
+    fraction = QUALITIES.get(quality)
+    if fraction is None:
+        fraction = min(1.0, AUTO_LONG_EDGE / max(w, h))
+    return max(1, round(w * fraction)), max(1, round(h * fraction))
+
+
+class RenderController(QObject):
+    frame_ready = Signal(object)  # Frame
+    gbuffer_ready = Signal(object)
+    restarted = Signal(int)
+    device_ready = Signal(dict)
+    render_error = Signal(str)  # "" when an edit made the scene renderable again
+    export_progress = Signal(object)
+    export_finished = Signal(int, str)
+    export_failed = Signal(int, str)
+    export_cancelled = Signal(int)
+
+    def __init__(self, doc, device_index: int | None = None, dispatch_seconds: float = 0.1,
+                 quality: str = "auto", target_spp: int | None = 1024, parent: QObject | None = None):
+        super().__init__(parent)
+        self.doc = doc
+        self.quality = quality if quality in QUALITIES else "auto"
+        self.target_spp = target_spp
+        self.paused = False
+        self.generation = 0
+        self.device: dict | None = None
+        self.device_error: str | None = None
+        self.error = ""
+        self.last_frame: Frame | None = None
+        self.last_gbuffer = None
+        self._ids = itertools.count(1)
+        self._pick_callbacks: dict[int, Callable] = {}
+        self._size = viewport_size(doc.scene.camera.resolution, self.quality)
+        self._error_generation = -1
+        self.worker = RenderWorker(device_index, dispatch_seconds)
+        w = self.worker
+        w.device_ready.connect(self._device_ready)
+        w.device_failed.connect(self._device_failed)
+        w.crashed.connect(self._crashed)
+        w.frame_ready.connect(self._take_frame)
+        w.gbuffer_ready.connect(self._gbuffer)
+        w.pick_ready.connect(self._pick_answered)
+        w.restarted.connect(self._restarted)
+        w.scene_failed.connect(self._scene_failed)
+        w.export_progress.connect(self.export_progress)
+        w.export_finished.connect(self.export_finished)
+        w.export_failed.connect(self.export_failed)
+        w.export_cancelled.connect(self.export_cancelled)
+        w.set_target_spp(target_spp)
+        doc.changed.connect(self._on_change)
+        w.start()
+        self.send_scene()
+
+    # -- keeping the worker up to date ----------------------------------------------------------------------
+    def _next_generation(self) -> int:
+        self.generation += 1
+        return self.generation
+
+    @property
+    def size(self) -> tuple[int, int]:
+        return self._size
+
+    def send_scene(self) -> None:
+        self._size = viewport_size(self.doc.scene.camera.resolution, self.quality)
+        self.worker.set_scene(copy_scene(self.doc.scene), *self._size, self._next_generation())
+
+    def _on_change(self, change) -> None:
+        if change.kind == "camera":
+            size = viewport_size(self.doc.scene.camera.resolution, self.quality)
+            moved = change.geometry or size != self._size
+            self._size = size
+            self.worker.set_camera(dataclasses.replace(self.doc.scene.camera), *size, self._next_generation(), moved)
+        elif change.kind == "render":
+            if change.field == ("spp",):
+                return  # the export default; the viewport has its own sample limit
+            self.worker.set_settings(dataclasses.replace(self.doc.scene.render), self._next_generation())
+        else:
+            self.send_scene()
+
+    def set_quality(self, quality: str) -> None:
+        if quality in QUALITIES and quality != self.quality:
+            self.quality = quality
+            self.send_scene()
+
+    def set_target_spp(self, spp: int | None) -> None:
+        self.target_spp = spp
+        self.worker.set_target_spp(spp)
+
+    def set_paused(self, paused: bool) -> None:
+        self.paused = paused
+        self.worker.set_paused(paused)
+
+    def restart(self) -> None:
+        self.send_scene()
+
+    # -- answers from the worker ---------------------------------------------------------------------------
+    def _device_ready(self, info: dict) -> None:
+        self.device = info
+        self.device_ready.emit(info)
+
+    def _device_failed(self, message: str) -> None:
+        self.device_error = message
+        self.error = f"No OpenGL 4.3 device: {message}"
+        self.render_error.emit(self.error)
+
+    def _crashed(self, trace: str) -> None:
+        last = trace.strip().splitlines()[-1] if trace.strip() else "unknown error"
+        self.error = f"The renderer stopped: {last}"
+        self.render_error.emit(self.error)
+
+    def _take_frame(self) -> None:
+        frame = self.worker.take_frame()
+        if frame is None:
+            return
+        self.last_frame = frame
+        self.frame_ready.emit(frame)
+
+    def _gbuffer(self, gbuffer) -> None:
+        self.last_gbuffer = gbuffer
+        self.gbuffer_ready.emit(gbuffer)
+
+    def _restarted(self, generation: int) -> None:
+        if self.error and generation > self._error_generation:
+            self.error = ""
+            self.render_error.emit("")
+        self.restarted.emit(generation)
+
+    def _scene_failed(self, generation: int, message: str) -> None:
+        self._error_generation = generation
+        self.error = f"Cannot render: {message}"
+        self.render_error.emit(self.error)
+
+    # -- picking -----------------------------------------------------------------------------------------------
+    def pick(self, u: float, v: float, callback: Callable) -> int:
+        request_id = next(self._ids)
+        self._pick_callbacks[request_id] = callback
+        self.worker.request_pick(u, v, request_id)
+        return request_id
+
+    def _pick_answered(self, result) -> None:
+        callback = self._pick_callbacks.pop(result.request_id, None)
+        if callback is not None:
+            callback(result)
+
+    # -- export ------------------------------------------------------------------------------------------------
+    def start_export(self, request: ExportRequest) -> int:
+        request_id = next(self._ids)
+        self.worker.start_export(request_id, request)
+        return request_id
+
+    def cancel_export(self, request_id: int) -> None:
+        self.worker.cancel_export(request_id)
+
+    # -- shutting down -----------------------------------------------------------------------------------------
+    def shutdown(self, timeout_ms: int = 15000) -> bool:
+        """Stop the worker (within a dispatch) and wait for it to release its GL context."""
+        try:
+            self.doc.changed.disconnect(self._on_change)
+        except (RuntimeError, TypeError):
+            pass
+        if not self.worker.isRunning():
+            return True
+        self.worker.stop()
+        return self.worker.wait(timeout_ms)
+
+
+def samples_text(frame: Frame) -> str:
+    if frame.preview:
+        return "preview"
+    target = f" / {frame.target_spp}" if frame.target_spp else ""
+    return f"{frame.samples_per_pixel}{target} spp"
+
+
+def rate_text(samples_per_second: float) -> str:
+    if samples_per_second >= 1e6:
+        return f"{samples_per_second / 1e6:.2f} M samples/s"
+    return f"{samples_per_second / 1e3:.0f} k samples/s"
+
+
+def elapsed_text(seconds: float) -> str:
+    seconds = int(math.floor(seconds))
+    if seconds >= 3600:
+        return f"{seconds // 3600}:{seconds // 60 % 60:02d}:{seconds % 60:02d}"
+    return f"{seconds // 60}:{seconds % 60:02d}"

@@ -1,0 +1,404 @@
+"""The viewport: the converging image, its display (exposure, tone map, fit / zoom / pan), the selection
+outline, the plane-of-focus overlay, and the tools that act on the picture (select, focus, pan).
+
+The image arrives as linear float radiance from the render worker; the display transform (exposure in stops,
+then clamp / Reinhard / filmic, then sRGB) is applied here, so changing exposure never restarts the render, and
+the readout under the cursor shows the linear values, not the displayed ones.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from PySide6.QtCore import QPointF, QRectF, Qt, QTimer, Signal
+from PySide6.QtGui import QColor, QFont, QImage, QPainter, QPen
+from PySide6.QtWidgets import QWidget
+
+from lenslab.gui import theme
+from lenslab.render.film import to_8bit, tone_map
+
+ZOOM_STEPS = (0.125, 0.25, 1 / 3, 0.5, 2 / 3, 1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0)
+OVERLAY_HOLD_SECONDS = 1.2
+OVERLAY_FADE_SECONDS = 0.6
+
+
+def numpy_to_qimage(rgb8: np.ndarray) -> QImage:
+    h, w = rgb8.shape[:2]
+    data = np.ascontiguousarray(rgb8)
+    return QImage(data.data, w, h, 3 * w, QImage.Format_RGB888).copy()
+
+
+def rgba_to_qimage(rgba8: np.ndarray) -> QImage:
+    h, w = rgba8.shape[:2]
+    data = np.ascontiguousarray(rgba8)
+    return QImage(data.data, w, h, 4 * w, QImage.Format_RGBA8888).copy()
+
+
+def outline_mask(mask: np.ndarray) -> np.ndarray:
+    """Pixels of ``mask`` with a 4-neighbour outside it."""
+    inner = mask.copy()
+    inner[1:, :] &= mask[:-1, :]
+    inner[:-1, :] &= mask[1:, :]
+    inner[:, 1:] &= mask[:, :-1]
+    inner[:, :-1] &= mask[:, 1:]
+    return mask & ~inner
+
+
+def focus_overlay(depth: np.ndarray, focus: float, near: float, far: float) -> np.ndarray:
+    """RGBA: the zone of acceptable sharpness tinted, the plane of focus itself drawn as a bright band."""
+    h, w = depth.shape
+    out = np.zeros((h, w, 4), np.uint8)
+    finite = np.isfinite(depth)
+    zone = finite & (depth >= near) & (depth <= far)
+    colour = np.array([89, 209, 140], np.uint8)  # theme.FOCUS
+    out[zone, :3] = colour
+    out[zone, 3] = 70
+    # The plane: where the surface crosses the focus distance, a band about 1% of the distance thick (at least
+    # a fifth of the depth of field, so that it reads at f/1.4 and at f/22 alike).
+    band = max(0.004 * focus, 0.1 * min(far - near, focus) if math.isfinite(far) else 0.004 * focus)
+    plane = finite & (np.abs(depth - focus) <= band)
+    out[plane, :3] = (255, 255, 255)
+    out[plane, 3] = 170
+    return out
+
+
+class Viewport(QWidget):
+    pixel_hovered = Signal(object)  # (x, y) image pixel or None
+    node_clicked = Signal(int, bool)  # depth-first node index (-1: background), add to selection
+    focus_clicked = Signal(float, float)  # (u, v) in [0, 1], a click of the focus tool
+    zoom_changed = Signal(float)
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.setObjectName("viewport")
+        self.setMouseTracking(True)
+        self.setFocusPolicy(Qt.StrongFocus)
+        self.setMinimumSize(320, 240)
+        self.setAttribute(Qt.WA_OpaquePaintEvent)
+        self.linear: np.ndarray | None = None
+        self.qimage: QImage | None = None
+        self.exposure = 0.0
+        self.tone_map = "filmic"
+        self.zoom: float | None = None  # None: fit the window
+        self.pan = QPointF(0, 0)
+        self.tool = "select"
+        self.gbuffer = None
+        self.selected_indices: list[int] = []
+        self._outline: QImage | None = None
+        self._overlay: QImage | None = None
+        self._overlay_until = 0.0
+        self._overlay_label = ""
+        self._drag_start: QPointF | None = None
+        self._pan_start = QPointF(0, 0)
+        self._press_pos: QPointF | None = None
+        self._space_down = False
+        self.hud_text = ""
+        self.message = ""  # an error to show over the image
+        self.status_text = ""  # e.g. "Preview" in the corner
+        self.focus_pending = False
+        self._fade_timer = QTimer(self)
+        self._fade_timer.setInterval(40)
+        self._fade_timer.timeout.connect(self._fade_tick)
+
+    # -- content ---------------------------------------------------------------------------------------------
+    def set_image(self, linear: np.ndarray) -> None:
+        size_changed = self.linear is None or self.linear.shape != linear.shape
+        self.linear = linear
+        self._redisplay()
+        if size_changed:
+            self._rebuild_outline()
+
+    def _redisplay(self) -> None:
+        if self.linear is None:
+            self.qimage = None
+        else:
+            self.qimage = numpy_to_qimage(to_8bit(tone_map(self.linear, self.exposure, self.tone_map)))
+        self.update()
+
+    def set_display(self, exposure: float | None = None, operator: str | None = None) -> None:
+        if exposure is not None:
+            self.exposure = float(exposure)
+        if operator is not None:
+            self.tone_map = operator
+        self._redisplay()
+
+    def display_image(self) -> QImage | None:
+        return self.qimage
+
+    def set_gbuffer(self, gbuffer) -> None:
+        self.gbuffer = gbuffer
+        self._rebuild_outline()
+
+    def set_selection(self, indices: list[int]) -> None:
+        self.selected_indices = list(indices)
+        self._rebuild_outline()
+
+    def _rebuild_outline(self) -> None:
+        self._outline = None
+        g = self.gbuffer
+        if g is not None and self.selected_indices:
+            mask = np.isin(g.node_index, np.asarray(self.selected_indices, np.int32))
+            if mask.any():
+                edge = outline_mask(mask)
+                rgba = np.zeros(mask.shape + (4,), np.uint8)
+                rgba[mask] = (232, 162, 58, 28)  # a faint fill
+                rgba[edge] = (232, 162, 58, 255)
+                self._outline = rgba_to_qimage(rgba)
+        self.update()
+
+    def show_focus_overlay(self, focus: float, near: float, far: float, hold: bool = False) -> None:
+        """Show the plane of focus and the depth of field on the image; it fades out unless ``hold``."""
+        g = self.gbuffer
+        if g is None:
+            return
+        self._overlay = rgba_to_qimage(focus_overlay(g.depth, focus, near, far))
+        self._overlay_label = f"focus {focus:.2f} m"
+        self._overlay_until = math.inf if hold else time.monotonic() + OVERLAY_HOLD_SECONDS
+        if not hold:
+            self._fade_timer.start()
+        self.update()
+
+    def hide_focus_overlay(self) -> None:
+        self._overlay_until = time.monotonic()
+        self._fade_timer.start()
+
+    def overlay_visible(self) -> bool:
+        return self._overlay is not None and self._overlay_opacity() > 0
+
+    def _overlay_opacity(self) -> float:
+        remaining = self._overlay_until - time.monotonic()
+        if remaining >= 0:
+            return 1.0
+        return max(0.0, 1.0 + remaining / OVERLAY_FADE_SECONDS)
+
+    def _fade_tick(self) -> None:
+        if self._overlay_opacity() <= 0:
+            self._overlay = None
+            self._fade_timer.stop()
+        self.update()
+
+    # -- geometry ---------------------------------------------------------------------------------------------
+    def image_size(self) -> tuple[int, int]:
+        if self.linear is None:
+            return (0, 0)
+        return self.linear.shape[1], self.linear.shape[0]
+
+    def fit_scale(self) -> float:
+        w, h = self.image_size()
+        if w == 0:
+            return 1.0
+        margin = 24
+        return max(0.01, min((self.width() - margin) / w, (self.height() - margin) / h))
+
+    def scale(self) -> float:
+        return self.fit_scale() if self.zoom is None else self.zoom
+
+    def image_rect(self) -> QRectF:
+        w, h = self.image_size()
+        s = self.scale()
+        centre = QPointF(self.width() / 2, self.height() / 2) + (self.pan if self.zoom is not None else QPointF())
+        return QRectF(centre.x() - w * s / 2, centre.y() - h * s / 2, w * s, h * s)
+
+    def widget_to_image(self, pos: QPointF) -> tuple[float, float] | None:
+        """Image coordinates in pixels (0, 0 = top-left corner of the top-left pixel), or None off the image."""
+        rect = self.image_rect()
+        if rect.width() <= 0 or not rect.contains(pos):
+            return None
+        s = self.scale()
+        return (pos.x() - rect.left()) / s, (pos.y() - rect.top()) / s
+
+    def image_to_widget(self, x: float, y: float) -> QPointF:
+        rect = self.image_rect()
+        s = self.scale()
+        return QPointF(rect.left() + x * s, rect.top() + y * s)
+
+    def fit(self) -> None:
+        self.zoom = None
+        self.pan = QPointF()
+        self.update()
+        self.zoom_changed.emit(self.scale())
+
+    def set_zoom(self, zoom: float, anchor: QPointF | None = None) -> None:
+        zoom = min(max(zoom, ZOOM_STEPS[0]), ZOOM_STEPS[-1])
+        anchor = anchor if anchor is not None else QPointF(self.width() / 2, self.height() / 2)
+        before = self.widget_to_image_unclamped(anchor)
+        if self.zoom is None:
+            self.pan = QPointF()
+        self.zoom = zoom
+        # Keep the image point under the anchor where it was.
+        after = self.image_to_widget(*before)
+        self.pan += anchor - after
+        self.update()
+        self.zoom_changed.emit(self.scale())
+
+    def widget_to_image_unclamped(self, pos: QPointF) -> tuple[float, float]:
+        rect = self.image_rect()
+        s = self.scale()
+        return (pos.x() - rect.left()) / s, (pos.y() - rect.top()) / s
+
+    def zoom_step(self, direction: int, anchor: QPointF | None = None) -> None:
+        current = self.scale()
+        if direction > 0:
+            target = next((z for z in ZOOM_STEPS if z > current * 1.001), ZOOM_STEPS[-1])
+        else:
+            target = next((z for z in reversed(ZOOM_STEPS) if z < current / 1.001), ZOOM_STEPS[0])
+        self.set_zoom(target, anchor)
+
+    # -- painting ---------------------------------------------------------------------------------------------
+    def paintEvent(self, event) -> None:
+        p = QPainter(self)
+        p.fillRect(self.rect(), QColor(theme.BACKGROUND))
+        if self.qimage is not None:
+            rect = self.image_rect()
+            smooth = self.scale() < 2.0  # pixel-peeping at 200% and above shows the pixels as they are
+            p.setRenderHint(QPainter.SmoothPixmapTransform, smooth)
+            p.fillRect(rect.adjusted(-1, -1, 1, 1), QColor("#000000"))
+            p.drawImage(rect, self.qimage)
+            if self.message:
+                p.fillRect(rect, QColor(0, 0, 0, 140))
+            if self._outline is not None and self._outline.size() == self.qimage.size():
+                p.drawImage(rect, self._outline)
+            if self._overlay is not None and self._overlay.size() == self.qimage.size():
+                p.setOpacity(self._overlay_opacity())
+                p.drawImage(rect, self._overlay)
+                self._draw_tag(p, QPointF(rect.left() + 10, rect.bottom() - 12), self._overlay_label, theme.FOCUS)
+                p.setOpacity(1.0)
+        self._draw_hud(p)
+        if self.message:
+            p.setPen(QColor("#f0c0a0"))
+            font = QFont(self.font())
+            font.setPointSizeF(font.pointSizeF() * 1.1)
+            p.setFont(font)
+            p.drawText(self.rect().adjusted(40, 40, -40, -40), Qt.AlignCenter | Qt.TextWordWrap, self.message)
+        elif self.qimage is None:
+            p.setPen(QColor(theme.DIM_TEXT))
+            p.drawText(self.rect(), Qt.AlignCenter, "Starting the renderer…")
+        p.end()
+
+    def _draw_tag(self, p: QPainter, at: QPointF, text: str, colour: str) -> None:
+        if not text:
+            return
+        metrics = p.fontMetrics()
+        w = metrics.horizontalAdvance(text) + 12
+        h = metrics.height() + 4
+        box = QRectF(at.x(), at.y() - h, w, h)
+        p.setPen(Qt.NoPen)
+        p.setBrush(QColor(20, 20, 22, 200))
+        p.drawRoundedRect(box, 3, 3)
+        p.setPen(QColor(colour))
+        p.drawText(box, Qt.AlignCenter, text)
+
+    def _draw_hud(self, p: QPainter) -> None:
+        rect = self.image_rect() if self.qimage is not None else QRectF(self.rect())
+        top = max(4.0, rect.top() - 4)
+        if self.hud_text:
+            self._draw_tag(p, QPointF(max(4.0, rect.left()), top + 22 if rect.top() < 26 else top), self.hud_text,
+                           "#e6e6e6")
+        if self.status_text:
+            metrics = p.fontMetrics()
+            x = min(self.width() - 4.0, rect.right()) - metrics.horizontalAdvance(self.status_text) - 12
+            self._draw_tag(p, QPointF(x, top + 22 if rect.top() < 26 else top), self.status_text, theme.DIM_TEXT)
+        if self.tool == "focus" and self.focus_pending:
+            self._draw_tag(p, QPointF(8, self.height() - 8), "focusing…", theme.FOCUS)
+
+    # -- interaction --------------------------------------------------------------------------------------------
+    def set_tool(self, tool: str) -> None:
+        self.tool = tool
+        self.setCursor({"select": Qt.ArrowCursor, "focus": Qt.CrossCursor, "pan": Qt.OpenHandCursor}[tool])
+        self.update()
+
+    def wheelEvent(self, event) -> None:
+        steps = event.angleDelta().y()
+        if steps:
+            self.zoom_step(1 if steps > 0 else -1, event.position())
+
+    def mousePressEvent(self, event) -> None:
+        pos = event.position()
+        panning = event.button() == Qt.MiddleButton or (event.button() == Qt.LeftButton and
+                                                          (self.tool == "pan" or self._space_down))
+        if panning:
+            if self.zoom is None:
+                self.zoom = self.fit_scale()
+                self.pan = QPointF()
+            self._drag_start = pos
+            self._pan_start = QPointF(self.pan)
+            self.setCursor(Qt.ClosedHandCursor)
+            return
+        if event.button() == Qt.LeftButton:
+            self._press_pos = pos
+            if self.tool == "focus":
+                self._preview_focus_at(pos)
+
+    def mouseMoveEvent(self, event) -> None:
+        pos = event.position()
+        if self._drag_start is not None:
+            self.pan = self._pan_start + (pos - self._drag_start)
+            self.update()
+            return
+        xy = self.widget_to_image(pos)
+        self.pixel_hovered.emit(None if xy is None else (int(xy[0]), int(xy[1])))
+        if self.tool == "focus" and self._press_pos is not None:
+            self._preview_focus_at(pos)
+
+    def mouseReleaseEvent(self, event) -> None:
+        pos = event.position()
+        if self._drag_start is not None:
+            self._drag_start = None
+            self.set_tool(self.tool)
+            return
+        if event.button() != Qt.LeftButton or self._press_pos is None:
+            return
+        self._press_pos = None
+        xy = self.widget_to_image(pos)
+        if xy is None:
+            if self.tool == "select":
+                self.node_clicked.emit(-1, False)
+            return
+        w, h = self.image_size()
+        if self.tool == "focus":
+            self.focus_pending = True
+            self.focus_clicked.emit(xy[0] / w, xy[1] / h)
+        elif self.tool == "select":
+            index = self.node_at(int(xy[0]), int(xy[1]))
+            self.node_clicked.emit(index, bool(event.modifiers() & (Qt.ShiftModifier | Qt.ControlModifier)))
+
+    def leaveEvent(self, event) -> None:
+        self.pixel_hovered.emit(None)
+
+    def keyPressEvent(self, event) -> None:
+        if event.key() == Qt.Key_Space and not event.isAutoRepeat():
+            self._space_down = True
+            self.setCursor(Qt.OpenHandCursor)
+            return
+        super().keyPressEvent(event)
+
+    def keyReleaseEvent(self, event) -> None:
+        if event.key() == Qt.Key_Space and not event.isAutoRepeat():
+            self._space_down = False
+            self.set_tool(self.tool)
+            return
+        super().keyReleaseEvent(event)
+
+    def node_at(self, x: int, y: int) -> int:
+        g = self.gbuffer
+        if g is None or not (0 <= y < g.node_index.shape[0] and 0 <= x < g.node_index.shape[1]):
+            return -1
+        return int(g.node_index[y, x])
+
+    def depth_at(self, x: int, y: int) -> float:
+        g = self.gbuffer
+        if g is None or not (0 <= y < g.depth.shape[0] and 0 <= x < g.depth.shape[1]):
+            return math.inf
+        return float(g.depth[y, x])
+
+    focus_preview = Signal(float)  # depth under the focus tool while the button is held
+
+    def _preview_focus_at(self, pos: QPointF) -> None:
+        xy = self.widget_to_image(pos)
+        if xy is None:
+            return
+        depth = self.depth_at(int(xy[0]), int(xy[1]))
+        if math.isfinite(depth):
+            self.focus_preview.emit(depth)

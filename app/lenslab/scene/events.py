@@ -1,0 +1,89 @@
+"""Observing a scene while it is edited: a small event emitter with no GUI toolkit in it.
+
+The scene classes are plain dataclasses; whoever edits them (the studio's undo commands, a script) says what
+changed by emitting a :class:`SceneChange` on a :class:`SceneEvents`. Observers (the viewport, the outliner,
+the render worker's feeder) connect callables and decide for themselves what to refresh, as napari's layers
+do with their event groups. Nothing here imports Qt, so a headless tool can observe a scene the same way.
+
+    events = SceneEvents()
+    events.changed.connect(lambda change: print(change.kind, change.field))
+    events.changed.emit(SceneChange("camera", ("camera",), ("f_number",)))
+"""
+
+from __future__ import annotations
+
+from contextlib import contextmanager
+from dataclasses import dataclass
+from typing import Any, Callable, Iterator
+
+#: What a change touched, from cheapest to dearest to re-render:
+#: ``camera`` (restart only), ``render`` (sampler settings), ``material`` (re-pack materials),
+#: ``environment``, ``node`` (a node's fields: transform, shape, material), ``structure`` (nodes or
+#: materials added, removed, renamed or moved) and ``scene`` (the whole scene replaced).
+CHANGE_KINDS = ("camera", "render", "material", "environment", "node", "structure", "scene")
+
+
+@dataclass(frozen=True)
+class SceneChange:
+    kind: str
+    target: tuple = ()  # what was edited: ("camera",), ("node", path), ("material", name), ...
+    field: tuple[str, ...] = ()  # which field of it, as an attribute path: ("transform", "translate")
+
+    def __post_init__(self):
+        if self.kind not in CHANGE_KINDS:
+            raise ValueError(f"unknown change kind {self.kind!r} (expected one of {', '.join(CHANGE_KINDS)})")
+
+    @property
+    def geometry(self) -> bool:
+        """True when what the camera sees may have moved (so picking and selection buffers are stale)."""
+        if self.kind in ("node", "structure", "scene"):
+            return self.field[:1] != ("material",) and self.field[:1] != ("name",)
+        if self.kind == "camera":
+            return self.field[:1] not in (("f_number",), ("focus_distance_m",), ("aperture_blades",),
+                                          ("blade_rotation_deg",))
+        return False
+
+
+class EventEmitter:
+    """Callables connected to one kind of event; ``emit`` calls them in the order they were connected."""
+
+    def __init__(self) -> None:
+        self._callbacks: list[Callable[[Any], None]] = []
+        self._blocked = 0
+
+    def connect(self, callback: Callable[[Any], None]) -> Callable[[Any], None]:
+        if callback not in self._callbacks:
+            self._callbacks.append(callback)
+        return callback  # usable as a decorator
+
+    def disconnect(self, callback: Callable[[Any], None] | None = None) -> None:
+        """Disconnect one callback, or all of them when none is given."""
+        if callback is None:
+            self._callbacks.clear()
+        elif callback in self._callbacks:
+            self._callbacks.remove(callback)
+
+    def emit(self, event: Any = None) -> None:
+        if self._blocked:
+            return
+        for callback in list(self._callbacks):  # a callback may disconnect itself
+            callback(event)
+
+    @contextmanager
+    def blocked(self) -> Iterator[None]:
+        """Emit nothing inside the block (for a batch of edits announced once at the end)."""
+        self._blocked += 1
+        try:
+            yield
+        finally:
+            self._blocked -= 1
+
+    def __len__(self) -> int:
+        return len(self._callbacks)
+
+
+class SceneEvents:
+    """The events of one edited scene: ``changed`` carries a :class:`SceneChange`."""
+
+    def __init__(self) -> None:
+        self.changed = EventEmitter()
