@@ -1,41 +1,252 @@
-// Scattering at a surface. Every material provides three functions that agree with one another:
-// evaluation (f * |cos theta_i|), its pdf, and importance sampling that returns f * |cos| / pdf.
-// Directions are world-space unit vectors; wo points away from the surface, towards where light goes.
+// Scattering at a surface. Every material provides three things that agree with one another:
+// evaluation (f |cos theta_i|), its pdf, and importance sampling that returns f |cos| / pdf.
+// Directions are world-space unit vectors; wo points back along the arriving ray. Work happens in the
+// local shading frame (normal = +Z), which surface_at() has already turned towards wo: reflecting
+// materials are two-sided without the user having to say so, and dielectrics know from front_face
+// whether the ray is entering or leaving.
 
 const int MATERIAL_DIFFUSE = 0;
 const int MATERIAL_EMISSIVE = 1;
+const int MATERIAL_CONDUCTOR = 2;
+const int MATERIAL_PLASTIC = 3;
+const int MATERIAL_DIELECTRIC = 4;
+const int MATERIAL_THIN_DIELECTRIC = 5;
+const int MATERIAL_STRIDE = 8;  // vec4 rows per material; see render/buffers.py
 
-int material_type(int m) { return int(materials[4 * m].w); }
-vec3 material_albedo(int m) { return materials[4 * m].xyz; }
-
+vec4 material_row(int m, int row) { return materials[MATERIAL_STRIDE * m + row]; }
+int material_type(int m) { return int(material_row(m, 0).w); }
 bool material_scatters(int m) { return material_type(m) != MATERIAL_EMISSIVE; }
 
 // Radiance a surface emits towards wo.
 vec3 emitted_radiance(int m, bool front_face) {
-    vec4 e = materials[4 * m + 1];
+    vec4 e = material_row(m, 1);
     return (front_face || e.w > 0.5) ? e.xyz : vec3(0.0);
 }
 
-// f(wo, wi) |cos theta_i|, with pdf the density bsdf_sample would have chosen wi with (solid angle).
-vec3 bsdf_eval(SurfaceHit s, vec3 wi, out float pdf) {
-    pdf = 0.0;
-    float cos_i = dot(wi, s.ns);
-    // Light must arrive on the side the ray came from: a shading normal must not let it leak through.
-    if (material_type(s.material) != MATERIAL_DIFFUSE || cos_i <= 0.0 || dot(wi, s.ng) <= 0.0) return vec3(0.0);
-    pdf = cos_i * INV_PI;
-    return material_albedo(s.material) * INV_PI * cos_i;
+// Beer-Lambert absorption coefficient (per metre) inside a dielectric; zero elsewhere.
+vec3 material_absorption(int m) {
+    return material_type(m) == MATERIAL_DIELECTRIC ? material_row(m, 5).xyz : vec3(0.0);
 }
 
-// Sample wi; weight = f |cos| / pdf. delta = the lobe is a Dirac (no MIS with light sampling possible).
-bool bsdf_sample(SurfaceHit s, vec3 u, out vec3 wi, out vec3 weight, out float pdf, out bool delta) {
-    delta = false;
+// A material's parameters at one surface point, textures resolved.
+struct Bsdf {
+    int type;
+    vec3 color;   // diffuse albedo
+    vec3 tint;    // specular tint
+    float alpha;  // GGX width; 0 = smooth
+    float eta;    // dielectrics: n_inside / n_outside, inverted when leaving; plastic: coating index
+    vec3 eta3;    // conductors: complex index
+    vec3 k;
+    float internal_reflectance;  // plastic: diffuse Fresnel reflectance inside the coating
+    mat3 frame;   // local shading frame: columns tangent, bitangent, normal
+};
+
+Bsdf bsdf_at(SurfaceHit s) {
+    Bsdf b;
+    int m = s.material;
+    vec4 r0 = material_row(m, 0), r2 = material_row(m, 2), r3 = material_row(m, 3), r4 = material_row(m, 4);
+    b.type = int(r0.w);
+    b.color = r0.xyz;
+    b.eta3 = r2.xyz;
+    b.alpha = r2.w;
+    b.k = r3.xyz;
+    b.tint = r4.xyz;
+    b.eta = r2.x;
+    b.internal_reflectance = r2.y;
+    if (r3.w >= 0.0) b.color = texture_rgb(int(r3.w), s.uv);
+    if (r4.w >= 0.0) {  // roughness texture: perceptual roughness in the red channel
+        float r = texture_rgb(int(r4.w), s.uv).x;
+        b.alpha = r * r;
+    }
+    if (b.type == MATERIAL_DIELECTRIC && !s.front_face) b.eta = 1.0 / b.eta;
+    b.alpha = b.alpha > 0.0 ? max(b.alpha, 1e-4) : 0.0;  // keep tiny roughness out of float trouble
+    b.frame = frame_around(s.ns);
+    return b;
+}
+
+bool bsdf_is_delta(Bsdf b) {
+    return b.type == MATERIAL_THIN_DIELECTRIC ||
+           ((b.type == MATERIAL_CONDUCTOR || b.type == MATERIAL_DIELECTRIC) && b.alpha == 0.0);
+}
+
+vec3 to_local(Bsdf b, vec3 w) { return w * b.frame; }  // = transpose(frame) * w
+vec3 to_world(Bsdf b, vec3 w) { return b.frame * w; }
+
+// -- plastic: the probability of choosing the specular coating when sampling (Mitsuba's heuristic) --------
+float plastic_specular_probability(Bsdf b, float cos_o) {
+    float f = fresnel_dielectric(cos_o, b.eta);
+    float d = (b.color.x + b.color.y + b.color.z) / 3.0;
+    float spec_weight = 1.0 / (1.0 + d);
+    float p_spec = f * spec_weight;
+    float p_diff = (1.0 - f) * (1.0 - spec_weight);
+    return p_spec / max(p_spec + p_diff, 1e-12);
+}
+
+vec3 plastic_diffuse(Bsdf b, float cos_o, float cos_i) {
+    float t = (1.0 - fresnel_dielectric(cos_i, b.eta)) * (1.0 - fresnel_dielectric(cos_o, b.eta));
+    return b.color / (1.0 - b.internal_reflectance) * (t / (b.eta * b.eta)) * INV_PI * cos_i;
+}
+
+// -- rough dielectric (Walter et al. 2007, as pbrt-v4's DielectricBxDF) -----------------------------------
+vec3 rough_dielectric_eval(Bsdf b, vec3 wo, vec3 wi, out float pdf) {
+    pdf = 0.0;
+    bool reflect = wi.z > 0.0;
+    vec3 m = reflect ? normalize(wo + wi) : normalize(wi * b.eta + wo);
+    if (m.z < 0.0) m = -m;
+    if (dot(m, wi) * wi.z < 0.0 || dot(m, wo) * wo.z < 0.0) return vec3(0.0);  // back-facing microfacet
+    float f = fresnel_dielectric(dot(wo, m), b.eta);
+    float vis_pdf = ggx_visible_normal_pdf(wo, m, b.alpha);
+    float d = ggx_d(m, b.alpha), g = ggx_g(wo, wi, b.alpha);
+    if (reflect) {
+        pdf = vis_pdf / (4.0 * abs(dot(wo, m))) * f;
+        return b.tint * (d * g * f / (4.0 * wo.z));
+    }
+    float denom = dot(wi, m) + dot(wo, m) / b.eta;
+    denom *= denom;
+    if (denom == 0.0) return vec3(0.0);
+    float dm_dwi = abs(dot(wi, m)) / denom;
+    pdf = vis_pdf * dm_dwi * (1.0 - f);
+    float ft = (1.0 - f) * d * g * abs(dot(wi, m) * dot(wo, m) / (wo.z * denom));
+    return b.tint * (ft / (b.eta * b.eta));  // radiance is compressed entering denser media: 1/eta^2
+}
+
+// f(wo, wi) |cos theta_i| and the density with which bsdf_sample would choose wi (solid angle).
+vec3 bsdf_eval(SurfaceHit s, vec3 wi_world, out float pdf) {
+    pdf = 0.0;
+    Bsdf b = bsdf_at(s);
+    if (bsdf_is_delta(b)) return vec3(0.0);
+    vec3 wo = to_local(b, s.wo), wi = to_local(b, wi_world);
+    if (wo.z <= 0.0) return vec3(0.0);
+    bool same_side = dot(wi_world, s.ng) > 0.0;  // the geometric normal decides, so shading normals never leak
+    if (b.type == MATERIAL_DIELECTRIC) {
+        if (same_side != (wi.z > 0.0)) return vec3(0.0);
+        return rough_dielectric_eval(b, wo, wi, pdf);
+    }
+    if (!same_side || wi.z <= 0.0) return vec3(0.0);
+    if (b.type == MATERIAL_DIFFUSE) {
+        pdf = wi.z * INV_PI;
+        return b.color * INV_PI * wi.z;
+    }
+    vec3 m = normalize(wo + wi);
+    if (b.type == MATERIAL_CONDUCTOR) {
+        pdf = ggx_visible_normal_pdf(wo, m, b.alpha) / (4.0 * dot(wo, m));
+        vec3 f = fresnel_conductor(dot(wo, m), b.eta3, b.k);
+        return b.tint * f * (ggx_d(m, b.alpha) * ggx_g(wo, wi, b.alpha) / (4.0 * wo.z));
+    }
+    if (b.type == MATERIAL_PLASTIC) {
+        float p_spec = plastic_specular_probability(b, wo.z);
+        vec3 value = plastic_diffuse(b, wo.z, wi.z);
+        pdf = (1.0 - p_spec) * wi.z * INV_PI;
+        if (b.alpha > 0.0) {
+            float f = fresnel_dielectric(dot(wo, m), b.eta);
+            value += vec3(f * ggx_d(m, b.alpha) * ggx_g(wo, wi, b.alpha) / (4.0 * wo.z));
+            pdf += p_spec * ggx_visible_normal_pdf(wo, m, b.alpha) / (4.0 * dot(wo, m));
+        }
+        return value;
+    }
+    return vec3(0.0);
+}
+
+// Sample wi given three uniform numbers; weight = f |cos| / pdf. delta: a Dirac lobe was chosen
+// (no MIS against light sampling is possible for it).
+bool bsdf_sample(SurfaceHit s, vec3 u, out vec3 wi_world, out vec3 weight, out float pdf, out bool delta) {
     weight = vec3(0.0);
     pdf = 0.0;
-    if (material_type(s.material) != MATERIAL_DIFFUSE) return false;
-    wi = frame_around(s.ns) * sample_cosine_hemisphere(u.xy);
-    if (dot(wi, s.ng) <= 0.0) return false;
-    pdf = dot(wi, s.ns) * INV_PI;
-    if (pdf <= 0.0) return false;
-    weight = material_albedo(s.material);  // (albedo / pi) cos / (cos / pi)
-    return true;
+    delta = false;
+    wi_world = vec3(0.0);
+    Bsdf b = bsdf_at(s);
+    vec3 wo = to_local(b, s.wo);
+    if (wo.z <= 0.0 || b.type == MATERIAL_EMISSIVE) return false;
+    vec3 wi;
+    bool transmit = false;
+
+    if (b.type == MATERIAL_DIFFUSE) {
+        wi = sample_cosine_hemisphere(u.xy);
+        pdf = wi.z * INV_PI;
+        weight = b.color;
+    } else if (b.type == MATERIAL_CONDUCTOR) {
+        vec3 m = b.alpha == 0.0 ? vec3(0.0, 0.0, 1.0) : ggx_sample_visible_normal(wo, b.alpha, u.xy);
+        wi = 2.0 * dot(wo, m) * m - wo;
+        if (wi.z <= 0.0) return false;
+        vec3 f = b.tint * fresnel_conductor(dot(wo, m), b.eta3, b.k);
+        if (b.alpha == 0.0) {
+            delta = true;
+            pdf = 1.0;
+            weight = f;
+        } else {
+            pdf = ggx_visible_normal_pdf(wo, m, b.alpha) / (4.0 * dot(wo, m));
+            weight = f * (ggx_g(wo, wi, b.alpha) / ggx_g1(wo, b.alpha));
+        }
+    } else if (b.type == MATERIAL_PLASTIC) {
+        float p_spec = plastic_specular_probability(b, wo.z);
+        if (u.z < p_spec) {
+            vec3 m = b.alpha == 0.0 ? vec3(0.0, 0.0, 1.0) : ggx_sample_visible_normal(wo, b.alpha, u.xy);
+            wi = 2.0 * dot(wo, m) * m - wo;
+            if (wi.z <= 0.0) return false;
+            if (b.alpha == 0.0) {
+                delta = true;
+                pdf = p_spec;
+                weight = vec3(fresnel_dielectric(wo.z, b.eta) / p_spec);
+            }
+        } else {
+            wi = sample_cosine_hemisphere(u.xy);
+        }
+        if (!delta) {  // both lobes can produce this direction: weigh by the full density
+            wi_world = to_world(b, wi);
+            if (dot(wi_world, s.ng) <= 0.0) return false;
+            vec3 f = bsdf_eval(s, wi_world, pdf);
+            if (pdf <= 0.0) return false;
+            weight = f / pdf;
+            return true;
+        }
+    } else if (b.type == MATERIAL_THIN_DIELECTRIC) {
+        float r = fresnel_dielectric(wo.z, b.eta);
+        if (r < 1.0) r += (1.0 - r) * (1.0 - r) * r / (1.0 - r * r);  // inter-reflections inside the pane
+        delta = true;
+        weight = b.tint;
+        if (u.z < r) {
+            wi = vec3(-wo.xy, wo.z);
+            pdf = r;
+        } else {
+            wi = -wo;
+            pdf = 1.0 - r;
+            transmit = true;
+        }
+    } else if (b.type == MATERIAL_DIELECTRIC) {
+        vec3 m = b.alpha == 0.0 ? vec3(0.0, 0.0, 1.0) : ggx_sample_visible_normal(wo, b.alpha, u.xy);
+        float f = fresnel_dielectric(dot(wo, m), b.eta);
+        if (u.z < f) {
+            wi = 2.0 * dot(wo, m) * m - wo;
+            if (wi.z <= 0.0) return false;
+        } else {
+            if (!refract_dir(wo, m, b.eta, wi) || wi.z >= 0.0) return false;
+            transmit = true;
+        }
+        if (b.alpha == 0.0) {
+            delta = true;
+            pdf = transmit ? 1.0 - f : f;
+            weight = transmit ? b.tint / (b.eta * b.eta) : b.tint;
+        } else {
+            wi_world = to_world(b, wi);
+            if ((dot(wi_world, s.ng) > 0.0) == transmit) return false;
+            vec3 value = rough_dielectric_eval(b, wo, wi, pdf);
+            if (pdf <= 0.0) return false;
+            weight = value / pdf;
+            return true;
+        }
+    } else {
+        return false;
+    }
+    wi_world = to_world(b, wi);
+    // The sampled side must agree with the geometric normal: reflection stays, transmission crosses.
+    if ((dot(wi_world, s.ng) > 0.0) == transmit) return false;
+    return pdf > 0.0;
+}
+
+// How much a transmission from wo to wi compresses radiance (eta^2 entering glass, 1/eta^2 leaving); 1 for
+// reflection. Russian roulette divides it out so that paths inside glass are not killed for looking dim.
+float bsdf_eta_scale(SurfaceHit s, vec3 wi) {
+    if (dot(wi, s.ng) >= 0.0 || material_type(s.material) != MATERIAL_DIELECTRIC) return 1.0;
+    float eta = material_row(s.material, 2).x;
+    return s.front_face ? eta * eta : 1.0 / (eta * eta);
 }

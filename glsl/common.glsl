@@ -15,7 +15,7 @@ layout(std430, binding = 1) readonly buffer PrimRefs { int prim_refs[]; };
 layout(std430, binding = 2) readonly buffer Geometry { vec4 geometry[]; };
 // Four vec4 per triangle (spheres have none): (n0, u0), (n1, v0), (n2, u1), (v1, u2, v2, -).
 layout(std430, binding = 3) readonly buffer Shading { vec4 shading[]; };
-// Four vec4 per material: (albedo, type), (emission, two-sided), then two of type-specific parameters.
+// Eight vec4 per material (see bsdf.glsl), then four per texture from row texture_base (textures.glsl).
 layout(std430, binding = 4) readonly buffer Materials { vec4 materials[]; };
 // One vec4 per emissive primitive: (primitive index as float bits, cumulative pmf, pmf, -).
 layout(std430, binding = 5) readonly buffer Lights { vec4 lights[]; };

@@ -11,6 +11,7 @@ vec3 path_radiance(Ray ray, inout Sampler sampler) {
     float prev_bsdf_pdf = 0.0;
     bool prev_delta = true;  // the camera ray: nothing to weigh emission against
     vec3 prev_p = ray.o;
+    float eta_scale = 1.0;  // radiance compression by refraction so far (see bsdf_eta_scale)
 
     for (int segments = 1; ; segments++) {
         Hit hit;
@@ -21,6 +22,10 @@ vec3 path_radiance(Ray ray, inout Sampler sampler) {
             break;
         }
         SurfaceHit s = surface_at(ray, hit);
+        if (!s.front_face) {
+            // The ray travelled inside this object: Beer-Lambert absorption over the distance (zero unless glass).
+            throughput *= exp(-material_absorption(s.material) * hit.t);
+        }
 
         vec3 le = emitted_radiance(s.material, s.front_face);
         if (max_component(le) > 0.0) {
@@ -57,6 +62,7 @@ vec3 path_radiance(Ray ray, inout Sampler sampler) {
         bool delta;
         if (!bsdf_sample(s, u_bsdf.xyz, wi, weight, pdf, delta)) break;
         throughput *= weight;
+        eta_scale *= bsdf_eta_scale(s, wi);
         prev_bsdf_pdf = pdf;
         prev_delta = delta;
         prev_p = s.p;
@@ -64,7 +70,7 @@ vec3 path_radiance(Ray ray, inout Sampler sampler) {
 
         if (segments >= rr_depth) {
             // Survive with probability q (at most 0.95), then divide by it: unbiased.
-            float q = min(max_component(throughput), 0.95);
+            float q = min(max_component(throughput) * eta_scale, 0.95);
             if (u_bsdf.w >= q) break;
             throughput /= q;
         }

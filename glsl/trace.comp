@@ -13,6 +13,8 @@ layout(local_size_x = LOCAL_SIZE_X) in;
 #include "intersect.glsl"
 #include "bsp.glsl"
 #include "surface.glsl"
+#include "textures.glsl"
+#include "microfacet.glsl"
 #include "bsdf.glsl"
 #include "lights.glsl"
 #include "integrator.glsl"

@@ -9,19 +9,23 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
 from lenslab.render.bsp import KdTree, build_kdtree
+from lenslab.render.fresnel import internal_diffuse_reflectance
+from lenslab.render.textures import TextureTable
 from lenslab.scene.flatten import FlatScene
-from lenslab.scene.materials import Diffuse, Emissive, Material
+from lenslab.scene.materials import Conductor, Diffuse, Dielectric, Emissive, Material, Plastic, ThinDielectric
 from lenslab.scene.scene import ConstantEnvironment, Environment
 
-# glsl/bsdf.glsl's material type codes.
-MATERIAL_CODES = {Diffuse: 0, Emissive: 1}
+# glsl/bsdf.glsl's material type codes and record size.
+MATERIAL_CODES = {Diffuse: 0, Emissive: 1, Conductor: 2, Plastic: 3, Dielectric: 4, ThinDielectric: 5}
+MATERIAL_ROWS = 8
 
-# Binding points, as declared in glsl/common.glsl and glsl/trace.comp.
-BINDINGS = {"kd_nodes": 0, "prim_refs": 1, "geometry": 2, "shading": 3, "materials": 4, "lights": 5}
+# Binding points, as declared in glsl/common.glsl, glsl/textures.glsl and glsl/trace.comp.
+BINDINGS = {"kd_nodes": 0, "prim_refs": 1, "geometry": 2, "shading": 3, "materials": 4, "lights": 5, "image_data": 7}
 ACCUMULATION_BINDING = 6
 
 
@@ -38,18 +42,39 @@ def _luminance(rgb) -> float:
     return 0.2126 * r + 0.7152 * g + 0.0722 * b
 
 
-def pack_material(material: Material) -> np.ndarray:
-    """Four vec4: (albedo, type), (emission, two-sided), then two of type-specific parameters."""
-    record = np.zeros((4, 4), np.float32)
+def pack_material(material: Material, textures: TextureTable) -> np.ndarray:
+    """Eight vec4 rows, read by glsl/bsdf.glsl's bsdf_at():
+    0 (albedo, type), 1 (emission, two-sided), 2 (eta rgb | ior, internal reflectance, -, alpha),
+    3 (k rgb, albedo texture), 4 (specular tint, roughness texture), 5 (absorption per metre), 6-7 spare."""
+    record = np.zeros((MATERIAL_ROWS, 4), np.float32)
     code = MATERIAL_CODES.get(type(material))
     if code is None:
         raise TypeError(f"no GPU packing for material type {type(material).__name__}")
     record[0, 3] = code
-    if isinstance(material, Diffuse):
+    record[3, 3] = record[4, 3] = -1.0  # no textures
+    record[4, :3] = 1.0
+    roughness = getattr(material, "roughness", 0.0)
+    record[2, 3] = roughness**2  # GGX alpha from perceptual roughness
+    if isinstance(material, (Diffuse, Plastic)):
         record[0, :3] = material.albedo
-    elif isinstance(material, Emissive):
+        record[3, 3] = textures.index_of(material.albedo_texture)
+    if isinstance(material, (Conductor, Plastic)):
+        record[4, 3] = textures.index_of(material.roughness_texture)
+    if isinstance(material, Emissive):
         record[1, :3] = material.radiance
         record[1, 3] = 1.0 if material.two_sided else 0.0
+    elif isinstance(material, Conductor):
+        eta, k = material.complex_ior()
+        record[2, :3], record[3, :3], record[4, :3] = eta, k, material.tint
+    elif isinstance(material, Plastic):
+        record[2, 0], record[2, 1] = material.ior, internal_diffuse_reflectance(material.ior)
+    elif isinstance(material, Dielectric):
+        record[2, 0] = material.ior
+        record[4, :3] = material.tint
+        record[5, :3] = material.absorption_coefficient()
+    elif isinstance(material, ThinDielectric):
+        record[2, 0] = material.ior
+        record[4, :3] = material.tint
     return record
 
 
@@ -89,13 +114,16 @@ class PackedScene:
     arrays: dict[str, np.ndarray]
     uniforms: dict[str, object]
     kdtree: KdTree
+    warnings: tuple[str, ...] = ()  # problems the render survives (a missing texture): show them to the user
 
     @property
     def nbytes(self) -> int:
         return sum(a.nbytes for a in self.arrays.values())
 
 
-def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None = None) -> PackedScene:
+def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None = None,
+               base_dir: Path | None = None) -> PackedScene:
+    """Arrays and uniforms for the trace kernel; ``base_dir`` resolves relative texture paths."""
     if kdtree is None:
         kdtree = build_kdtree(flat.prim_bounds(), triangles=flat.triangles)
     n_tri, n_prim = flat.triangle_count, flat.prim_count
@@ -131,7 +159,9 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
     lights[:, 1] = np.cumsum(prim_pmf[emitters])
     lights[:, 2] = prim_pmf[emitters]
 
-    materials = np.stack([pack_material(m) for m in flat.materials]) if flat.materials else np.zeros((1, 4, 4))
+    textures = TextureTable(base_dir or Path.cwd())
+    materials = [pack_material(m, textures) for m in flat.materials] or [np.zeros((MATERIAL_ROWS, 4), np.float32)]
+    material_rows = np.concatenate(materials)
     env_radiance = environment.radiance if isinstance(environment, ConstantEnvironment) else (0.0, 0.0, 0.0)
 
     def at_least_one(a: np.ndarray) -> np.ndarray:  # GL refuses zero-sized buffers
@@ -142,8 +172,9 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
         "prim_refs": kdtree.prim_refs.astype(np.int32),
         "geometry": geometry,
         "shading": shading,
-        "materials": materials.astype(np.float32),
+        "materials": np.concatenate([material_rows, textures.records()]).astype(np.float32),
         "lights": lights,
+        "image_data": textures.texels(),
     }
     arrays = {name: at_least_one(np.ascontiguousarray(a)) for name, a in arrays.items()}
     uniforms = {
@@ -154,8 +185,9 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
         "light_count": len(emitters),
         "env_select_pmf": float(env_pmf),
         "env_radiance": tuple(float(v) for v in env_radiance),
+        "texture_base": len(material_rows),
     }
-    return PackedScene(arrays, uniforms, kdtree)
+    return PackedScene(arrays, uniforms, kdtree, tuple(textures.warnings))
 
 
 class GpuScene:

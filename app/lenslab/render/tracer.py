@@ -109,7 +109,7 @@ class RenderSession:
         self.scene = scene
         self.settings = settings or scene.render
         self.flat_scene = scene.flatten()
-        packed = pack_scene(self.flat_scene, scene.environment)
+        packed = pack_scene(self.flat_scene, scene.environment, base_dir=scene.base_dir())
         gpu_scene = GpuScene(self.ctx, packed, self.renderer.limits.max_storage_block_bytes)
         if self._gpu_scene is not None:
             self._gpu_scene.release()

@@ -3,14 +3,29 @@
 Each material is a small dataclass registered under the ``type`` name that the scene file uses. The renderer
 packs each type into its own GPU record (``lenslab.render.buffers``); adding a material means adding a class
 here, a packer there and a branch in ``glsl/bsdf.glsl``.
+
+Roughness is the artist's "perceptual" roughness r in [0, 1]; the GGX microfacet width is alpha = r^2 (as in
+Disney's and glTF's conventions). Zero means a perfectly smooth surface (a mirror-like delta lobe).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import ClassVar
 
+from lenslab.scene.textures import Texture
+
 RGB = tuple[float, float, float]
+
+# Complex refractive indices (eta, k) of common metals at red, green and blue (about 650, 550 and 450 nm),
+# from the measured spectra that pbrt and Mitsuba ship, reduced to RGB.
+METALS: dict[str, tuple[RGB, RGB]] = {
+    "gold": ((0.143, 0.374, 1.442), (3.983, 2.386, 1.603)),
+    "silver": ((0.155, 0.117, 0.138), (4.828, 3.122, 2.147)),
+    "copper": ((0.200, 0.924, 1.102), (3.912, 2.452, 2.142)),
+    "aluminium": ((1.657, 0.880, 0.521), (9.224, 6.270, 4.837)),
+}
 
 
 @dataclass
@@ -28,6 +43,7 @@ class Diffuse(Material):
 
     type_name: ClassVar[str] = "diffuse"
     albedo: RGB = field(default=(0.8, 0.8, 0.8), metadata={"range": (0.0, 1.0), "doc": "reflectance per channel"})
+    albedo_texture: Texture | None = field(default=None, metadata={"doc": "overrides albedo where given"})
 
 
 @dataclass
@@ -43,4 +59,63 @@ class Emissive(Material):
         return max(self.radiance) > 0.0
 
 
-MATERIAL_TYPES: dict[str, type[Material]] = {cls.type_name: cls for cls in (Diffuse, Emissive)}
+@dataclass
+class Conductor(Material):
+    """A metal: Fresnel reflection with a complex index of refraction, smooth or GGX-rough."""
+
+    type_name: ClassVar[str] = "conductor"
+    metal: str = field(default="aluminium", metadata={"choices": (*METALS, "custom"), "doc": "preset, or custom eta/k"})
+    eta: RGB = field(default=(1.657, 0.880, 0.521), metadata={"range": (0.0, 100.0), "doc": "used when metal is custom"})
+    k: RGB = field(default=(9.224, 6.270, 4.837), metadata={"range": (0.0, 100.0), "doc": "used when metal is custom"})
+    tint: RGB = field(default=(1.0, 1.0, 1.0), metadata={"range": (0.0, 1.0), "doc": "scales the reflectance"})
+    roughness: float = field(default=0.0, metadata={"range": (0.0, 1.0), "doc": "0 = polished mirror"})
+    roughness_texture: Texture | None = None
+
+    def complex_ior(self) -> tuple[RGB, RGB]:
+        return (self.eta, self.k) if self.metal == "custom" else METALS[self.metal]
+
+
+@dataclass
+class Plastic(Material):
+    """A diffuse base under a smooth or rough dielectric coating (Mitsuba's plastic and roughplastic)."""
+
+    type_name: ClassVar[str] = "plastic"
+    albedo: RGB = field(default=(0.5, 0.5, 0.5), metadata={"range": (0.0, 1.0), "doc": "colour of the base"})
+    albedo_texture: Texture | None = None
+    ior: float = field(default=1.49, metadata={"range": (1.0, 4.0), "doc": "index of refraction of the coating"})
+    roughness: float = field(default=0.0, metadata={"range": (0.0, 1.0)})
+    roughness_texture: Texture | None = None
+
+
+@dataclass
+class Dielectric(Material):
+    """Glass and water: Fresnel reflection and Snell refraction, smooth or rough, with Beer-Lambert absorption.
+
+    Absorption is given the way an artist sees it (Bouguer's law): light that travels ``absorption_distance_m``
+    through the material keeps ``absorption_color`` of itself; white means clear.
+    """
+
+    type_name: ClassVar[str] = "dielectric"
+    ior: float = field(default=1.5, metadata={"range": (1.0001, 4.0), "doc": "index of refraction inside"})
+    roughness: float = field(default=0.0, metadata={"range": (0.0, 1.0)})
+    tint: RGB = field(default=(1.0, 1.0, 1.0), metadata={"range": (0.0, 1.0), "doc": "scales reflection and transmission"})
+    absorption_color: RGB = field(default=(1.0, 1.0, 1.0), metadata={"range": (1e-6, 1.0)})
+    absorption_distance_m: float = field(default=0.1, metadata={"range": (1e-6, 1e6)})
+
+    def absorption_coefficient(self) -> RGB:
+        """sigma_a per metre, from exp(-sigma_a d) = colour."""
+        return tuple(-math.log(c) / self.absorption_distance_m for c in self.absorption_color)
+
+
+@dataclass
+class ThinDielectric(Material):
+    """A pane of glass too thin to model: reflects, and lets light through without bending it."""
+
+    type_name: ClassVar[str] = "thin_dielectric"
+    ior: float = field(default=1.5, metadata={"range": (1.0001, 4.0)})
+    tint: RGB = field(default=(1.0, 1.0, 1.0), metadata={"range": (0.0, 1.0)})
+
+
+MATERIAL_TYPES: dict[str, type[Material]] = {
+    cls.type_name: cls for cls in (Diffuse, Emissive, Conductor, Plastic, Dielectric, ThinDielectric)
+}

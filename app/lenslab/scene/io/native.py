@@ -24,13 +24,14 @@ from typing import Any
 from lenslab.scene.materials import MATERIAL_TYPES, Material
 from lenslab.scene.scene import ENVIRONMENT_TYPES, Environment, Node, Scene, SceneError
 from lenslab.scene.shapes import SHAPE_TYPES, MeshFile, Shape
+from lenslab.scene.textures import TEXTURE_TYPES, ImageTexture, Texture
 
 FORMAT_KEY = "lenslab_scene"
 FORMAT_VERSION = 1
 SCENE_SUFFIX = ".json"
 
 # Polymorphic fields: the JSON object's "type" key picks the dataclass.
-_TAGGED = {Shape: SHAPE_TYPES, Material: MATERIAL_TYPES, Environment: ENVIRONMENT_TYPES}
+_TAGGED = {Shape: SHAPE_TYPES, Material: MATERIAL_TYPES, Environment: ENVIRONMENT_TYPES, Texture: TEXTURE_TYPES}
 
 
 class _Invalid(Exception):

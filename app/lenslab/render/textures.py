@@ -1,0 +1,108 @@
+"""Textures for the GPU: image files read through OpenImageIO, linearised, packed as half floats.
+
+A texture that cannot be read is not fatal: the render goes on with a magenta-and-black checkerboard in its
+place (hard to miss in a picture) and a warning naming the file, so one broken path never costs the user
+the rest of the scene.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from lenslab.scene.textures import Checkerboard, ImageTexture, Texture
+
+log = logging.getLogger("lenslab.textures")
+
+TEXTURE_IMAGE, TEXTURE_CHECKER = 0, 1
+RECORD_ROWS = 4  # vec4 rows per texture record (glsl/textures.glsl)
+MAX_SIDE = 4096  # larger images are downsampled: one storage buffer holds all texels
+MISSING = Checkerboard(color_a=(1.0, 0.0, 1.0), color_b=(0.0, 0.0, 0.0), tiles=(16.0, 16.0))
+FLOAT_FORMATS = ("half", "float", "double")
+
+
+def srgb_to_linear(c: np.ndarray) -> np.ndarray:
+    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+
+
+def read_texture_image(path: Path, color_space: str = "auto") -> np.ndarray:
+    """(H, W, 3) float32 linear RGB. Raises OSError naming the file when it cannot be read."""
+    import OpenImageIO as oiio
+
+    image = oiio.ImageBuf(str(path))
+    if image.has_error or image.spec().width == 0:
+        raise OSError(f"{path}: cannot read texture ({image.geterror() or 'unknown format'})")
+    spec = image.spec()
+    if max(spec.width, spec.height) > MAX_SIDE:
+        scale = MAX_SIDE / max(spec.width, spec.height)
+        roi = oiio.ROI(0, max(1, round(spec.width * scale)), 0, max(1, round(spec.height * scale)), 0, 1, 0, spec.nchannels)
+        image = oiio.ImageBufAlgo.resize(image, roi=roi)
+        log.warning("%s: %dx%d texture reduced to %dx%d", path, spec.width, spec.height, roi.width, roi.height)
+    pixels = np.asarray(image.get_pixels(oiio.FLOAT), dtype=np.float32)
+    if pixels.ndim == 2:
+        pixels = pixels[..., None]
+    channels = pixels.shape[2]
+    rgb = np.repeat(pixels[..., :1], 3, axis=2) if channels < 3 else pixels[..., :3]
+    is_float = str(spec.format) in FLOAT_FORMATS
+    if color_space == "srgb" or (color_space == "auto" and not is_float):
+        rgb = srgb_to_linear(np.clip(rgb, 0.0, 1.0))
+    return np.ascontiguousarray(rgb, dtype=np.float32)
+
+
+@dataclass
+class TextureTable:
+    """Collects the textures a scene's materials use, each once, as GPU records and packed texels."""
+
+    base_dir: Path
+    warnings: list[str] = field(default_factory=list)
+    _records: list[np.ndarray] = field(default_factory=list)
+    _texels: list[np.ndarray] = field(default_factory=list)
+    _texel_count: int = 0  # in uints
+    _index: dict[int, int] = field(default_factory=dict)
+
+    def index_of(self, texture: Texture | None) -> int:
+        """The record index of ``texture`` (added on first use), or -1 for none."""
+        if texture is None:
+            return -1
+        key = id(texture)
+        if key not in self._index:
+            self._index[key] = self._add(texture)
+        return self._index[key]
+
+    def _add(self, texture: Texture) -> int:
+        record = np.zeros((RECORD_ROWS, 4), np.float32)
+        if isinstance(texture, ImageTexture):
+            path = Path(texture.file)
+            path = path if path.is_absolute() else self.base_dir / path
+            try:
+                rgb = read_texture_image(path, texture.color_space)
+            except OSError as exc:
+                message = str(exc) if path.exists() else f"{path}: texture file not found"
+                self.warnings.append(f"{message}; showing a magenta checkerboard instead")
+                log.warning("%s", self.warnings[-1])
+                return self._add(MISSING)
+            height, width = rgb.shape[:2]
+            halves = np.zeros((height, width, 4), np.float16)
+            halves[..., :3] = rgb
+            packed = halves.view(np.uint32).reshape(-1)  # two uints per texel: (r, g), (b, 0)
+            record[0] = (TEXTURE_IMAGE, np.int32(self._texel_count).view(np.float32), width, height)
+            record[1, :2] = texture.tiles
+            self._texels.append(packed)
+            self._texel_count += packed.size
+        elif isinstance(texture, Checkerboard):
+            record[0, 0] = TEXTURE_CHECKER
+            record[1, :2] = texture.tiles
+            record[2, :3], record[3, :3] = texture.color_a, texture.color_b
+        else:
+            raise TypeError(f"no GPU packing for texture type {type(texture).__name__}")
+        self._records.append(record)
+        return len(self._records) - 1
+
+    def records(self) -> np.ndarray:
+        return np.concatenate(self._records) if self._records else np.zeros((0, 4), np.float32)
+
+    def texels(self) -> np.ndarray:
+        return np.concatenate(self._texels) if self._texels else np.zeros(0, np.uint32)

@@ -1,0 +1,70 @@
+"""Run glsl/bsdf_probe.comp: sample or evaluate one material's BSDF on the GPU, for the material tests."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from lenslab.render.buffers import MATERIAL_ROWS, pack_material
+from lenslab.render.textures import TextureTable
+
+
+@dataclass
+class Samples:
+    wi: np.ndarray  # (N, 3)
+    pdf: np.ndarray
+    weight: np.ndarray  # (N, 3): f |cos| / pdf
+    ok: np.ndarray  # sampling succeeded
+    delta: np.ndarray
+
+
+class BsdfProbe:
+    def __init__(self, renderer, material, tmp_dir="."):
+        self.renderer = renderer
+        ctx = renderer.ctx
+        textures = TextureTable(base_dir=tmp_dir)
+        rows = pack_material(material, textures)
+        self.materials = ctx.buffer(np.concatenate([rows, textures.records()]).astype(np.float32).tobytes())
+        texels = textures.texels()
+        self.image_data = ctx.buffer(texels.tobytes() if texels.size else np.zeros(4, np.uint32).tobytes())
+        self.program = renderer.program("bsdf_probe.comp")
+        if "texture_base" in self.program:
+            self.program["texture_base"].value = MATERIAL_ROWS
+
+    def _run(self, items: np.ndarray) -> np.ndarray:
+        ctx, n = self.renderer.ctx, len(items)
+        inp = ctx.buffer(items.astype(np.float32).tobytes())
+        out = ctx.buffer(reserve=n * 32)
+        self.materials.bind_to_storage_buffer(4)
+        self.image_data.bind_to_storage_buffer(7)
+        inp.bind_to_storage_buffer(6)
+        out.bind_to_storage_buffer(8)
+        self.program["item_count"].value = n
+        self.program["probe_material"].value = 0
+        self.program.run((n + 63) // 64, 1, 1)
+        result = np.frombuffer(out.read(), np.float32).reshape(n, 2, 4).copy()
+        inp.release()
+        out.release()
+        return result
+
+    def sample(self, wo, u: np.ndarray, front_face=True) -> Samples:
+        n = len(u)
+        items = np.zeros((n, 2, 4), np.float32)
+        items[:, 0, :3], items[:, 0, 3] = wo, float(front_face)
+        items[:, 1, :3] = u
+        r = self._run(items)
+        return Samples(r[:, 0, :3], r[:, 0, 3], r[:, 1, :3], r[:, 1, 3] > 0, r[:, 1, 3] > 1.5)
+
+    def evaluate(self, wo, wi: np.ndarray, front_face=True) -> tuple[np.ndarray, np.ndarray]:
+        """(f |cos|, pdf) for each direction wi."""
+        n = len(wi)
+        items = np.zeros((n, 2, 4), np.float32)
+        items[:, 0, :3], items[:, 0, 3] = wo, float(front_face)
+        items[:, 1, :3], items[:, 1, 3] = wi, 1.0
+        r = self._run(items)
+        return r[:, 1, :3], r[:, 0, 3]
+
+    def release(self):
+        self.materials.release()
+        self.image_data.release()
