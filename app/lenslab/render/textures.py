@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lenslab.scene.textures import Checkerboard, ImageTexture, Texture
+from lenslab.scene.textures import Checkerboard, ImageTexture, InlineImageTexture, Texture
 
 log = logging.getLogger("lenslab.textures")
 
@@ -84,14 +84,9 @@ class TextureTable:
                 self.warnings.append(f"{message}; showing a magenta checkerboard instead")
                 log.warning("%s", self.warnings[-1])
                 return self._add(MISSING)
-            height, width = rgb.shape[:2]
-            halves = np.zeros((height, width, 4), np.float16)
-            halves[..., :3] = rgb
-            packed = halves.view(np.uint32).reshape(-1)  # two uints per texel: (r, g), (b, 0)
-            record[0] = (TEXTURE_IMAGE, np.int32(self._texel_count).view(np.float32), width, height)
-            record[1, :2] = texture.tiles
-            self._texels.append(packed)
-            self._texel_count += packed.size
+            self._add_texels(record, rgb, texture.tiles)
+        elif isinstance(texture, InlineImageTexture):
+            self._add_texels(record, np.asarray(texture.pixels, np.float32)[..., :3], texture.tiles)
         elif isinstance(texture, Checkerboard):
             record[0, 0] = TEXTURE_CHECKER
             record[1, :2] = texture.tiles
@@ -100,6 +95,16 @@ class TextureTable:
             raise TypeError(f"no GPU packing for texture type {type(texture).__name__}")
         self._records.append(record)
         return len(self._records) - 1
+
+    def _add_texels(self, record: np.ndarray, rgb: np.ndarray, tiles) -> None:
+        height, width = rgb.shape[:2]
+        halves = np.zeros((height, width, 4), np.float16)
+        halves[..., :3] = rgb
+        packed = halves.view(np.uint32).reshape(-1)  # two uints per texel: (r, g), (b, 0)
+        record[0] = (TEXTURE_IMAGE, np.int32(self._texel_count).view(np.float32), width, height)
+        record[1, :2] = tiles
+        self._texels.append(packed)
+        self._texel_count += packed.size
 
     def records(self) -> np.ndarray:
         return np.concatenate(self._records) if self._records else np.zeros((0, 4), np.float32)

@@ -14,7 +14,7 @@ import numpy as np
 from lenslab.scene.materials import Material
 from lenslab.scene.scene import DEFAULT_MATERIAL, Node, Scene, SceneError
 from lenslab.scene.shapes import Box, MeshFile, Rectangle, Sphere, TriangleMesh
-from lenslab.scene.io.meshes import MeshLoadError
+from lenslab.scene.io.meshes import LoadedMesh, MeshLoadError, MeshPart
 from lenslab.scene.transform import transform_normals, transform_points
 
 
@@ -30,6 +30,7 @@ class FlatScene:
     material_names: list[str]
     prim_node: np.ndarray  # (T + S,) int32 index into nodes
     nodes: list[Node]  # every node, depth first
+    warnings: tuple[str, ...] = ()  # what could not be mapped from mesh files, once per material
 
     @property
     def triangle_count(self) -> int:
@@ -63,10 +64,10 @@ def _flat_normals(corners: np.ndarray) -> np.ndarray:
     return np.repeat(n[:, None, :], 3, axis=1)
 
 
-def _mesh_for(scene: Scene, node: Node, loader) -> TriangleMesh:
+def _mesh_parts(scene: Scene, node: Node, loader) -> LoadedMesh:
     shape = node.shape
     if isinstance(shape, (Rectangle, Box)):
-        return shape.mesh()
+        return LoadedMesh((MeshPart(shape.mesh()),))
     assert isinstance(shape, MeshFile)
     path = Path(shape.file)
     if not path.is_absolute():
@@ -80,14 +81,24 @@ def _mesh_for(scene: Scene, node: Node, loader) -> TriangleMesh:
 
 def flatten_scene(scene: Scene, mesh_loader=None) -> FlatScene:
     if mesh_loader is None:
-        from lenslab.scene.io.meshes import load_mesh as mesh_loader
+        from lenslab.scene.io.meshes import load_mesh_parts as mesh_loader
 
     material_names = list(scene.materials)
     materials = [scene.materials[n] for n in material_names]
     default_index = None
 
-    def material_index(node: Node) -> int:
+    file_materials: dict[int, int] = {}  # id(material from a mesh file) -> index
+    warnings: list[str] = []
+
+    def material_index(node: Node, part: MeshPart | None = None) -> int:
         nonlocal default_index
+        if not node.material and part is not None and part.material is not None:
+            # The mesh file's own material, unless the node names one of the scene's.
+            if id(part.material) not in file_materials:
+                material_names.append(f"{node.name}: {part.name}" if part.name else node.name)
+                materials.append(part.material)
+                file_materials[id(part.material)] = len(materials) - 1
+            return file_materials[id(part.material)]
         if node.material:
             if node.material not in scene.materials:
                 raise SceneError(f"node '{node.name}': unknown material '{node.material}'")
@@ -99,23 +110,8 @@ def flatten_scene(scene: Scene, mesh_loader=None) -> FlatScene:
         return default_index
 
     tris, tri_normals, tri_uvs, tri_mat, tri_node = [], [], [], [], []
-    spheres, sph_mat, sph_node = [], [], []
-    nodes: list[Node] = []
-    for node, matrix in scene.walk():
-        node_index = len(nodes)
-        nodes.append(node)
-        if node.shape is None:
-            continue
-        mat = material_index(node)
-        if isinstance(node.shape, Sphere):
-            scale = np.linalg.norm(matrix[:3, :3], axis=0)
-            if np.ptp(scale) > 1e-6 * scale.max():
-                raise SceneError(f"node '{node.name}': a sphere cannot take a non-uniform scale {tuple(scale.round(6))}")
-            spheres.append([*matrix[:3, 3], node.shape.radius * scale[0]])
-            sph_mat.append(mat)
-            sph_node.append(node_index)
-            continue
-        mesh = _mesh_for(scene, node, mesh_loader)
+
+    def add_mesh(mesh: TriangleMesh, matrix: np.ndarray, mat: int, node_index: int) -> None:
         corners = transform_points(matrix, mesh.vertices)[mesh.faces]
         if np.linalg.det(matrix[:3, :3]) < 0:  # a mirroring transform flips winding: keep the front face in front
             corners = corners[:, ::-1]
@@ -133,6 +129,27 @@ def flatten_scene(scene: Scene, mesh_loader=None) -> FlatScene:
         tri_mat.append(np.full(len(faces), mat))
         tri_node.append(np.full(len(faces), node_index))
 
+    spheres, sph_mat, sph_node = [], [], []
+    nodes: list[Node] = []
+    for node, matrix in scene.walk():
+        node_index = len(nodes)
+        nodes.append(node)
+        if node.shape is None:
+            continue
+        if isinstance(node.shape, Sphere):
+            mat = material_index(node)
+            scale = np.linalg.norm(matrix[:3, :3], axis=0)
+            if np.ptp(scale) > 1e-6 * scale.max():
+                raise SceneError(f"node '{node.name}': a sphere cannot take a non-uniform scale {tuple(scale.round(6))}")
+            spheres.append([*matrix[:3, 3], node.shape.radius * scale[0]])
+            sph_mat.append(mat)
+            sph_node.append(node_index)
+            continue
+        loaded = _mesh_parts(scene, node, mesh_loader)
+        warnings.extend(w for w in loaded.warnings if w not in warnings)
+        for part in loaded.parts:
+            add_mesh(part.mesh, matrix, material_index(node, part), node_index)
+
     def cat(parts, shape, dtype):
         return np.concatenate(parts).astype(dtype) if parts else np.zeros(shape, dtype)
 
@@ -147,4 +164,5 @@ def flatten_scene(scene: Scene, mesh_loader=None) -> FlatScene:
         material_names=material_names,
         prim_node=np.concatenate([cat(tri_node, (0,), np.int32), np.asarray(sph_node, np.int32)]),
         nodes=nodes,
+        warnings=tuple(warnings),
     )

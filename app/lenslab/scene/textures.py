@@ -35,4 +35,17 @@ class Checkerboard(Texture):
     tiles: tuple[float, float] = field(default=(8.0, 8.0), metadata={"range": (1e-6, 1e6), "doc": "squares per unit uv"})
 
 
+@dataclass(eq=False)
+class InlineImageTexture(Texture):
+    """Pixels that came inside another file (a GLB's embedded images): linear float RGB, (H, W, 3).
+
+    Not written to scene files: it is re-read from the mesh file that holds it whenever the scene loads.
+    """
+
+    type_name: ClassVar[str] = "inline_image"
+    pixels: object = None  # numpy array; `object` keeps the scene format's reader away from it
+    name: str = ""
+    tiles: tuple[float, float] = (1.0, 1.0)
+
+
 TEXTURE_TYPES: dict[str, type[Texture]] = {cls.type_name: cls for cls in (ImageTexture, Checkerboard)}

@@ -11,6 +11,9 @@ from pathlib import Path
 
 import numpy as np
 
+from dataclasses import dataclass, field
+
+from lenslab.scene.materials import Material
 from lenslab.scene.shapes import TriangleMesh
 
 MESH_SUFFIXES = (".obj", ".ply", ".gltf", ".glb", ".stl", ".off")
@@ -18,6 +21,26 @@ MESH_SUFFIXES = (".obj", ".ply", ".gltf", ".glb", ".stl", ".off")
 
 class MeshLoadError(ValueError):
     pass
+
+
+@dataclass(frozen=True)
+class MeshPart:
+    """One piece of a mesh file with one material: the file's own material mapped onto ours, or None."""
+
+    mesh: TriangleMesh
+    material: Material | None = None
+    name: str = ""
+
+
+@dataclass(frozen=True)
+class LoadedMesh:
+    parts: tuple[MeshPart, ...]
+    warnings: tuple[str, ...] = field(default=())  # what of the file's materials could not be mapped
+
+
+def load_mesh_parts(path: Path, smooth: bool = True) -> LoadedMesh:
+    """The mesh file as parts, one per material it defines (one part when it defines none)."""
+    return LoadedMesh((MeshPart(load_mesh(path, smooth)),))
 
 
 def load_mesh(path: Path, smooth: bool = True) -> TriangleMesh:
