@@ -16,7 +16,7 @@ import pytest
 
 from lenslab.scene.io import mitsuba_values as mv
 from lenslab.scene.io.mitsuba_xml import BSDF_MAPPINGS, load_mitsuba_scene, load_mitsuba_string
-from lenslab.scene.materials import Diffuse, Emissive
+from lenslab.scene.materials import Conductor, Dielectric, Diffuse, Emissive, Plastic, ThinDielectric
 from lenslab.scene.scene import ConstantEnvironment, SceneError
 from lenslab.scene.shapes import Box, MeshFile, Rectangle, Sphere
 from lenslab.scene.transform import Transform
@@ -340,8 +340,8 @@ def test_refs_resolve_forwards_and_share_one_material(tmp_path):
     scene, warnings = load(tmp_path, body)
     a, b = scene.nodes
     assert a.material == b.material == "gold"
-    assert scene.materials["gold"] == Diffuse(mv.CONDUCTOR_F0["Au"])
-    assert len(warnings) == 1 and ':3: <bsdf type="conductor" id="gold">' in warnings[0]
+    assert scene.materials == {"gold": Conductor(metal="gold")}
+    assert warnings == []
 
 
 def test_unknown_ref_and_duplicate_id_are_errors(tmp_path):
@@ -416,26 +416,51 @@ def test_flip_normals_turns_a_rectangle_light_around(tmp_path):
 
 
 def test_each_bsdf_maps_to_a_material_with_one_warning_per_approximation(tmp_path):
-    bsdfs = {
-        "diffuse": ('<rgb name="reflectance" value="0.2, 0.4, 0.6"/>', (0.2, 0.4, 0.6), False),
-        "conductor": ('<rgb name="eta" value="0.2"/><rgb name="k" value="3"/>', mv.conductor_f0((0.2,) * 3, (3,) * 3), True),
-        "roughconductor": ('<float name="alpha" value="0.2"/>', (1.0, 1.0, 1.0), True),
-        "plastic": ('<rgb name="diffuse_reflectance" value="0.1, 0.2, 0.3"/>', (0.1, 0.2, 0.3), True),
-        "roughplastic": ("", (0.5, 0.5, 0.5), True),
-        "dielectric": ('<float name="int_ior" value="1.5"/>', (0.8, 0.8, 0.8), True),
-        "roughdielectric": ("", (0.8, 0.8, 0.8), True),
-        "thindielectric": ("", (0.8, 0.8, 0.8), True),
-        "principled": ('<rgb name="base_color" value="0.3"/><float name="metallic" value="1"/>', (0.3,) * 3, True),
+    mirror = Conductor(metal="custom", eta=(0.0, 0.0, 0.0), k=(1.0, 1.0, 1.0))
+    bsdfs = {  # plugin: (its properties, the material expected, a word of the warning or None)
+        "diffuse": ('<rgb name="reflectance" value="0.2, 0.4, 0.6"/>', Diffuse((0.2, 0.4, 0.6)), None),
+        "conductor": ("", mirror, None),
+        "roughconductor": ('<string name="material" value="Cu"/><string name="distribution" value="ggx"/>'
+                           '<float name="alpha" value="0.09"/><rgb name="specular_reflectance" value="0.5"/>',
+                           Conductor(metal="copper", tint=(0.5, 0.5, 0.5), roughness=0.3), None),
+        "plastic": ('<rgb name="diffuse_reflectance" value="0.1, 0.2, 0.3"/><string name="int_ior" value="bk7"/>',
+                    Plastic((0.1, 0.2, 0.3), ior=1.5046 / 1.000277), None),
+        "roughplastic": ("", Plastic((0.5, 0.5, 0.5), ior=1.49 / 1.000277, roughness=math.sqrt(0.1)), "beckmann"),
+        "dielectric": ('<float name="int_ior" value="1.33"/><float name="ext_ior" value="1"/>'
+                       '<rgb name="specular_transmittance" value="0.9, 1, 1"/>', Dielectric(1.33, tint=(0.9, 1.0, 1.0)), None),
+        "roughdielectric": ('<float name="alpha_u" value="0.04"/><float name="alpha_v" value="0.16"/>'
+                            '<string name="distribution" value="ggx"/>',
+                            Dielectric(1.5046 / 1.000277, roughness=math.sqrt(0.08)), "anisotropic"),
+        "thindielectric": ("", ThinDielectric(1.5046 / 1.000277), None),
+        "principled": ('<rgb name="base_color" value="0.3"/><float name="metallic" value="1"/>',
+                       Diffuse((0.3, 0.3, 0.3)), "not renderable yet"),
     }
-    for kind, (inner, albedo, warned) in bsdfs.items():
+    for kind, (inner, expected, warned) in bsdfs.items():
         scene, warnings = load(tmp_path, camera_xml() + f'<shape type="sphere" id="s">\n<bsdf type="{kind}">{inner}'
                                "</bsdf></shape>")
-        assert scene.materials[scene.nodes[0].material] == Diffuse(tuple(albedo)), kind
+        got = scene.materials[scene.nodes[0].material]
+        assert type(got) is type(expected), kind
+        for name, value in vars(expected).items():
+            if value is None or isinstance(value, str):
+                assert getattr(got, name) == value, (kind, name)
+            else:
+                assert np.allclose(getattr(got, name), value, rtol=1e-9), (kind, name)
         if warned:
-            assert f':4: <bsdf type="{kind}">' in only(warnings, "not renderable yet"), kind
+            assert f':4: <bsdf type="{kind}">' in only(warnings, warned), kind
         else:
             assert warnings == [], kind
     assert set(bsdfs) | {"twosided"} <= set(BSDF_MAPPINGS)
+
+
+def test_conductors_without_a_preset_reflect_their_normal_incidence_colour(tmp_path):
+    scene, warnings = load(tmp_path, camera_xml() + '<shape type="sphere"><bsdf type="conductor">'
+                           '<string name="material" value="Cr"/></bsdf></shape>')
+    metal = scene.materials[scene.nodes[0].material]
+    assert np.allclose(mv.conductor_f0(*metal.complex_ior()), mv.CONDUCTOR_F0["Cr"])
+    assert "normal incidence" in only(warnings, '"Cr"')
+    with pytest.raises(SceneError, match='line 3: <string name="int_ior">: unknown index of refraction "glas"'):
+        load(tmp_path, camera_xml() + '<shape type="sphere"><bsdf type="plastic"><string name="int_ior" '
+             'value="glas"/></bsdf></shape>')
 
 
 def test_twosided_unwraps_and_unknown_bsdfs_warn(tmp_path):
@@ -578,11 +603,11 @@ def test_malformed_xml_is_one_error_with_file_line_and_column(tmp_path):
 
 def test_warnings_go_to_the_lenslab_import_logger_by_default(tmp_path, caplog):
     path = tmp_path / "s.xml"
-    path.write_text('<scene version="3.0.0"><shape type="sphere"><bsdf type="plastic"/></shape></scene>')
+    path.write_text('<scene version="3.0.0"><shape type="sphere"><bsdf type="principled"/></shape></scene>')
     with caplog.at_level(logging.WARNING, logger="lenslab.import"):
         load_mitsuba_scene(path)
     messages = [r.getMessage() for r in caplog.records if r.name == "lenslab.import"]
-    assert any('s.xml:1: <bsdf type="plastic">' in m for m in messages)
+    assert any('s.xml:1: <bsdf type="principled">' in m for m in messages)
     assert any("no sensor" in m for m in messages)
 
 
@@ -602,7 +627,7 @@ def test_imported_cornell_box_renders(renderer):
 
     warnings: list[str] = []
     scene = load_mitsuba_scene(DATA / "cbox.xml", defines={"spp": "1"}, warn=warnings.append)
-    assert scene.render.spp == 1 and len(warnings) == 1  # the gold ball is approximated
+    assert scene.render.spp == 1 and warnings == []
     session = RenderSession(renderer, scene, width=32, height=32)
     session.step(5, target_spp=1)
     image = session.image()

@@ -7,18 +7,19 @@ when it is an approximation (the importer reports the note once per BSDF element
 Every property a mapping does not read is reported as unsupported, so read (``p.take``) what you
 deliberately ignore.
 
-Today only ``Diffuse`` and ``Emissive`` render, so conductors, plastics and glass are approximated by diffuse
-surfaces; when their material classes land, replacing an entry of the table is the whole change.
 Mitsuba's defaults (``src/bsdfs/*.cpp``): diffuse reflectance 0.5; conductor material "none" (a perfect
-mirror); plastic diffuse_reflectance 0.5, int_ior 1.49; dielectric int_ior 1.5046 (bk7), ext_ior 1.000277.
+mirror); plastic diffuse_reflectance 0.5, int_ior 1.49; dielectric int_ior 1.5046 (bk7), ext_ior 1.000277;
+rough variants alpha 0.1 with the Beckmann distribution. Our microfacets are GGX with alpha = roughness^2,
+so ``roughness = sqrt(alpha)``; a Beckmann alpha is carried over as a GGX one, with a note.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Callable
 
-from lenslab.scene.materials import Diffuse, Material
+from lenslab.scene.materials import Conductor, Dielectric, Diffuse, Material, Plastic, ThinDielectric
 
 from . import mitsuba_values as mv
 
@@ -47,46 +48,152 @@ def _grey_note(kind: str, what: str) -> str:
     return f"{kind} is not renderable yet: approximated by a diffuse surface with {what}"
 
 
-def _map_diffuse(p: Props, imp: "_Importer") -> Mapped:
+def _map_diffuse(p: "Props", imp: "_Importer") -> Mapped:
     return Mapped(Diffuse(_clip_albedo(p.color("reflectance", 0.5))))
 
 
-def _map_roughdiffuse(p: Props, imp: "_Importer") -> Mapped:
+def _map_roughdiffuse(p: "Props", imp: "_Importer") -> Mapped:
     p.float("alpha")
     return Mapped(Diffuse(_clip_albedo(p.color("reflectance", 0.5))), "rough diffuse (Oren-Nayar) is rendered as Lambertian")
 
 
-def _map_conductor(p: Props, imp: "_Importer") -> Mapped:
-    for key in ("alpha", "alpha_u", "alpha_v", "distribution", "sample_visible"):
-        p.take(key)
+# Mitsuba's named indices of refraction (include/mitsuba/render/ior.h).
+NAMED_IOR: dict[str, float] = {
+    "vacuum": 1.0, "helium": 1.000036, "hydrogen": 1.000132, "air": 1.000277, "carbon dioxide": 1.00045,
+    "water": 1.3330, "acetone": 1.36, "ethanol": 1.361, "carbon tetrachloride": 1.461, "glycerol": 1.4729,
+    "benzene": 1.501, "silicone oil": 1.52045, "bromine": 1.661, "water ice": 1.31, "fused quartz": 1.458,
+    "pyrex": 1.470, "acrylic glass": 1.49, "polypropylene": 1.49, "bk7": 1.5046, "sodium chloride": 1.544,
+    "amber": 1.55, "pet": 1.5750, "diamond": 2.419,
+}
+
+# Mitsuba's conductor names that are one of our metal presets (same measured data, reduced to RGB).
+MITSUBA_METALS = {"Au": "gold", "Ag": "silver", "Cu": "copper", "Al": "aluminium"}
+
+
+def _ior(p: "Props", name: str, default: float) -> float:
+    node = p.take(name)
+    if node is None:
+        return default
+    if node.tag == "string":
+        key = node.attrs.get("value", "").strip().lower()
+        if key not in NAMED_IOR:
+            raise node.error(f'unknown index of refraction "{key}" (expected a number or one of {", ".join(NAMED_IOR)})')
+        return NAMED_IOR[key]
+    if node.tag not in ("float", "integer"):
+        raise node.error("expected a <float> or a named <string> index of refraction")
+    try:
+        return float(node.attrs.get("value", ""))
+    except ValueError:
+        raise node.error(f"could not parse floating point value \"{node.attrs.get('value')}\"") from None
+
+
+def _roughness(p: "Props", notes: list[str]) -> float:
+    """Our perceptual roughness r from Mitsuba's microfacet alpha (ours is GGX with alpha = r^2)."""
+    distribution = p.string("distribution", "beckmann")
+    p.take("sample_visible")
+    if p.has("alpha_u") or p.has("alpha_v"):
+        au, av = _alpha(p, "alpha_u", notes), _alpha(p, "alpha_v", notes)
+        alpha = math.sqrt(au * av)
+        if abs(au - av) > 1e-6:
+            notes.append(f"anisotropic roughness ({au:g}, {av:g}) is rendered isotropic (alpha {alpha:.3g})")
+    else:
+        alpha = _alpha(p, "alpha", notes)
+    if distribution != "ggx":
+        notes.append(f'the "{distribution}" microfacet distribution is rendered as GGX with the same alpha')
+    if alpha > 1:
+        notes.append(f"alpha {alpha:g} is rougher than LensLab allows: 1 used")
+        alpha = 1.0
+    return math.sqrt(max(alpha, 0.0))
+
+
+def _alpha(p: "Props", name: str, notes: list[str]) -> float:
+    node = p.values.get(name)
+    if node is not None and node.tag not in ("float", "integer"):
+        p.take(name)
+        notes.append(f"a textured {name} is not supported: 0.1 used")
+        return 0.1
+    return p.float(name, 0.1)
+
+
+def _unit(rgb) -> RGB:
+    return tuple(float(min(max(c, 0.0), 1.0)) for c in rgb)  # type: ignore[return-value]
+
+
+def _note(notes: list[str]) -> str | None:
+    return "; ".join(notes) or None
+
+
+def _map_conductor(p: "Props", imp: "_Importer") -> Mapped:
+    notes: list[str] = []
+    rough = p.node.type == "roughconductor"
+    roughness = _roughness(p, notes) if rough else 0.0
+    tint = _unit(p.color("specular_reflectance", 1.0))
     if p.has("eta") or p.has("k"):
+        if p.has("material"):
+            p.take("material")
+            notes.append("both material and eta/k given: eta/k used")
         eta, k = p.color("eta", 0.0), p.color("k", 1.0)
-        f0, what = mv.conductor_f0(eta, k), "its normal-incidence reflectance (from eta, k)"
+        material = Conductor(metal="custom", eta=_clip(eta, 0, 100), k=_clip(k, 0, 100), tint=tint, roughness=roughness)
     else:
         name = p.string("material", "none")
-        f0, what = mv.CONDUCTOR_F0.get(name, (0.9, 0.9, 0.9)), f'the normal-incidence reflectance of "{name}"'
-    tint = p.color("specular_reflectance", 1.0)
-    albedo = _clip_albedo(a * b for a, b in zip(f0, tint))
-    return Mapped(Diffuse(albedo), _grey_note(p.node.type, what))
+        if name in MITSUBA_METALS:
+            material = Conductor(metal=MITSUBA_METALS[name], tint=tint, roughness=roughness)
+        elif name == "none":  # Mitsuba's default: a perfect mirror, which eta 0, k 1 gives at every angle
+            material = Conductor(metal="custom", eta=(0.0, 0.0, 0.0), k=(1.0, 1.0, 1.0), tint=tint, roughness=roughness)
+        else:
+            f0 = mv.CONDUCTOR_F0.get(name)
+            if f0 is None:
+                raise p.node.error(f'unknown conductor material "{name}"')
+            # eta 1 and k = 2 sqrt(F0 / (1 - F0)) reflect F0 at normal incidence
+            k = tuple(min(2 * math.sqrt(f / (1 - f)), 100.0) for f in f0)
+            material = Conductor(metal="custom", eta=(1.0, 1.0, 1.0), k=k, tint=tint, roughness=roughness)
+            notes.append(f'"{name}" is not a LensLab metal preset: matched at normal incidence only')
+    return Mapped(material, _note(notes))
 
 
-def _map_plastic(p: Props, imp: "_Importer") -> Mapped:
-    for key in ("int_ior", "ext_ior", "alpha", "distribution", "nonlinear", "sample_visible", "specular_reflectance"):
-        p.take(key)
-    albedo = _clip_albedo(p.color("diffuse_reflectance", 0.5))
-    return Mapped(Diffuse(albedo), _grey_note(p.node.type, "its diffuse reflectance (no specular coat)"))
+def _clip(rgb, lo: float, hi: float) -> RGB:
+    return tuple(float(min(max(c, lo), hi)) for c in rgb)  # type: ignore[return-value]
 
 
-def _map_dielectric(p: Props, imp: "_Importer") -> Mapped:
-    for key in ("int_ior", "ext_ior", "alpha", "alpha_u", "alpha_v", "distribution", "sample_visible",
-                "specular_reflectance"):
-        p.take(key)
-    tint = p.color("specular_transmittance", 1.0)
-    albedo = _clip_albedo(0.8 * c for c in tint)
-    return Mapped(Diffuse(albedo), _grey_note(p.node.type, "80% of its transmittance (no refraction)"))
+def _relative_ior(p: "Props", notes: list[str], lo: float) -> float:
+    ior = _ior(p, "int_ior", 1.5046) / _ior(p, "ext_ior", 1.000277)
+    if not lo <= ior <= 4.0:
+        clamped = min(max(ior, lo), 4.0)
+        notes.append(f"relative index of refraction {ior:.4g} is outside LensLab's {lo:g}-4: {clamped:g} used")
+        ior = clamped
+    return ior
 
 
-def _map_principled(p: Props, imp: "_Importer") -> Mapped:
+def _map_plastic(p: "Props", imp: "_Importer") -> Mapped:
+    notes: list[str] = []
+    roughness = _roughness(p, notes) if p.node.type == "roughplastic" else 0.0
+    albedo = _unit(p.color("diffuse_reflectance", 0.5))
+    ior = _ior(p, "int_ior", 1.49) / _ior(p, "ext_ior", 1.000277)
+    if not 1.0 <= ior <= 4.0:
+        notes.append(f"relative index of refraction {ior:.4g} is outside LensLab's 1-4: clamped")
+        ior = min(max(ior, 1.0), 4.0)
+    if p.color("specular_reflectance", 1.0) != (1.0, 1.0, 1.0):
+        notes.append("specular_reflectance is not supported: the coat reflects as clear plastic")
+    if p.bool("nonlinear", False):
+        notes.append("nonlinear colour shift is not supported")
+    return Mapped(Plastic(albedo=albedo, ior=ior, roughness=roughness), _note(notes))
+
+
+def _map_dielectric(p: "Props", imp: "_Importer") -> Mapped:
+    notes: list[str] = []
+    kind = p.node.type
+    roughness = _roughness(p, notes) if kind == "roughdielectric" else 0.0
+    transmit = _unit(p.color("specular_transmittance", 1.0))
+    reflect = _unit(p.color("specular_reflectance", 1.0))
+    if reflect != (1.0, 1.0, 1.0) and reflect != transmit:
+        notes.append("a specular_reflectance unlike the transmittance is not supported: the transmittance tints both")
+    if kind == "thindielectric":
+        return Mapped(ThinDielectric(ior=_relative_ior(p, notes, 1.0001), tint=transmit), _note(notes))
+    ior = _relative_ior(p, notes, 1.0001)
+    return Mapped(Dielectric(ior=ior, roughness=roughness, tint=transmit), _note(notes))
+
+
+def _map_principled(p: "Props", imp: "_Importer") -> Mapped:
     for key in list(p.values):
         if key != "base_color":
             p.take(key)
@@ -94,7 +201,7 @@ def _map_principled(p: Props, imp: "_Importer") -> Mapped:
     return Mapped(Diffuse(albedo), _grey_note(p.node.type, "its base colour"))
 
 
-def _map_wrapper(p: Props, imp: "_Importer") -> Mapped:
+def _map_wrapper(p: "Props", imp: "_Importer") -> Mapped:
     """twosided, mask, bumpmap, normalmap, blendbsdf: the (first) nested BSDF, unwrapped."""
     kind = p.node.type
     for key in list(p.values):

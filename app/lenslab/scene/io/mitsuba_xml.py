@@ -6,8 +6,8 @@ Two passes, as in Mitsuba's own parser (``src/core/parser.cpp``):
    ``<default>`` and ``$param`` substitution (``defines`` win over ``<default>``, as ``mitsuba -D`` does),
    splice ``<include>`` files in (relative to the including file), and register every ``id``.
 2. **Convert** the expanded tree: integrator, sensor/film/sampler, shapes with their BSDFs and area lights,
-   the constant emitter. Each plugin is a small function; BSDFs go through :data:`BSDF_MAPPINGS`, one entry
-   per Mitsuba plugin name, so that a real mapping replaces an approximation by replacing one entry.
+   the constant emitter. Each plugin is a small function; BSDFs go through ``mitsuba_bsdfs.BSDF_MAPPINGS``,
+   one entry per Mitsuba plugin name.
 
 Whatever LensLab cannot render yet gives one warning naming the element and its line, and the rest of the
 scene still loads. A file that is not well-formed XML, or that Mitsuba itself would reject (an undefined
