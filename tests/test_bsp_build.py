@@ -439,3 +439,18 @@ def test_statistics_are_consistent():
     assert tree.build_seconds > 0
     # The SAH cost of a tree beats that of a single leaf holding everything.
     assert 1.0 < tree.sah_cost < tree.params["intersection_cost"] * 1000 / 4
+
+
+def test_threads_build_the_same_tree(monkeypatch):
+    """Levels cut into parts for worker threads give exactly the single-threaded tree."""
+    import lenslab.render.bsp as bsp
+
+    rng = np.random.default_rng(8)
+    tris, spheres = mixed_scene(rng)
+    bounds = np.concatenate([triangle_bounds(tris), sphere_bounds(spheres)])
+    single = build_kdtree(bounds, triangles=tris, threads=1)
+    monkeypatch.setattr(bsp, "MIN_REFS_PER_THREAD", 50)
+    threaded = build_kdtree(bounds, triangles=tris, threads=3)
+    assert np.array_equal(single.nodes, threaded.nodes)
+    assert np.array_equal(single.prim_refs, threaded.prim_refs)
+    check_leaf_contents(threaded, bounds, tris)
