@@ -17,7 +17,7 @@ layout(std430, binding = 2) readonly buffer Geometry { vec4 geometry[]; };
 layout(std430, binding = 3) readonly buffer Shading { vec4 shading[]; };
 // Eight vec4 per material (see bsdf.glsl), then four per texture from row texture_base (textures.glsl).
 layout(std430, binding = 4) readonly buffer Materials { vec4 materials[]; };
-// One vec4 per emissive primitive: (primitive index as float bits, cumulative pmf, pmf, -).
+// Three vec4 per light, chosen by power (see lights.glsl).
 layout(std430, binding = 5) readonly buffer Lights { vec4 lights[]; };
 
 uniform int triangle_count;
@@ -25,7 +25,7 @@ uniform int prim_count;
 uniform vec3 scene_min;
 uniform vec3 scene_max;
 
-uniform int light_count;      // emissive primitives
+uniform int light_count;      // entries in the light table
 uniform float env_select_pmf; // probability that next-event estimation picks the environment
 uniform vec3 env_radiance;    // constant environment
 

@@ -16,9 +16,14 @@ vec3 path_radiance(Ray ray, inout Sampler sampler) {
     for (int segments = 1; ; segments++) {
         Hit hit;
         if (!trace_bsp(ray, 0.0, INFINITY, false, hit)) {
+            // The ray leaves the scene: the sky, and the sun's disk if it looks straight at it.
             vec3 le = environment_radiance(ray.d);
             float w = prev_delta ? 1.0 : power_heuristic(prev_bsdf_pdf, environment_pdf(ray.d));
             radiance += throughput * le * w;
+            vec3 sun = sun_seen(ray.d);
+            if (max_component(sun) > 0.0) {
+                radiance += throughput * sun * (prev_delta ? 1.0 : power_heuristic(prev_bsdf_pdf, sun_pdf()));
+            }
             break;
         }
         SurfaceHit s = surface_at(ray, hit);
@@ -50,7 +55,7 @@ vec3 path_radiance(Ray ray, inout Sampler sampler) {
                 Ray shadow = spawn_ray(s, ls.wi);
                 float t_max = isinf(ls.dist) ? INFINITY : ls.dist * (1.0 - 1e-4);
                 if (!occluded(shadow, t_max)) {
-                    float w = power_heuristic(ls.pdf, bsdf_pdf);
+                    float w = ls.delta ? 1.0 : power_heuristic(ls.pdf, bsdf_pdf);
                     radiance += throughput * f * ls.radiance * (w / ls.pdf);
                 }
             }

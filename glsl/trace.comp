@@ -27,6 +27,7 @@ uniform int tile_pixels;
 uniform uint sample_start;
 uniform int sample_count;
 uniform uint seed;
+uniform float clamp_max;  // 0: off. Otherwise the most radiance one sample may add (a biased firefly filter)
 
 void main() {
     int local = int(gl_GlobalInvocationID.x);
@@ -42,6 +43,7 @@ void main() {
         vec3 l = path_radiance(ray, sampler);
         // A NaN or infinity (a degenerate triangle, say) would poison the pixel forever: count it as black.
         if (any(isnan(l)) || any(isinf(l))) l = vec3(0.0);
+        if (clamp_max > 0.0 && max_component(l) > clamp_max) l *= clamp_max / max_component(l);
         sum += vec4(l, 1.0);
     }
     accumulation[pixel_index] = sum;

@@ -78,7 +78,7 @@ def _write_broken(tmp_path, edit):
         (lambda d: d["render"].update(sampler="halton"), r"render\.sampler: 'halton' is not one of sobol, independent"),
         (lambda d: d.update(lenslab_scene=7), r"lenslab_scene: version 7 is not supported"),
         (lambda d: d.pop("lenslab_scene"), r"lenslab_scene: missing: this is not a LensLab scene"),
-        (lambda d: d.update(lights=[]), r"broken\.json: lights: unknown key"),
+        (lambda d: d.update(cameras=[]), r"broken\.json: cameras: unknown key"),
     ],
 )
 def test_invalid_scene_is_one_line_naming_file_and_key(tmp_path, edit, message):

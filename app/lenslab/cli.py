@@ -185,6 +185,8 @@ def render_headless(args) -> int:
     target_spp = args.spp if args.spp is not None else (None if args.time_limit else scene.render.spp)
     renderer = Renderer(args.device)
     session = RenderSession(renderer, scene, dispatch_seconds=HEADLESS_DISPATCH_SECONDS)
+    for warning in session.warnings:
+        print(f"lenslab: warning: {warning}", file=sys.stderr)
     start = time.perf_counter()
     deadline = start + args.time_limit if args.time_limit else None
     with _progress_display(target_spp, args.time_limit) as bar:

@@ -72,6 +72,7 @@ TRAVERSAL_COST = 1.0
 INTERSECTION_COST = 1.5
 EMPTY_BONUS = 0.5  # pbrt-v3's value: a cut with one empty side costs half as much
 
+BONUS_FN = lambda b, d, L: b
 MIN_REFS_PER_THREAD = 100_000  # smaller levels are not worth handing to threads
 
 
@@ -193,7 +194,8 @@ def _build_levels(refs, root, triangles, costs, leaf_prims, min_bins, max_bins, 
         def best_splits(part):
             k0, k1, r0, r1 = part
             sub = refs.slice(r0, r1, node_offset=k0)
-            return _best_splits(sub, level.lo[:, k0:k1], level.hi[:, k0:k1], costs, min_bins, max_bins)
+            c = _Costs(costs.traversal, costs.intersection, BONUS_FN(costs.empty_bonus, depth, depth_limit))
+            return _best_splits(sub, level.lo[:, k0:k1], level.hi[:, k0:k1], c, min_bins, max_bins)
 
         cost, level.axis, level.split = (np.concatenate(c) for c in zip(*_map(pool, best_splits, parts)))
         level.is_leaf |= ~(cost < costs.intersection * level.counts)

@@ -10,15 +10,19 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Sequence
 
 import numpy as np
 
 from lenslab.render.bsp import KdTree, build_kdtree
 from lenslab.render.fresnel import internal_diffuse_reflectance
-from lenslab.render.textures import TextureTable
+from lenslab.render.environment import EnvironmentDistribution, environment_power
+from lenslab.render.textures import TextureTable, read_texture_image
 from lenslab.scene.flatten import FlatScene
 from lenslab.scene.materials import Conductor, Diffuse, Dielectric, Emissive, Material, Plastic, ThinDielectric
-from lenslab.scene.scene import ConstantEnvironment, Environment
+from lenslab.scene.lights import Light, PointLight, SunLight
+from lenslab.scene.scene import ConstantEnvironment, Environment, EnvironmentMap
+from lenslab.scene.textures import InlineImageTexture
 
 # glsl/bsdf.glsl's material type codes and record size.
 MATERIAL_CODES = {Diffuse: 0, Emissive: 1, Conductor: 2, Plastic: 3, Dielectric: 4, ThinDielectric: 5}
@@ -27,6 +31,7 @@ MATERIAL_ROWS = 8
 # Binding points, as declared in glsl/common.glsl, glsl/textures.glsl and glsl/trace.comp.
 BINDINGS = {"kd_nodes": 0, "prim_refs": 1, "geometry": 2, "shading": 3, "materials": 4, "lights": 5, "image_data": 7}
 ACCUMULATION_BINDING = 6
+MISSING_SKY = (0.2, 0.0, 0.2)  # what a scene whose environment map cannot be read is lit by
 
 
 class SceneTooLarge(RuntimeError):
@@ -100,11 +105,47 @@ def _emitted_power(flat: FlatScene) -> np.ndarray:
     return power
 
 
-def _environment_power(environment: Environment, scene_radius: float) -> float:
-    # pbrt-v4's UniformInfiniteLight::Phi: 4 pi^2 r^2 L for a scene of bounding radius r.
+LIGHT_AREA, LIGHT_POINT, LIGHT_SUN, LIGHT_ENVIRONMENT = 0, 1, 2, 3  # glsl/lights.glsl
+
+
+@dataclass
+class _LightEntry:
+    kind: int
+    power: float
+    prim: int = 0
+    vector: tuple = (0.0, 0.0, 0.0)
+    rgb: tuple = (0.0, 0.0, 0.0)
+
+
+def _environment_uniforms(environment: Environment, textures: TextureTable, scene_radius: float,
+                          importance: bool = True):
+    """(uniform values, power for light selection, sampling tables to append to image_data)."""
+    uniforms = {"env_type": 0, "env_radiance": (0.0, 0.0, 0.0), "env_strength": 1.0, "env_texture": -1,
+                "env_rotation": 0.0, "env_dist_offset": 0, "env_size": (1, 1)}
     if isinstance(environment, ConstantEnvironment):
-        return 4.0 * math.pi**2 * scene_radius**2 * _luminance(environment.radiance)
-    return 0.0
+        uniforms["env_radiance"] = tuple(float(v) for v in environment.radiance)
+        # pbrt-v4's UniformInfiniteLight::Phi: 4 pi^2 r^2 L for a scene of bounding radius r.
+        return uniforms, 4.0 * math.pi**2 * scene_radius**2 * _luminance(environment.radiance)
+    if isinstance(environment, EnvironmentMap):
+        path = Path(environment.file)
+        path = path if path.is_absolute() else textures.base_dir / path
+        try:
+            rgb = read_texture_image(path, "linear")
+        except OSError as exc:
+            message = str(exc) if path.exists() else f"{path}: environment map not found"
+            textures.warnings.append(f"{message}; lighting with a dim magenta sky instead")
+            uniforms["env_radiance"] = MISSING_SKY
+            return uniforms, 4.0 * math.pi**2 * scene_radius**2 * _luminance(MISSING_SKY)
+        # Without importance sampling (for comparisons) the tables describe a uniform image.
+        distribution = EnvironmentDistribution.from_image(rgb if importance else np.ones_like(rgb))
+        uniforms.update(
+            env_type=1, env_strength=float(environment.strength),
+            env_texture=textures.index_of(InlineImageTexture(pixels=rgb, name=str(path))),
+            env_rotation=math.radians(environment.rotation_deg),
+            env_dist_offset=textures.add_floats(distribution.packed()), env_size=(rgb.shape[1], rgb.shape[0]),
+        )
+        return uniforms, environment_power(rgb, environment.strength, scene_radius)
+    raise TypeError(f"no GPU packing for environment type {type(environment).__name__}")
 
 
 @dataclass(frozen=True)
@@ -122,21 +163,54 @@ class PackedScene:
 
 
 def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None = None,
-               base_dir: Path | None = None) -> PackedScene:
-    """Arrays and uniforms for the trace kernel; ``base_dir`` resolves relative texture paths."""
+               base_dir: Path | None = None, lights: Sequence[Light] = (),
+               environment_importance: bool = True) -> PackedScene:
+    """Arrays and uniforms for the trace kernel; ``base_dir`` resolves relative texture paths.
+    ``environment_importance=False`` samples an environment map uniformly (to measure what importance
+    sampling gains)."""
     if kdtree is None:
         kdtree = build_kdtree(flat.prim_bounds(), triangles=flat.triangles)
     n_tri, n_prim = flat.triangle_count, flat.prim_count
     material_ids = np.concatenate([flat.triangle_material, flat.sphere_material]).astype(np.int32)
 
-    # Light selection: environment by its power against the sum of the area lights'.
-    power = _emitted_power(flat)
+    textures = TextureTable(base_dir or Path.cwd())
     bounds = flat.bounds()
     scene_radius = max(0.5 * float(np.linalg.norm(bounds[1] - bounds[0])), 1e-3)
-    env_power = _environment_power(environment, scene_radius)
-    total = env_power + power.sum()
-    env_pmf = env_power / total if total > 0 else 0.0
-    prim_pmf = power / total if total > 0 else power
+
+    # Every light, with its power: next-event estimation chooses among them in proportion to it.
+    power = _emitted_power(flat)
+    entries = [_LightEntry(LIGHT_AREA, float(power[i]), prim=int(i)) for i in np.flatnonzero(power > 0)]
+    sun_uniforms = {"sun_direction": (0.0, 1.0, 0.0), "sun_one_minus_cos": 0.0, "sun_radiance": (0.0, 0.0, 0.0)}
+    suns = [light.name for light in lights if isinstance(light, SunLight)]
+    if len(suns) > 1:
+        raise ValueError(f"only one sun per scene (found {', '.join(suns)})")
+    for light in lights:
+        if isinstance(light, PointLight):
+            entries.append(_LightEntry(LIGHT_POINT, 4.0 * math.pi * _luminance(light.intensity),
+                                       vector=light.position, rgb=light.intensity))
+        elif isinstance(light, SunLight):
+            half_angle = math.radians(light.angular_diameter_deg) / 2
+            sun_uniforms = {"sun_direction": light.unit_direction(), "sun_one_minus_cos": 2 * math.sin(half_angle / 2) ** 2,
+                            "sun_radiance": tuple(float(v) for v in light.radiance())}
+            # pbrt-v4's DistantLight::Phi: the irradiance falling on a disk of the scene's radius.
+            entries.append(_LightEntry(LIGHT_SUN, math.pi * scene_radius**2 * _luminance(light.irradiance),
+                                       vector=light.unit_direction(), rgb=light.radiance()))
+    env_uniforms, env_power = _environment_uniforms(environment, textures, scene_radius, environment_importance)
+    if env_power > 0:
+        entries.append(_LightEntry(LIGHT_ENVIRONMENT, env_power))
+    total = sum(e.power for e in entries)
+    pmfs = np.array([e.power / total for e in entries]) if total > 0 else np.zeros(len(entries))
+    prim_pmf = np.zeros(n_prim)
+    lights_table = np.zeros((len(entries), 3, 4), np.float32)
+    for row, (entry, pmf, cdf) in enumerate(zip(entries, pmfs, np.cumsum(pmfs))):
+        lights_table[row, 0] = (entry.kind, np.int32(entry.prim).view(np.float32), cdf, pmf)
+        lights_table[row, 1, :3], lights_table[row, 2, :3] = entry.vector, entry.rgb
+        if entry.kind == LIGHT_AREA:
+            prim_pmf[entry.prim] = pmf
+    if len(entries):
+        lights_table[-1, 0, 2] = 1.0  # the last cumulative value is exactly 1, whatever the rounding
+    env_pmf = next((float(p) for e, p in zip(entries, pmfs) if e.kind == LIGHT_ENVIRONMENT), 0.0)
+    sun_pmf = next((float(p) for e, p in zip(entries, pmfs) if e.kind == LIGHT_SUN), 0.0)
 
     geometry = np.zeros((n_prim, 3, 4), np.float32)
     tris = flat.triangles
@@ -153,16 +227,8 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
     shading[:, 0, 3], shading[:, 1, 3], shading[:, 2, 3] = uv[:, 0], uv[:, 1], uv[:, 2]
     shading[:, 3, :3] = uv[:, 3:6]
 
-    emitters = np.flatnonzero(power > 0).astype(np.int32)
-    lights = np.zeros((len(emitters), 4), np.float32)
-    lights[:, 0] = emitters.view(np.float32)
-    lights[:, 1] = np.cumsum(prim_pmf[emitters])
-    lights[:, 2] = prim_pmf[emitters]
-
-    textures = TextureTable(base_dir or Path.cwd())
     materials = [pack_material(m, textures) for m in flat.materials] or [np.zeros((MATERIAL_ROWS, 4), np.float32)]
     material_rows = np.concatenate(materials)
-    env_radiance = environment.radiance if isinstance(environment, ConstantEnvironment) else (0.0, 0.0, 0.0)
 
     def at_least_one(a: np.ndarray) -> np.ndarray:  # GL refuses zero-sized buffers
         return a if a.size else np.zeros(4, a.dtype)
@@ -173,7 +239,7 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
         "geometry": geometry,
         "shading": shading,
         "materials": np.concatenate([material_rows, textures.records()]).astype(np.float32),
-        "lights": lights,
+        "lights": lights_table.reshape(-1, 4),
         "image_data": textures.texels(),
     }
     arrays = {name: at_least_one(np.ascontiguousarray(a)) for name, a in arrays.items()}
@@ -182,10 +248,12 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
         "prim_count": n_prim,
         "scene_min": tuple(float(v) for v in kdtree.bounds[0]),
         "scene_max": tuple(float(v) for v in kdtree.bounds[1]),
-        "light_count": len(emitters),
-        "env_select_pmf": float(env_pmf),
-        "env_radiance": tuple(float(v) for v in env_radiance),
+        "light_count": len(entries),
+        "env_select_pmf": env_pmf,
+        "sun_pmf": sun_pmf,
         "texture_base": len(material_rows),
+        **env_uniforms,
+        **sun_uniforms,
     }
     return PackedScene(arrays, uniforms, kdtree, tuple(textures.warnings))
 

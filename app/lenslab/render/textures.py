@@ -106,6 +106,13 @@ class TextureTable:
         self._texels.append(packed)
         self._texel_count += packed.size
 
+    def add_floats(self, values: np.ndarray) -> int:
+        """Append raw float32 data (sampling tables) to the texel buffer; returns its offset in uints."""
+        offset = self._texel_count
+        self._texels.append(np.asarray(values, np.float32).view(np.uint32))
+        self._texel_count += len(values)
+        return offset
+
     def records(self) -> np.ndarray:
         return np.concatenate(self._records) if self._records else np.zeros((0, 4), np.float32)
 

@@ -94,8 +94,10 @@ class RenderSession:
     """One scene on the GPU, one image accumulating. Not thread-safe: use it from the context's thread."""
 
     def __init__(self, renderer: Renderer, scene: Scene, *, width: int | None = None, height: int | None = None,
-                 settings: RenderSettings | None = None, dispatch_seconds: float = DEFAULT_DISPATCH_SECONDS):
+                 settings: RenderSettings | None = None, dispatch_seconds: float = DEFAULT_DISPATCH_SECONDS,
+                 environment_importance: bool = True):
         self.renderer = renderer
+        self.environment_importance = environment_importance
         self.ctx = renderer.ctx
         self.dispatch_seconds = dispatch_seconds
         self._gpu_scene: GpuScene | None = None
@@ -109,7 +111,10 @@ class RenderSession:
         self.scene = scene
         self.settings = settings or scene.render
         self.flat_scene = scene.flatten()
-        packed = pack_scene(self.flat_scene, scene.environment, base_dir=scene.base_dir())
+        packed = pack_scene(self.flat_scene, scene.environment, base_dir=scene.base_dir(), lights=scene.lights,
+                            environment_importance=self.environment_importance)
+        # What the render survives but the user should hear about: unmapped mesh materials, missing textures.
+        self.warnings = self.flat_scene.warnings + packed.warnings
         gpu_scene = GpuScene(self.ctx, packed, self.renderer.limits.max_storage_block_bytes)
         if self._gpu_scene is not None:
             self._gpu_scene.release()
@@ -156,7 +161,8 @@ class RenderSession:
         program = self.program
         values = dict(self._gpu_scene.packed.uniforms)
         values.update(camera_uniforms(self.camera, self.width, self.height))
-        values.update(max_depth=self.settings.max_depth, rr_depth=self.settings.rr_depth, seed=self.settings.seed)
+        values.update(max_depth=self.settings.max_depth, rr_depth=self.settings.rr_depth, seed=self.settings.seed,
+                      clamp_max=self.settings.clamp)
         for name, value in values.items():
             if name in program:  # the GLSL compiler drops uniforms a kernel never reads
                 program[name].value = value

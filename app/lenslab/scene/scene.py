@@ -14,6 +14,7 @@ from typing import Callable, ClassVar, Iterator
 import numpy as np
 
 from lenslab.scene.camera import ThinLensCamera
+from lenslab.scene.lights import Light
 from lenslab.scene.materials import Diffuse, Material
 from lenslab.scene.shapes import Shape
 from lenslab.scene.transform import Transform
@@ -56,7 +57,21 @@ class ConstantEnvironment(Environment):
     radiance: RGB = field(default=(0.0, 0.0, 0.0), metadata={"range": (0.0, 1e6)})
 
 
-ENVIRONMENT_TYPES = {cls.type_name: cls for cls in (ConstantEnvironment,)}
+@dataclass
+class EnvironmentMap(Environment):
+    """An HDR panorama in latitude-longitude layout (EXR, HDR, ...) wrapped around the scene.
+
+    The image's centre column looks down -Z; its top row is straight up (+Y). ``rotation_deg`` turns the
+    panorama about the vertical axis, ``strength`` scales it.
+    """
+
+    type_name: ClassVar[str] = "map"
+    file: str = field(default="", metadata={"required": True, "doc": "lat-long image, relative to the scene"})
+    strength: float = field(default=1.0, metadata={"range": (0.0, 1e6)})
+    rotation_deg: float = field(default=0.0, metadata={"range": (-360.0, 360.0)})
+
+
+ENVIRONMENT_TYPES = {cls.type_name: cls for cls in (ConstantEnvironment, EnvironmentMap)}
 
 
 @dataclass
@@ -68,6 +83,8 @@ class RenderSettings:
     rr_depth: int = field(default=5, metadata={"range": (1, 1024), "doc": "path length at which Russian roulette starts"})
     seed: int = field(default=0, metadata={"range": (0, 2**31 - 1)})
     sampler: str = field(default="sobol", metadata={"choices": ("sobol", "independent")})
+    clamp: float = field(default=0.0, metadata={"range": (0.0, 1e9), "doc": "0 = off (unbiased); else the most "
+                                                 "radiance one sample may add, to tame fireflies (biased)"})
 
 
 @dataclass
@@ -77,6 +94,7 @@ class Scene:
     render: RenderSettings = field(default_factory=RenderSettings)
     materials: dict[str, Material] = field(default_factory=dict)
     nodes: list[Node] = field(default_factory=list)
+    lights: list[Light] = field(default_factory=list)
     # Where the scene came from: relative mesh paths resolve against its folder. Not saved.
     source_path: Path | None = field(default=None, compare=False, repr=False)
 

@@ -25,13 +25,14 @@ from lenslab.scene.materials import MATERIAL_TYPES, Material
 from lenslab.scene.scene import ENVIRONMENT_TYPES, Environment, Node, Scene, SceneError
 from lenslab.scene.shapes import SHAPE_TYPES, MeshFile, Shape
 from lenslab.scene.textures import TEXTURE_TYPES, ImageTexture, Texture
+from lenslab.scene.lights import LIGHT_TYPES, Light
 
 FORMAT_KEY = "lenslab_scene"
 FORMAT_VERSION = 1
 SCENE_SUFFIX = ".json"
 
 # Polymorphic fields: the JSON object's "type" key picks the dataclass.
-_TAGGED = {Shape: SHAPE_TYPES, Material: MATERIAL_TYPES, Environment: ENVIRONMENT_TYPES, Texture: TEXTURE_TYPES}
+_TAGGED = {Shape: SHAPE_TYPES, Material: MATERIAL_TYPES, Environment: ENVIRONMENT_TYPES, Texture: TEXTURE_TYPES, Light: LIGHT_TYPES}
 
 
 class _Invalid(Exception):
@@ -98,7 +99,10 @@ def _read_value(value: Any, annotation: Any, path: str, meta: dict) -> Any:
     if origin is tuple:
         if not isinstance(value, list) or len(value) != len(args):
             raise _Invalid(path, f"expected a list of {len(args)} numbers, got {_describe(value)}")
-        return tuple(_read_value(v, a, _join(path, i), meta) for i, (v, a) in enumerate(zip(value, args)))
+        result = tuple(_read_value(v, a, _join(path, i), meta) for i, (v, a) in enumerate(zip(value, args)))
+        if meta.get("nonzero_vector") and not any(result):
+            raise _Invalid(path, "must not be the zero vector")
+        return result
     if origin is list:
         if not isinstance(value, list):
             raise _Invalid(path, f"expected a list, got {_describe(value)}")

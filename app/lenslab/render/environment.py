@@ -1,0 +1,81 @@
+"""Environment maps: the lat-long mapping and the piecewise-constant distribution that importance-samples
+them (pbrt-v4's PiecewiseConstant2D over (u, v), weighted by sin(theta) for the sphere's area).
+
+Directions map to (u, v) in [0, 1)^2 with v = 0 straight up (+Y, the image's top row) and u = 0.5 looking
+down -Z; ``rotation`` (radians) turns the panorama about +Y. The same mapping is in glsl/lights.glsl.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+
+def direction_to_uv(d: np.ndarray, rotation: float = 0.0) -> np.ndarray:
+    d = np.asarray(d, float)
+    phi = np.arctan2(d[..., 0], -d[..., 2]) - rotation
+    u = np.mod(0.5 + phi / (2 * np.pi), 1.0)
+    v = np.arccos(np.clip(d[..., 1], -1, 1)) / np.pi
+    return np.stack([u, v], axis=-1)
+
+
+def uv_to_direction(uv: np.ndarray, rotation: float = 0.0) -> np.ndarray:
+    phi = (uv[..., 0] - 0.5) * 2 * np.pi + rotation
+    theta = uv[..., 1] * np.pi
+    s = np.sin(theta)
+    return np.stack([s * np.sin(phi), np.cos(theta), -s * np.cos(phi)], axis=-1)
+
+
+def luminance(rgb: np.ndarray) -> np.ndarray:
+    return rgb[..., 0] * 0.2126 + rgb[..., 1] * 0.7152 + rgb[..., 2] * 0.0722
+
+
+@dataclass(frozen=True)
+class EnvironmentDistribution:
+    """Sampling tables for an (H, W) lat-long image: the pdf per pixel over (u, v), cumulative tables."""
+
+    pdf: np.ndarray  # (H, W) density over [0,1]^2 (integrates to 1)
+    marginal_cdf: np.ndarray  # (H + 1,) over rows
+    conditional_cdf: np.ndarray  # (H, W + 1) over columns of each row
+
+    @classmethod
+    def from_image(cls, rgb: np.ndarray) -> "EnvironmentDistribution":
+        h, w = rgb.shape[:2]
+        lum = np.maximum(luminance(rgb.astype(np.float64)), 0.0)
+        # Bilinear lookups reach into neighbouring pixels: weight each pixel by the brightest it can show,
+        # so that the pdf is never zero where the radiance is not (that would bias the estimate).
+        padded = np.pad(lum, 1, mode="edge")
+        padded[:, 0], padded[:, -1] = padded[:, -2], padded[:, 1]  # u wraps around
+        func = np.max([padded[1 + dy : 1 + dy + h, 1 + dx : 1 + dx + w] for dy in (-1, 0, 1) for dx in (-1, 0, 1)], axis=0)
+        sin_theta = np.sin(np.pi * (np.arange(h) + 0.5) / h)[:, None]
+        func = func * sin_theta
+        func += 1e-6 * max(func.mean(), 1e-12)  # never exactly zero: every direction stays reachable
+        row_sums = func.sum(axis=1)
+        conditional = np.concatenate([np.zeros((h, 1)), np.cumsum(func, axis=1) / row_sums[:, None]], axis=1)
+        marginal = np.concatenate([[0.0], np.cumsum(row_sums) / row_sums.sum()])
+        pdf = func / func.sum() * (h * w)
+        return cls(pdf.astype(np.float32), marginal.astype(np.float32), conditional.astype(np.float32))
+
+    def pdf_direction(self, d: np.ndarray, rotation: float = 0.0) -> np.ndarray:
+        """Density per steradian of choosing direction d."""
+        h, w = self.pdf.shape
+        uv = direction_to_uv(d, rotation)
+        row = np.clip((uv[..., 1] * h).astype(int), 0, h - 1)
+        col = np.clip((uv[..., 0] * w).astype(int), 0, w - 1)
+        sin_theta = np.sin(uv[..., 1] * np.pi)
+        return np.where(sin_theta > 0, self.pdf[row, col] / (2 * math.pi**2 * np.maximum(sin_theta, 1e-12)), 0.0)
+
+    def packed(self) -> np.ndarray:
+        """As float32 for the GPU: marginal cdf, then conditional cdfs row by row, then the pdf."""
+        return np.concatenate([self.marginal_cdf, self.conditional_cdf.reshape(-1), self.pdf.reshape(-1)])
+
+
+def environment_power(rgb: np.ndarray, strength: float, scene_radius: float) -> float:
+    """Power for choosing between lights, as pbrt-v4's infinite lights: the radiance integrated over all
+    directions (sum of L sin(theta) d(phi) d(theta) over pixels) falling on a disk of the scene's radius."""
+    h = rgb.shape[0]
+    sin_theta = np.sin(np.pi * (np.arange(h) + 0.5) / h)[:, None]
+    radiance_integral = 2.0 * math.pi**2 * float((luminance(rgb) * sin_theta).mean())
+    return math.pi * scene_radius**2 * strength * radiance_integral

@@ -1,0 +1,184 @@
+"""Lights (point, sun, environment maps) and textures against closed-form answers."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from lenslab.render.film import write_image
+from lenslab.render.tracer import RenderSession
+from lenslab.scene.camera import ThinLensCamera
+from lenslab.scene.lights import PointLight, SunLight
+from lenslab.scene.materials import Diffuse
+from lenslab.scene.scene import ConstantEnvironment, EnvironmentMap, Node, RenderSettings, Scene
+from lenslab.scene.shapes import Rectangle, Sphere
+from lenslab.scene.textures import Checkerboard, ImageTexture
+from lenslab.scene.transform import Transform
+
+ALBEDO = 0.6
+
+
+def looking_down_at_floor(**scene_args) -> Scene:
+    """A camera 2 m above a large diffuse floor, looking straight down at its centre."""
+    defaults = dict(
+        camera=ThinLensCamera(position=(0, 2, 0), look_at=(0, 0, 0), up=(0, 0, -1), focal_length_mm=200,
+                              f_number=16, focus_distance_m=2, resolution=(16, 16)),
+        render=RenderSettings(max_depth=2),
+        materials={"floor": Diffuse((ALBEDO, ALBEDO, ALBEDO))},
+        nodes=[Node("floor", Transform(rotate_deg=(-90, 0, 0)), Rectangle((100, 100)), "floor")],
+    )
+    return Scene(**(defaults | scene_args))
+
+
+def render(renderer, scene, spp, **session_args):
+    session = RenderSession(renderer, scene, **session_args)
+    session.step(120.0, target_spp=spp)
+    image, warnings = session.image(), session.warnings
+    session.release()
+    return image, warnings
+
+
+def test_point_light_follows_the_inverse_square_law(renderer):
+    intensity, height = 20.0, 1.5
+    scene = looking_down_at_floor(lights=[PointLight("bulb", position=(0, height, 0), intensity=(intensity,) * 3)])
+    image, _ = render(renderer, scene, 4)
+    expected = ALBEDO / math.pi * intensity / height**2  # radiance of a Lambertian floor right under the bulb
+    assert image[6:10, 6:10].mean() == pytest.approx(expected, rel=0.01)
+
+
+@pytest.mark.parametrize("diameter", [0.0, 0.53, 5.0])
+def test_sun_irradiance_gives_lambertian_radiance(renderer, diameter):
+    irradiance, elevation = 4.0, 60.0
+    direction = (math.cos(math.radians(elevation)), math.sin(math.radians(elevation)), 0.0)
+    sun = SunLight("sun", direction=direction, irradiance=(irradiance,) * 3, angular_diameter_deg=diameter)
+    image, _ = render(renderer, looking_down_at_floor(lights=[sun]), 32)
+    expected = ALBEDO / math.pi * irradiance * math.sin(math.radians(elevation))
+    # A disk of finite size spreads its irradiance over a cone: the cosine factor averages almost unchanged.
+    assert image.mean() == pytest.approx(expected, rel=0.01)
+
+
+def test_the_sun_disk_is_seen_by_rays_that_escape(renderer):
+    # A camera looking straight at a 5-degree sun sees its radiance inside the disk and black sky outside.
+    sun = SunLight("sun", direction=(0, 0, 1), irradiance=(1.0, 1.0, 1.0), angular_diameter_deg=5.0)
+    scene = Scene(camera=ThinLensCamera(position=(0, 0, 0), look_at=(0, 0, 1), focal_length_mm=200, f_number=16,
+                                        focus_distance_m=100, resolution=(32, 32)),
+                  render=RenderSettings(max_depth=1), lights=[sun])
+    image, _ = render(renderer, scene, 4)
+    assert image[16, 16, 0] == pytest.approx(sun.radiance()[0], rel=1e-3)
+    assert image[0, 0].max() == 0.0
+
+
+def write_sky(path, sun_pixels=True):
+    """A small HDR panorama: a dim blue sky, a bright sun above the horizon, a darker ground."""
+    h, w = 64, 128
+    sky = np.zeros((h, w, 3), np.float32)
+    sky[: h // 2] = (0.3, 0.4, 0.6)
+    sky[h // 2 :] = (0.1, 0.08, 0.05)
+    if sun_pixels:
+        sky[12:15, 40:43] = (4000.0, 3800.0, 3500.0)
+    write_image(path, sky)
+    return sky
+
+
+def sphere_under_sky(path, **env):
+    return Scene(
+        camera=ThinLensCamera(position=(0, 0, 4), look_at=(0, 0, 0), focal_length_mm=70, f_number=8,
+                              focus_distance_m=4, resolution=(24, 24)),
+        environment=EnvironmentMap(file=str(path), **env),
+        render=RenderSettings(max_depth=2),
+        materials={"white": Diffuse((0.8, 0.8, 0.8))},
+        nodes=[Node("ball", shape=Sphere(1.0), material="white")],
+    )
+
+
+def test_uniform_environment_map_is_a_white_furnace(renderer, tmp_path):
+    write_image(tmp_path / "white.exr", np.ones((32, 64, 3), np.float32))
+    scene = sphere_under_sky(tmp_path / "white.exr")
+    scene = dataclasses.replace(scene, materials={"white": Diffuse((1, 1, 1))}, render=RenderSettings(max_depth=64))
+    image, _ = render(renderer, scene, 32)
+    assert image.mean() == pytest.approx(1.0, abs=0.01)
+
+
+def test_environment_importance_sampling_lowers_the_error_at_equal_samples(renderer, tmp_path):
+    write_sky(tmp_path / "sky.exr")
+    scene = sphere_under_sky(tmp_path / "sky.exr", rotation_deg=30.0)
+    reference, _ = render(renderer, scene, 1024)
+    importance, _ = render(renderer, dataclasses.replace(scene, render=RenderSettings(max_depth=2, seed=5)), 16)
+    uniform, _ = render(renderer, dataclasses.replace(scene, render=RenderSettings(max_depth=2, seed=5)), 16,
+                        environment_importance=False)
+    mse_importance = np.mean((importance - reference) ** 2)
+    mse_uniform = np.mean((uniform - reference) ** 2)
+    assert mse_importance < 0.2 * mse_uniform
+    # Both estimators are unbiased: their means agree with the reference within noise.
+    assert importance.mean() == pytest.approx(reference.mean(), rel=0.02)
+    assert uniform.mean() == pytest.approx(reference.mean(), rel=0.25)
+
+
+def test_environment_rotation_turns_the_lighting(renderer, tmp_path):
+    write_sky(tmp_path / "sky.exr")
+    lit_side = []
+    for rotation in (0.0, 180.0):
+        image, _ = render(renderer, sphere_under_sky(tmp_path / "sky.exr", rotation_deg=rotation), 32)
+        lit_side.append(image[:, :12].mean() > image[:, 12:].mean())
+    assert lit_side[0] != lit_side[1]
+
+
+def textured_card(texture) -> Scene:
+    """A card filling the view, lit evenly by a white sky: its radiance equals its albedo."""
+    return Scene(
+        camera=ThinLensCamera(position=(0, 0, 2), look_at=(0, 0, 0), focal_length_mm=72, f_number=16,
+                              focus_distance_m=2, sensor_mm=(36, 36), resolution=(32, 32)),
+        environment=ConstantEnvironment((1.0, 1.0, 1.0)),
+        render=RenderSettings(max_depth=2),
+        materials={"card": Diffuse(albedo_texture=texture)},
+        nodes=[Node("card", shape=Rectangle((1.0, 1.0)), material="card")],
+    )
+
+
+def quarters(image):
+    """Mean colour of the middle of each quarter of the card (which spans the middle half of the frame)."""
+    return [image[y : y + 4, x : x + 4].reshape(-1, 3).mean(axis=0) for y in (10, 18) for x in (10, 18)]
+
+
+def test_image_texture_is_linearised_and_oriented(renderer, tmp_path):
+    import OpenImageIO as oiio
+
+    # A 16x16 sRGB PNG in quarters: top-left red, top-right green, bottom-left blue, bottom-right mid grey
+    # (sRGB 128). Quarters of 8x8 texels keep bilinear filtering away from the colour boundaries we sample.
+    quad = np.array([[[255, 0, 0], [0, 255, 0]], [[0, 0, 255], [128, 128, 128]]], np.uint8)
+    pixels = np.ascontiguousarray(quad.repeat(8, axis=0).repeat(8, axis=1))
+    out = oiio.ImageOutput.create(str(tmp_path / "quad.png"))
+    out.open(str(tmp_path / "quad.png"), oiio.ImageSpec(16, 16, 3, oiio.UINT8))
+    out.write_image(pixels)
+    out.close()
+    image, warnings = render(renderer, textured_card(ImageTexture(file=str(tmp_path / "quad.png"))), 64)
+    assert warnings == ()
+    top_left, top_right, bottom_left, bottom_right = quarters(image)
+    assert top_left.argmax() == 0 and top_right.argmax() == 1 and bottom_left.argmax() == 2
+    grey = ((128 / 255 + 0.055) / 1.055) ** 2.4  # sRGB 128 in linear light: 0.216, not 0.5
+    np.testing.assert_allclose(bottom_right, grey, rtol=0.03)
+
+
+def test_checkerboard_texture(renderer):
+    card = textured_card(Checkerboard(color_a=(0.9, 0.9, 0.9), color_b=(0.1, 0.1, 0.1), tiles=(2, 2)))
+    image, _ = render(renderer, card, 64)
+    q = [c[0] for c in quarters(image)]
+    # Squares alternate along both axes: diagonal quarters match, and the two colours are the two given.
+    assert q[0] == pytest.approx(q[3], rel=0.03) and q[1] == pytest.approx(q[2], rel=0.03)
+    assert sorted([q[0], q[1]]) == pytest.approx([0.1, 0.9], rel=0.03)
+
+
+def test_missing_texture_warns_and_shows_a_placeholder(renderer, tmp_path):
+    image, warnings = render(renderer, textured_card(ImageTexture(file=str(tmp_path / "gone.png"))), 4)
+    assert len(warnings) == 1 and "gone.png: texture file not found" in warnings[0] and "magenta" in warnings[0]
+    centre = image[12:20, 12:20].reshape(-1, 3)
+    assert centre[:, 0].max() > 0.5 and centre[:, 1].max() < 0.05  # magenta (and black) squares
+
+
+def test_missing_environment_map_warns_and_still_renders(renderer, tmp_path):
+    image, warnings = render(renderer, sphere_under_sky(tmp_path / "nowhere.exr"), 2)
+    assert len(warnings) == 1 and "nowhere.exr: environment map not found" in warnings[0]
+    assert image.max() > 0
