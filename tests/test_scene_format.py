@@ -126,3 +126,15 @@ def test_saving_is_atomic(tmp_path, monkeypatch):
         save_scene(scene, target)
     assert target.read_text() == before
     assert [p.name for p in tmp_path.iterdir()] == ["scene.json"]  # no temporary left behind
+
+
+def test_saved_files_get_ordinary_permissions(tmp_path):
+    import os
+    import stat
+
+    mask = os.umask(0o022)
+    try:
+        save_scene(open_scene("cornell_box"), tmp_path / "scene.json")
+    finally:
+        os.umask(mask)
+    assert stat.S_IMODE((tmp_path / "scene.json").stat().st_mode) == 0o644  # not the temporary file's 0600

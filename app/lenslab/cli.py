@@ -77,6 +77,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--max-depth", type=_number(int, 1, 1024, "--max-depth"), metavar="D",
                    help="longest light path in segments (2 = direct light only)")
     p.add_argument("--sampler", choices=("sobol", "independent"), help="sample pattern (default: the scene's)")
+    p.add_argument("--clamp", type=_number(float, 0, 1e9, "--clamp"), metavar="L",
+                   help="tame fireflies: cap the radiance one sample may add (biased; 0 = off, the default)")
     p.add_argument("--exposure", type=_number(float, -30, 30, "--exposure"), default=0.0, metavar="STOPS",
                    help="PNG only: brighten (+) or darken (-) by this many stops")
     p.add_argument("--tone-map", choices=("clamp", "reinhard", "filmic"), default="clamp",
@@ -131,7 +133,8 @@ def _apply_overrides(scene, args):
             width = max(1, round(args.height * width / height))
         camera_changes["resolution"] = (args.width or width, args.height or height)
     render_changes = {k: v for k, v in (("seed", args.seed), ("max_depth", args.max_depth),
-                                        ("sampler", args.sampler), ("spp", args.spp)) if v is not None}
+                                        ("sampler", args.sampler), ("spp", args.spp), ("clamp", args.clamp))
+                      if v is not None}
     return dataclasses.replace(scene, camera=dataclasses.replace(scene.camera, **camera_changes),
                                render=dataclasses.replace(scene.render, **render_changes))
 
@@ -160,6 +163,7 @@ def image_metadata(scene, spp: int) -> dict[str, object]:
         "lenslab:Seed": int(scene.render.seed),
         "lenslab:MaxDepth": int(scene.render.max_depth),
         "lenslab:Sampler": scene.render.sampler,
+        "lenslab:Clamp": float(scene.render.clamp),
     }
 
 

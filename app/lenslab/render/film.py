@@ -8,10 +8,11 @@ beside the target and renamed into place, so an export is whole or absent, never
 from __future__ import annotations
 
 import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
+
+from lenslab.atomic import atomic_path
 
 EXPORT_SUFFIXES = (".exr", ".png")
 TONE_MAPS = ("clamp", "reinhard", "filmic")
@@ -82,10 +83,7 @@ def write_image(path: str | os.PathLike, linear: np.ndarray, metadata: dict[str,
     for key, value in (metadata or {}).items():
         spec.attribute(key, value if not isinstance(value, bool) else int(value))
 
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=suffix, dir=path.parent)
-    os.close(fd)
-    tmp = Path(tmp_name)
-    try:
+    with atomic_path(path) as tmp:
         out = oiio.ImageOutput.create(str(tmp))
         if out is None or not out.open(str(tmp), spec):
             raise ExportError(f"{path}: cannot open for writing ({oiio.geterror() or (out and out.geterror())})")
@@ -94,10 +92,6 @@ def write_image(path: str | os.PathLike, linear: np.ndarray, metadata: dict[str,
         out.close()
         if not ok:
             raise ExportError(f"{path}: write failed ({error})")
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
     return path
 
 

@@ -15,12 +15,12 @@ import dataclasses
 import json
 import math
 import os
-import tempfile
 import types
 import typing
 from pathlib import Path
 from typing import Any
 
+from lenslab.atomic import atomic_path
 from lenslab.scene.materials import MATERIAL_TYPES, Material
 from lenslab.scene.scene import ENVIRONMENT_TYPES, Environment, Node, Scene, SceneError
 from lenslab.scene.shapes import SHAPE_TYPES, MeshFile, Shape
@@ -240,11 +240,5 @@ def save_scene(scene: Scene, path: str | os.PathLike) -> None:
     """Write atomically: a crash mid-save leaves the previous file intact."""
     path = Path(path)
     text = _format_json(scene_to_dict(scene)) + "\n"
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with atomic_path(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
