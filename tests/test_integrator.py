@@ -69,3 +69,16 @@ def test_step_returns_between_bounded_dispatches(renderer):
     assert session.samples_per_pixel == 2
     assert np.all(session.accumulation()[..., 3] == 2)
     session.release()
+
+
+def test_firefly_clamp_is_off_by_default_and_caps_samples_when_asked(renderer):
+    from lenslab.scene.materials import Emissive
+
+    scene = furnace_scene(max_depth=4)
+    bright = dataclasses.replace(scene, environment=dataclasses.replace(scene.environment, radiance=(5.0, 5.0, 5.0)),
+                                 materials={"white": Emissive((0.0, 0.0, 0.0))})
+    unclamped = render(renderer, bright, 2)
+    assert (unclamped[..., :3] / unclamped[..., 3:4]).max() == pytest.approx(5.0)  # the default is unbiased
+    clamped_scene = dataclasses.replace(bright, render=dataclasses.replace(bright.render, clamp=2.0))
+    clamped = render(renderer, clamped_scene, 2)
+    assert (clamped[..., :3] / clamped[..., 3:4]).max() == pytest.approx(2.0)
