@@ -39,8 +39,14 @@ class LoadedMesh:
 
 
 def load_mesh_parts(path: Path, smooth: bool = True) -> LoadedMesh:
-    """The mesh file as parts, one per material it defines (one part when it defines none)."""
-    return LoadedMesh((MeshPart(load_mesh(path, smooth)),))
+    """The mesh file as parts, one per material it uses (geometry without one: a part each, material None).
+
+    The file's materials (OBJ+MTL, glTF 2.0) are mapped onto ours by ``mesh_materials``, which says in
+    ``warnings`` what it could not map, once per material.
+    """
+    from lenslab.scene.io.mesh_materials import load_parts  # it imports this module's MeshPart and LoadedMesh
+
+    return load_parts(path, smooth)
 
 
 def load_mesh(path: Path, smooth: bool = True) -> TriangleMesh:
