@@ -181,21 +181,22 @@ def build_kdtree(
 
 
 def _build_levels(refs, root, triangles, costs, leaf_prims, min_bins, max_bins, depth_limit, pool):
-    """The build proper: one iteration per tree level, each a few whole-array passes."""
-    node_lo, node_hi = root[0][:, None].copy(), root[1][:, None].copy()
-    levels: list[_Level] = []
-    while True:
-        depth = len(levels)
-        level = _Level(node_lo, node_hi, np.bincount(refs.node, minlength=node_lo.shape[1]))
-        levels.append(level)
-        # Small nodes and nodes at the depth cap are leaves whatever the SAH says.
-        level.is_leaf = (level.counts <= leaf_prims) | (depth >= depth_limit)
-        refs = level.emit_leaf_refs(refs)
-        if len(refs) == 0:
-            return levels
+    """The build proper: one iteration per tree level, each a few whole-array passes.
 
-        # The SAH decides for the others. Runs of whole nodes go to the worker threads.
-        parts = _node_parts(refs.node, len(level.counts), 1 if pool is None else pool._max_workers)
+    ``refs`` always holds the references of the current level's nodes that are not leaves yet;
+    the references of leaves go to their level's ``leaf_chunks`` as soon as the leaf is known.
+    """
+    workers = 1 if pool is None else pool._max_workers
+    counts = np.array([len(refs)])
+    # Small nodes and nodes at the depth cap are leaves whatever the SAH says.
+    level = _Level(root[0][:, None].copy(), root[1][:, None].copy(), counts, (counts <= leaf_prims) | (depth_limit == 0))
+    levels = [level]
+    if level.is_leaf[0]:
+        level.leaf_chunks.append((refs.node, refs.prim))
+        return levels
+    while True:
+        # The SAH decides for the other nodes. Runs of whole nodes go to the worker threads.
+        parts = _node_parts(refs.node, len(level.counts), workers)
 
         def best_splits(part):
             k0, k1, r0, r1 = part
@@ -205,17 +206,27 @@ def _build_levels(refs, root, triangles, costs, leaf_prims, min_bins, max_bins, 
         cost, level.axis, level.split = (np.concatenate(c) for c in zip(*_map(pool, best_splits, parts)))
         level.is_leaf |= ~(cost < costs.intersection * level.counts)
         if level.is_leaf.all():
-            level.emit_leaf_refs(refs)
+            level.leaf_chunks.append((refs.node, refs.prim))
             return levels
 
-        def split_refs(part):
-            return _split_refs(refs.slice(part[2], part[3]), level, triangles)
+        # Partition the references into the children, in three steps (see _PartSplit).
+        child = np.cumsum(~level.is_leaf, dtype=np.int32) - 1  # below child's index; above is S + child
+        next_counts = np.zeros(2 * (int(child[-1]) + 1), np.int64)
+        splits = _map(pool, lambda p: _PartSplit(refs.slice(p[2], p[3]), level, child, next_counts, triangles), parts)
+        next_is_leaf = (next_counts <= leaf_prims) | (len(levels) >= depth_limit)
+        carried = np.array(_map(pool, lambda split: split.drop_leaf_refs(next_is_leaf), splits)).reshape(-1, 2)
+        starts = np.cumsum(np.concatenate([carried[:, 0], carried[:, 1]])) - np.concatenate([carried[:, 0], carried[:, 1]])
+        refs = _Refs.empty(int(carried.sum()))
+        _map(pool, lambda i: splits[i].write(refs, starts[i], starts[len(splits) + i]), range(len(splits)))
 
-        below, above, leaf_chunks = zip(*_map(pool, split_refs, parts))
-        level.leaf_chunks.extend(chunk for chunk in leaf_chunks if len(chunk[0]))
-        # Below children are numbered before above children, so this keeps refs grouped by node.
-        refs = _Refs.concatenate(below + above)
-        node_lo, node_hi = _child_boxes(level)
+        next_level = _Level(*_child_boxes(level), next_counts, next_is_leaf)
+        for split in splits:
+            level.leaf_chunks.append(split.leaf_chunk)
+            next_level.leaf_chunks.extend(split.next_leaf_chunks)
+        level = next_level
+        levels.append(level)
+        if len(refs) == 0:
+            return levels
 
 
 def _worker_count(threads: int | None) -> int:
@@ -303,18 +314,9 @@ class _Refs:
         return _Refs(node, self.prim[start:end], self.lo[:, start:end], self.hi[:, start:end])
 
     @staticmethod
-    def concatenate(parts) -> _Refs:
+    def empty(count: int) -> _Refs:
         return _Refs(
-            np.concatenate([p.node for p in parts]),
-            np.concatenate([p.prim for p in parts]),
-            np.concatenate([p.lo for p in parts], axis=1),
-            np.concatenate([p.hi for p in parts], axis=1),
-        )
-
-    def take(self, index: np.ndarray) -> _Refs:
-        # np.take along axis 1 is about three times faster than fancy indexing lo[:, index].
-        return _Refs(
-            self.node[index], self.prim[index], np.take(self.lo, index, axis=1), np.take(self.hi, index, axis=1)
+            np.empty(count, np.int32), np.empty(count, np.int32), np.empty((3, count), np.float32), np.empty((3, count), np.float32)
         )
 
 
@@ -326,21 +328,11 @@ class _Level:
     the order of the references when partitioning leaves the next level grouped by node again.
     """
 
-    def __init__(self, lo: np.ndarray, hi: np.ndarray, counts: np.ndarray):
-        self.lo, self.hi, self.counts = lo, hi, counts
-        self.is_leaf = np.ones(len(counts), bool)
+    def __init__(self, lo: np.ndarray, hi: np.ndarray, counts: np.ndarray, is_leaf: np.ndarray):
+        self.lo, self.hi, self.counts, self.is_leaf = lo, hi, counts, is_leaf
         self.axis = np.zeros(len(counts), np.int8)
         self.split = np.zeros(len(counts), np.float32)
         self.leaf_chunks: list[tuple[np.ndarray, np.ndarray]] = []  # (node, prim), grouped by node
-
-    def emit_leaf_refs(self, refs: _Refs) -> _Refs:
-        """Move the references of nodes now marked as leaves out of ``refs`` into this level."""
-        in_leaf = self.is_leaf[refs.node]
-        if not in_leaf.any():
-            return refs
-        leaf = np.flatnonzero(in_leaf)
-        self.leaf_chunks.append((refs.node[leaf], refs.prim[leaf]))
-        return refs.take(np.flatnonzero(~in_leaf))
 
 
 # --------------------------------------------------------------------------------------------------
@@ -491,45 +483,80 @@ def _half_area(extent: np.ndarray) -> np.ndarray:
 # Partitioning the references of one level into the next
 
 
-def _split_refs(refs: _Refs, level: _Level, triangles: np.ndarray | None):
-    """Send every reference to the child (or children) of its node that it overlaps.
+class _PartSplit:
+    """Sends the references of one part of a level (runs of whole nodes) on to the next level.
 
-    Returns the references of the below children, those of the above children (with their new node
-    indices), and the (node, prim) references of the nodes that became leaves.
+    Three steps, so that parts can run in threads and still fill one next-level array in node order:
+    the constructor picks each reference's side(s), clips the straddlers and counts references per
+    child; ``drop_leaf_refs`` sets aside those of children that are leaves from the start (few
+    references, or the depth cap); ``write`` copies the others into place.
     """
-    in_leaf = level.is_leaf[refs.node]
-    leaf = np.flatnonzero(in_leaf)
-    leaf_chunk = (refs.node[leaf], refs.prim[leaf])
 
-    axis = level.axis[refs.node].astype(np.intp)
-    split = level.split[refs.node]
-    lo, hi = _pick_rows(refs.lo, axis), _pick_rows(refs.hi, axis)
-    starts_below = lo < split
-    reaches_above = hi > split
-    above = (reaches_above | ~starts_below) & ~in_leaf
-    below = starts_below & ~in_leaf
-    straddle = np.flatnonzero(below & reaches_above)
+    def __init__(self, refs: _Refs, level: _Level, child, next_counts, triangles):
+        self.refs = refs
+        in_leaf = level.is_leaf[refs.node]  # decided by the SAH: the references stop here
+        leaf = np.flatnonzero(in_leaf)
+        self.leaf_chunk = (refs.node[leaf], refs.prim[leaf])
 
-    clipped = _clip_straddlers(refs, straddle, axis[straddle], split[straddle], triangles)
-    below_lo, below_hi, below_ok, above_lo, above_hi, above_ok = clipped
-    below[straddle[~below_ok]] = False
-    above[straddle[~above_ok]] = False
+        axis = level.axis[refs.node].astype(np.intp)
+        split = level.split[refs.node]
+        lo, hi = _pick_rows(refs.lo, axis), _pick_rows(refs.hi, axis)
+        starts_below = lo < split
+        reaches_above = hi > split
+        above = (reaches_above | ~starts_below) & ~in_leaf
+        below = starts_below & ~in_leaf
+        straddle = np.flatnonzero(below & reaches_above)
 
-    child = np.cumsum(~level.is_leaf, dtype=np.int32) - 1  # below child's index; above is S + child
-    interior_count = int(child[-1]) + 1
-    sides = []
-    for goes, part_lo, part_hi, ok, first_child in (
-        (below, below_lo, below_hi, below_ok, 0),
-        (above, above_lo, above_hi, above_ok, interior_count),
-    ):
-        index = np.flatnonzero(goes)
-        side = refs.take(index)
-        side.node = child[side.node] + np.int32(first_child)
-        # The straddlers get their clipped bounds, at their new positions.
-        at = np.searchsorted(index, straddle[ok])
-        side.lo[:, at], side.hi[:, at] = part_lo[:, ok], part_hi[:, ok]
-        sides.append(side)
-    return sides[0], sides[1], leaf_chunk
+        clipped = _clip_straddlers(refs, straddle, axis[straddle], split[straddle], triangles)
+        below_lo, below_hi, below_ok, above_lo, above_hi, above_ok = clipped
+        below[straddle[~below_ok]] = False
+        above[straddle[~above_ok]] = False
+
+        # This part's children are contiguous ranges of the next level: count into those slices.
+        # (child[k] is the number of interior nodes before k, for interior k; none has no refs.)
+        first_child = child[refs.node[0]] + level.is_leaf[refs.node[0]]
+        end_child = child[refs.node[-1]] + 1
+        interior_count = len(next_counts) // 2
+        self.sides = []
+        for goes, part_lo, part_hi, ok, offset in (
+            (below, below_lo, below_hi, below_ok, 0),
+            (above, above_lo, above_hi, above_ok, interior_count),
+        ):
+            index = np.flatnonzero(goes)
+            node = child[refs.node[index]] + np.int32(offset)
+            clip_at = np.searchsorted(index, straddle[ok])  # where the straddlers are in ``index``
+            self.sides.append([index, node, clip_at, part_lo[:, ok], part_hi[:, ok]])
+            lo_child = offset + first_child
+            next_counts[lo_child : offset + end_child] = np.bincount(node - lo_child, minlength=end_child - first_child)
+
+    def drop_leaf_refs(self, next_is_leaf: np.ndarray):
+        """Set aside the references of children that are leaves; returns how many remain per side."""
+        self.next_leaf_chunks = []
+        remaining = []
+        for side in self.sides:
+            index, node, clip_at, clip_lo, clip_hi = side
+            to_leaf = next_is_leaf[node]
+            if to_leaf.any():
+                self.next_leaf_chunks.append((node[to_leaf], self.refs.prim[index[to_leaf]]))
+                kept = ~to_leaf
+                new_position = np.cumsum(kept) - 1
+                clip_kept = kept[clip_at]
+                side[:] = [index[kept], node[kept], new_position[clip_at[clip_kept]], clip_lo[:, clip_kept], clip_hi[:, clip_kept]]
+            remaining.append(len(side[0]))
+        return remaining
+
+    def write(self, out: _Refs, below_start: int, above_start: int):
+        """Copy the remaining references into ``out`` from the given positions, clipped bounds too."""
+        refs = self.refs
+        for (index, node, clip_at, clip_lo, clip_hi), start in zip(self.sides, (below_start, above_start)):
+            where = slice(start, start + len(index))
+            out.node[where] = node
+            np.take(refs.prim, index, out=out.prim[where], mode="clip")
+            for axis in range(3):
+                np.take(refs.lo[axis], index, out=out.lo[axis, where], mode="clip")
+                np.take(refs.hi[axis], index, out=out.hi[axis, where], mode="clip")
+            out.lo[:, start + clip_at] = clip_lo
+            out.hi[:, start + clip_at] = clip_hi
 
 
 def _pick_rows(rows: np.ndarray, axis: np.ndarray) -> np.ndarray:
