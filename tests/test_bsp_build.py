@@ -454,3 +454,46 @@ def test_threads_build_the_same_tree(monkeypatch):
     assert np.array_equal(single.nodes, threaded.nodes)
     assert np.array_equal(single.prim_refs, threaded.prim_refs)
     check_leaf_contents(threaded, bounds, tris)
+
+
+def clip_to_half_space(tri, axis, split, sign):
+    """Vertices of the part of a triangle with sign * (p[axis] - split) >= 0 (closed), in float64."""
+    poly = [np.asarray(p, float) for p in tri]
+    out = []
+    for k in range(3):
+        p, q = poly[k], poly[(k + 1) % 3]
+        dp, dq = sign * (p[axis] - split), sign * (q[axis] - split)
+        if dp >= 0:
+            out.append(p)
+        if dp * dq < 0:
+            out.append(p + (q - p) * (dp / (dp - dq)))
+    return np.array(out)
+
+
+def test_triangle_halves_are_bounded_tightly_and_conservatively():
+    """The clipped bounds of straddling triangles, against exact clipping, vertices on the plane included."""
+    from lenslab.render.bsp import _triangle_half_bounds
+
+    rng = np.random.default_rng(9)
+    m = 3000
+    tris = rng.uniform(-3, 3, (m, 3, 3)).astype(np.float32)
+    axis = rng.integers(0, 3, m)
+    split = rng.uniform(-2, 2, m).astype(np.float32)
+    # Put one, two or all three vertices exactly on the plane in some of the triangles.
+    for k in range(m):
+        on_plane = rng.permutation(3)[: [0, 0, 1, 1, 2, 3][k % 6]]
+        tris[k, on_plane, axis[k]] = split[k]
+    below_lo, below_hi, above_lo, above_hi = _triangle_half_bounds(tris, axis, split)
+    for k in range(m):
+        d = tris[k, :, axis[k]].astype(float) - split[k]
+        for sign, lo, hi, present in (
+            (-1, below_lo[:, k], below_hi[:, k], (d < 0).any()),
+            (1, above_lo[:, k], above_hi[:, k], (d > 0).any() or (d == 0).all()),
+        ):
+            if not present:
+                assert np.isnan(lo).all() and np.isnan(hi).all()
+                continue
+            part = clip_to_half_space(tris[k], axis[k], split[k], sign)
+            exact_lo, exact_hi = part.min(axis=0), part.max(axis=0)
+            assert (lo <= exact_lo).all() and (hi >= exact_hi).all(), f"triangle {k} side {sign}"
+            assert np.allclose(lo, exact_lo, atol=1e-4) and np.allclose(hi, exact_hi, atol=1e-4)

@@ -41,13 +41,23 @@ A per-node recursive build in Python costs minutes per million triangles, so the
 every step (binning, prefix sums, choosing the best plane, partitioning) is a whole-array numpy
 operation over (node, axis, bin) keys. The only Python loops run over levels and over the three axes.
 
+Per level: count references per (node, axis, bin) with ``bincount`` over flat keys, sweep prefix
+sums over the bins for every node at once, pick each node's cheapest plane, make leaves of nodes whose
+best split does not beat the leaf cost, and partition the references into the next level. A node
+with at most ``leaf_prims`` references, or at the depth cap, is a leaf without asking the SAH.
+
 When a triangle straddles a plane, each copy gets the bounds of the part of the triangle on its own
 side, intersected with its previous (already clipped) bounds. That keeps the references tight (a
 triangle crossing one corner of a node does not drag the whole node into the next SAH decisions) and
 drops the reference entirely when the triangle's box crosses the plane but the triangle does not.
 Spheres, and all primitives when no triangles are given, are clipped as boxes.
 
-Finally the level-order tree is renumbered depth first with prefix sums over subtree sizes.
+Large levels are cut into runs of whole nodes handled by worker threads (numpy releases the GIL in
+its loops); the result does not depend on the number of threads. Finally the level-order tree is
+renumbered depth first with prefix sums over subtree sizes.
+
+Measured on this project's 2-core machine (``benchmarks/bsp_build.py``): a 1M-triangle terrain
+builds in about 5 s (7.5 s of CPU), with about 3 references per triangle.
 """
 
 from __future__ import annotations
@@ -66,15 +76,14 @@ LEAF = 3
 
 # Default SAH constants, in units of one traversal step.
 #
-# INTERSECTION_COST: a triangle test reads three vec4s and does about twenty flops, a traversal step
-# reads one 8-byte node and may touch the stack; on llvmpipe, whose eight lanes run in lockstep like a
-# GPU's, the two cost about the same, so 1.5 (not pbrt's CPU-tuned 80) keeps trees shallow.
+# INTERSECTION_COST: a triangle test reads three vec4s and does about twenty flops; a traversal step
+# reads one 8-byte node and may touch the stack. On llvmpipe, whose eight lanes run in lockstep like a
+# GPU's, the two cost about the same (docs: GPU-NOTES), so 1.5 rather than pbrt's CPU-tuned 80.
 #
-# EMPTY_BONUS: pbrt's 0.5 spends the depth budget (the cap below) on thin empty slices: on a 1M
-# triangle mesh its leaves end up with dozens of triangles. Wald and Havran (2006) use 0.2. Measured
-# on 100k and 1M triangle meshes with a Python replica of the GLSL traversal, 0.3 needs as few
-# traversal steps and triangle tests per ray as 0.2 and about 30% fewer references; 0.35 and up
-# double the triangle tests per ray at 1M triangles.
+# EMPTY_BONUS: with the depth cap below, pbrt's 0.5 spends the depth on thin empty slices: at 1M
+# triangles its leaves hold dozens of triangles (64 triangle tests per ray against 13 with 0.3, in a
+# Python replica of the GLSL traversal). Wald and Havran's 0.2 saves a few more tests per ray but
+# costs about 50% more references and three times the build time at 1M triangles.
 TRAVERSAL_COST = 1.0
 INTERSECTION_COST = 1.5
 EMPTY_BONUS = 0.3
@@ -125,8 +134,8 @@ def build_kdtree(
     triangles: optional (T, 3, 3) vertices of the first T primitives; used to clip straddling triangles
         exactly to each side of a split, which keeps references per triangle low.
     traversal_cost, intersection_cost, empty_bonus: the SAH constants (see module docstring).
-    max_bins, min_bins: split candidates per axis and node are the boundaries of
-        ``clip(n_refs, min_bins, max_bins)`` equal bins.
+    max_bins, min_bins: split candidates per axis and node are the inner boundaries of about one
+        equal bin per reference, at least ``min_bins`` and at most ``max_bins``.
     leaf_prims: a node with this many references or fewer becomes a leaf without evaluating the SAH.
     max_depth_limit: depth cap (root = 0); ``default_depth_limit(N)`` when None.
     threads: worker threads (numpy releases the GIL in its loops); default: the usable CPU cores.
@@ -134,6 +143,8 @@ def build_kdtree(
     start = time.perf_counter()
     prim_bounds = np.ascontiguousarray(prim_bounds, dtype=np.float32).reshape(-1, 2, 3)
     prim_count = len(prim_bounds)
+    if not np.isfinite(prim_bounds).all() or (prim_bounds[:, 0] > prim_bounds[:, 1]).any():
+        raise ValueError("primitive boxes must be finite with min <= max")
     if triangles is not None:
         triangles = np.ascontiguousarray(triangles, dtype=np.float32).reshape(-1, 3, 3)
         if len(triangles) > prim_count:
@@ -141,7 +152,10 @@ def build_kdtree(
     depth_limit = default_depth_limit(prim_count) if max_depth_limit is None else int(max_depth_limit)
     if not 0 <= depth_limit <= 64:
         raise ValueError("max_depth_limit must lie in [0, 64]")
+    if not 2 <= min_bins <= max_bins:
+        raise ValueError("need 2 <= min_bins <= max_bins")
     costs = _Costs(float(traversal_cost), float(intersection_cost), float(empty_bonus))
+    params = _Params(costs, int(leaf_prims), int(min_bins), int(max_bins), depth_limit, _worker_count(threads))
 
     root = root_bounds(prim_bounds)
     refs = _Refs(
@@ -151,9 +165,8 @@ def build_kdtree(
         hi=np.ascontiguousarray(prim_bounds[:, 1].T),
     )
 
-    workers = _worker_count(threads)
-    with ThreadPoolExecutor(workers) if workers > 1 else nullcontext() as pool:
-        levels = _build_levels(refs, root, triangles, costs, leaf_prims, min_bins, max_bins, depth_limit, pool)
+    with ThreadPoolExecutor(params.workers) if params.workers > 1 else nullcontext() as pool:
+        levels = _build_levels(refs, root, triangles, params, pool)
 
     nodes, prim_refs = _flatten(levels)
     leaf_counts = np.concatenate([lv.counts[lv.is_leaf] for lv in levels])
@@ -180,28 +193,27 @@ def build_kdtree(
     )
 
 
-def _build_levels(refs, root, triangles, costs, leaf_prims, min_bins, max_bins, depth_limit, pool):
+def _build_levels(refs: _Refs, root: np.ndarray, triangles, params: _Params, pool) -> list[_Level]:
     """The build proper: one iteration per tree level, each a few whole-array passes.
 
-    ``refs`` always holds the references of the current level's nodes that are not leaves yet;
-    the references of leaves go to their level's ``leaf_chunks`` as soon as the leaf is known.
+    ``refs`` always holds the references of the current level's nodes that are not leaves yet; the
+    references of a leaf go to its level's ``leaf_chunks`` as soon as the leaf is known.
     """
-    workers = 1 if pool is None else pool._max_workers
+    costs = params.costs
     counts = np.array([len(refs)])
-    # Small nodes and nodes at the depth cap are leaves whatever the SAH says.
-    level = _Level(root[0][:, None].copy(), root[1][:, None].copy(), counts, (counts <= leaf_prims) | (depth_limit == 0))
+    level = _Level(root[0][:, None].copy(), root[1][:, None].copy(), counts, params.forced_leaves(counts, 0))
     levels = [level]
     if level.is_leaf[0]:
         level.leaf_chunks.append((refs.node, refs.prim))
         return levels
     while True:
-        # The SAH decides for the other nodes. Runs of whole nodes go to the worker threads.
-        parts = _node_parts(refs.node, len(level.counts), workers)
+        # The SAH decides for the nodes still open. Runs of whole nodes go to the worker threads.
+        parts = _node_parts(refs.node, len(level.counts), params.workers)
 
         def best_splits(part):
             k0, k1, r0, r1 = part
-            sub = refs.slice(r0, r1, node_offset=k0)
-            return _best_splits(sub, level.lo[:, k0:k1], level.hi[:, k0:k1], costs, min_bins, max_bins)
+            in_part = refs.slice(r0, r1, node_offset=k0)
+            return _best_splits(in_part, level.lo[:, k0:k1], level.hi[:, k0:k1], params)
 
         cost, level.axis, level.split = (np.concatenate(c) for c in zip(*_map(pool, best_splits, parts)))
         level.is_leaf |= ~(cost < costs.intersection * level.counts)
@@ -212,11 +224,17 @@ def _build_levels(refs, root, triangles, costs, leaf_prims, min_bins, max_bins, 
         # Partition the references into the children, in three steps (see _PartSplit).
         child = np.cumsum(~level.is_leaf, dtype=np.int32) - 1  # below child's index; above is S + child
         next_counts = np.zeros(2 * (int(child[-1]) + 1), np.int64)
-        splits = _map(pool, lambda p: _PartSplit(refs.slice(p[2], p[3]), level, child, next_counts, triangles), parts)
-        next_is_leaf = (next_counts <= leaf_prims) | (len(levels) >= depth_limit)
-        carried = np.array(_map(pool, lambda split: split.drop_leaf_refs(next_is_leaf), splits)).reshape(-1, 2)
-        starts = np.cumsum(np.concatenate([carried[:, 0], carried[:, 1]])) - np.concatenate([carried[:, 0], carried[:, 1]])
-        refs = _Refs.empty(int(carried.sum()))
+
+        def split_part(part):
+            return _PartSplit(refs.slice(part[2], part[3]), level, child, next_counts, triangles)
+
+        splits = _map(pool, split_part, parts)
+        next_is_leaf = params.forced_leaves(next_counts, len(levels))
+        remaining = np.array(_map(pool, lambda split: split.drop_leaf_refs(next_is_leaf), splits))
+        # All parts' below references first, then all above ones: the next level in node order.
+        sizes = np.concatenate([remaining[:, 0], remaining[:, 1]])
+        starts = np.cumsum(sizes) - sizes
+        refs = _Refs.empty(int(sizes.sum()))
         _map(pool, lambda i: splits[i].write(refs, starts[i], starts[len(splits) + i]), range(len(splits)))
 
         next_level = _Level(*_child_boxes(level), next_counts, next_is_leaf)
@@ -230,6 +248,7 @@ def _build_levels(refs, root, triangles, costs, leaf_prims, min_bins, max_bins, 
 
 
 def _worker_count(threads: int | None) -> int:
+    """Threads to use: as asked, or the CPU cores this process may run on (at most 8)."""
     if threads is not None:
         return max(1, int(threads))
     try:
@@ -255,6 +274,7 @@ def _node_parts(ref_node: np.ndarray, node_count: int, workers: int):
 
 
 def _map(pool, function, items):
+    """``[function(item) for item in items]``, on the pool's threads when there is more than one."""
     if pool is None or len(items) == 1:
         return [function(item) for item in items]
     return list(pool.map(function, items))
@@ -290,6 +310,20 @@ class _Costs:
     traversal: float
     intersection: float
     empty_bonus: float
+
+
+@dataclass(frozen=True)
+class _Params:
+    costs: _Costs
+    leaf_prims: int
+    min_bins: int
+    max_bins: int
+    depth_limit: int
+    workers: int
+
+    def forced_leaves(self, counts: np.ndarray, depth: int) -> np.ndarray:
+        """Nodes that are leaves whatever the SAH says: few references, or at the depth cap."""
+        return (counts <= self.leaf_prims) | (depth >= self.depth_limit)
 
 
 class _Refs:
@@ -339,13 +373,14 @@ class _Level:
 # Choosing the split planes of one level
 
 
-def _best_splits(refs: _Refs, node_lo, node_hi, costs: _Costs, min_bins: int, max_bins: int):
+def _best_splits(refs: _Refs, node_lo, node_hi, params: _Params):
     """Binned SAH for every node (boxes ``node_lo``, ``node_hi``, (3, K)) of a level at once.
 
     Returns per node the best split's cost (inf where there is none), axis and position.
     """
+    costs = params.costs
     node_count = node_lo.shape[1]
-    slots = _Slots(np.bincount(refs.node, minlength=node_count), min_bins, max_bins)
+    slots = _Slots(np.bincount(refs.node, minlength=node_count), params.min_bins, params.max_bins)
     extent = node_hi - node_lo
     half_area = _half_area(extent)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -621,8 +656,9 @@ def _triangle_half_bounds(vertices, axis, split):
     The part of a triangle on one side is the polygon made of its vertices on that side and the points
     where its edges cross the plane; its bounds are those points' bounds. The below part is empty
     unless a vertex lies strictly below; the above part is empty unless a vertex lies strictly above,
-    or the triangle lies in the plane (which belongs to the above region). Crossing points are computed in float32, so all bounds are padded by a few ulps to
-    stay conservative. Empty parts get NaN bounds.
+    or the triangle lies in the plane (which belongs to the above region). Crossing points are
+    computed in float32, so all bounds are padded by a few ulps to stay conservative. Empty parts get
+    NaN bounds.
     """
     m = len(vertices)
     # (vertex, coordinate, triangle): the last axis is long, so reductions over the others are cheap.
