@@ -27,7 +27,37 @@ uniform int tile_pixels;
 uniform uint sample_start;
 uniform int sample_count;
 uniform uint seed;
+uniform float filter_stddev; // 0: box filter over the pixel; else a gaussian truncated at 4 stddev (Mitsuba's)
 uniform float clamp_max;  // 0: off. Otherwise the most radiance one sample may add (a biased firefly filter)
+
+// Filter importance sampling (pbrt-v4, section 8.8): draw the offset from the pixel centre in proportion to
+// the reconstruction filter and give every sample weight 1, so the filtered image is estimated unbiased.
+float inverse_erf(float x) {  // Giles 2010, single precision
+    float w = -log(max((1.0 - x) * (1.0 + x), 1e-30));
+    float p;
+    if (w < 5.0) {
+        w -= 2.5;
+        p = 2.81022636e-08;
+        p = 3.43273939e-07 + p * w; p = -3.5233877e-06 + p * w; p = -4.39150654e-06 + p * w;
+        p = 0.00021858087 + p * w; p = -0.00125372503 + p * w; p = -0.00417768164 + p * w;
+        p = 0.246640727 + p * w; p = 1.50140941 + p * w;
+    } else {
+        w = sqrt(w) - 3.0;
+        p = -0.000200214257;
+        p = 0.000100950558 + p * w; p = 0.00134934322 + p * w; p = -0.00367342844 + p * w;
+        p = 0.00573950773 + p * w; p = -0.0076224613 + p * w; p = 0.00943887047 + p * w;
+        p = 1.00167406 + p * w; p = 2.83297682 + p * w;
+    }
+    return p * x;
+}
+
+vec2 pixel_offset(vec2 u) {
+    if (filter_stddev <= 0.0) return u - 0.5;  // box
+    // Each axis: a normal distribution truncated at +-4 stddev, by inverting its CDF.
+    const float edge = 0.99993666;  // erf(4 / sqrt(2))
+    vec2 x = (2.0 * u - 1.0) * edge;
+    return filter_stddev * sqrt(2.0) * vec2(inverse_erf(x.x), inverse_erf(x.y));
+}
 
 void main() {
     int local = int(gl_GlobalInvocationID.x);
@@ -39,7 +69,7 @@ void main() {
     for (int k = 0; k < sample_count; k++) {
         Sampler sampler = sampler_start(pixel, sample_start + uint(k), seed);
         vec4 u = sample4(sampler);  // pixel jitter (box filter) and lens position, jointly stratified
-        Ray ray = camera_ray(vec2(pixel) + u.xy, u.zw);
+        Ray ray = camera_ray(vec2(pixel) + 0.5 + pixel_offset(u.xy), u.zw);
         vec3 l = path_radiance(ray, sampler);
         // A NaN or infinity (a degenerate triangle, say) would poison the pixel forever: count it as black.
         if (any(isnan(l)) || any(isinf(l))) l = vec3(0.0);

@@ -44,3 +44,13 @@ def test_mirroring_transform_keeps_front_faces_in_front(tmp_path):
 
     assert outward_fraction(plain) == 1.0
     assert outward_fraction(mirrored) == 1.0
+
+
+def test_disk_keeps_the_area_of_the_circle():
+    from lenslab.scene.shapes import Disk
+
+    mesh = Disk(radius=0.7, segments=12).mesh()
+    tri = mesh.vertices[mesh.faces]
+    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    assert area.sum() == pytest.approx(np.pi * 0.7**2, rel=1e-9)
+    assert np.all(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])[:, 2] > 0)  # front face towards +Z

@@ -155,3 +155,27 @@ def test_six_blade_aperture_gives_a_hexagonal_bokeh(renderer):
     assert harmonic(aperture_blades=6) == pytest.approx(ideal, rel=0.1)
     assert harmonic(aperture_blades=6, blade_rotation_deg=30.0) == pytest.approx(-ideal, rel=0.1)  # blades turn
     assert abs(harmonic(aperture_blades=0)) < 0.1 * ideal
+
+
+@pytest.mark.parametrize("pixel_filter, left, right", [("box", 0.0, 1.0), ("gaussian", 0.1587, 0.8413)])
+def test_pixel_filter_spreads_an_edge_as_the_filter_says(renderer, pixel_filter, left, right):
+    """A sharp edge of light on a pixel boundary: a box filter keeps it, a gaussian of 0.5 px spreads it into
+    the neighbouring pixels as its CDF at -+1 stddev (0.159 and 0.841)."""
+    import dataclasses
+
+    from lenslab.scene.materials import Emissive
+    from lenslab.scene.scene import Node, RenderSettings, Scene
+    from lenslab.scene.shapes import Rectangle
+    from lenslab.scene.transform import Transform
+
+    camera = axis_camera(focal_length_mm=50.0, sensor_mm=(36.0, 36.0), resolution=(32, 32), pinhole=True)
+    half_width = 10.0 * 18.0 / 50.0  # the image half-width at 10 m
+    scene = Scene(camera=camera, render=RenderSettings(max_depth=1, pixel_filter=pixel_filter),
+                  materials={"lamp": Emissive((1.0, 1.0, 1.0))},
+                  nodes=[Node("right half", Transform(translate=(half_width, 0.0, -10.0)),
+                              Rectangle((2 * half_width, 4 * half_width)), "lamp")])
+    image = render(renderer, scene, spp=256, width=32, height=32)
+    assert camera.lens_radius == 0.0
+    columns = image[8:24].mean(axis=0)
+    assert columns[15] == pytest.approx(left, abs=0.02) and columns[16] == pytest.approx(right, abs=0.02)
+    assert columns[:14].max() < 0.01 and columns[18:].min() > 0.99

@@ -83,6 +83,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="PNG only: brighten (+) or darken (-) by this many stops")
     p.add_argument("--tone-map", choices=("clamp", "reinhard", "filmic"), default="clamp",
                    help="PNG only: how radiance above 1 is brought into the displayable range")
+    p.add_argument("-D", dest="defines", action="append", default=[], metavar="NAME=VALUE",
+                   help="Mitsuba XML scenes: set the parameter $NAME, as mitsuba -D does (repeatable)")
     p.add_argument("--device", type=_number(int, 0, 64, "--device"), metavar="N", help="which GPU to use (EGL device index)")
     p.add_argument("--info", action="store_true", help="print the OpenGL device and the limits in use, then exit")
     p.add_argument("--version", action="version", version=f"lenslab {__version__}")
@@ -115,6 +117,20 @@ def _check_output(path_text: str | None) -> Path:
     if not os.access(folder, os.W_OK):
         raise CliError(f"{path}: folder '{folder}' is not writable")
     return path
+
+
+def parse_defines(items: list[str]) -> dict[str, str]:
+    defines = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        if not sep or not name.strip():
+            raise CliError(f"-D {item}: expected NAME=VALUE", EXIT_USAGE)
+        defines[name.strip()] = value
+    return defines
+
+
+def _warn(message: str) -> None:
+    print(f"lenslab: warning: {message}", file=sys.stderr)
 
 
 def _apply_overrides(scene, args):
@@ -185,12 +201,12 @@ def render_headless(args) -> int:
     from lenslab.scene.io.loader import open_scene
 
     output = _check_output(args.output)
-    scene = _apply_overrides(open_scene(args.scene), args)
+    scene = _apply_overrides(open_scene(args.scene, defines=parse_defines(args.defines), warn=_warn), args)
     target_spp = args.spp if args.spp is not None else (None if args.time_limit else scene.render.spp)
     renderer = Renderer(args.device)
     session = RenderSession(renderer, scene, dispatch_seconds=HEADLESS_DISPATCH_SECONDS)
     for warning in session.warnings:
-        print(f"lenslab: warning: {warning}", file=sys.stderr)
+        _warn(warning)
     start = time.perf_counter()
     deadline = start + args.time_limit if args.time_limit else None
     with _progress_display(target_spp, args.time_limit) as bar:

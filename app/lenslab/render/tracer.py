@@ -162,7 +162,8 @@ class RenderSession:
         values = dict(self._gpu_scene.packed.uniforms)
         values.update(camera_uniforms(self.camera, self.width, self.height))
         values.update(max_depth=self.settings.max_depth, rr_depth=self.settings.rr_depth, seed=self.settings.seed,
-                      clamp_max=self.settings.clamp)
+                      clamp_max=self.settings.clamp,
+                      filter_stddev=self.settings.filter_stddev if self.settings.pixel_filter == "gaussian" else 0.0)
         for name, value in values.items():
             if name in program:  # the GLSL compiler drops uniforms a kernel never reads
                 program[name].value = value

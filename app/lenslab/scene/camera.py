@@ -31,6 +31,7 @@ class ThinLensCamera:
     aperture_blades: int = field(default=0, metadata={"range": (0, 32), "doc": "0 = round; otherwise >= 3"})
     blade_rotation_deg: float = field(default=0.0, metadata={"range": (-360.0, 360.0)})
     resolution: tuple[int, int] = field(default=(640, 480), metadata={"range": (1, 16384)})
+    pinhole: bool = field(default=False, metadata={"doc": "an ideal pinhole: everything sharp, the f-number ignored"})
 
     # -- derived quantities -------------------------------------------------------------------------------
     @property
@@ -39,7 +40,7 @@ class ThinLensCamera:
 
     @property
     def lens_radius(self) -> float:
-        return lens_radius_m(self.focal_length_mm, self.f_number)
+        return 0.0 if self.pinhole else lens_radius_m(self.focal_length_mm, self.f_number)
 
     @property
     def aspect(self) -> float:

@@ -13,7 +13,7 @@ import numpy as np
 
 from lenslab.scene.materials import Material
 from lenslab.scene.scene import DEFAULT_MATERIAL, Node, Scene, SceneError
-from lenslab.scene.shapes import Box, MeshFile, Rectangle, Sphere, TriangleMesh
+from lenslab.scene.shapes import Box, Disk, MeshFile, Rectangle, Sphere, TriangleMesh
 from lenslab.scene.io.meshes import LoadedMesh, MeshLoadError, MeshPart
 from lenslab.scene.transform import transform_normals, transform_points
 
@@ -66,7 +66,7 @@ def _flat_normals(corners: np.ndarray) -> np.ndarray:
 
 def _mesh_parts(scene: Scene, node: Node, loader) -> LoadedMesh:
     shape = node.shape
-    if isinstance(shape, (Rectangle, Box)):
+    if isinstance(shape, (Rectangle, Disk, Box)):
         return LoadedMesh((MeshPart(shape.mesh()),))
     assert isinstance(shape, MeshFile)
     path = Path(shape.file)

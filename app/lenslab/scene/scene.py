@@ -83,6 +83,9 @@ class RenderSettings:
     rr_depth: int = field(default=5, metadata={"range": (1, 1024), "doc": "path length at which Russian roulette starts"})
     seed: int = field(default=0, metadata={"range": (0, 2**31 - 1)})
     sampler: str = field(default="sobol", metadata={"choices": ("sobol", "independent")})
+    pixel_filter: str = field(default="box", metadata={"choices": ("box", "gaussian"),
+                                                      "doc": "how samples are spread over a pixel"})
+    filter_stddev: float = field(default=0.5, metadata={"range": (0.05, 4.0), "doc": "gaussian: standard deviation in pixels"})
     clamp: float = field(default=0.0, metadata={"range": (0.0, 1e9), "doc": "0 = off (unbiased); else the most "
                                                  "radiance one sample may add, to tame fireflies (biased)"})
 

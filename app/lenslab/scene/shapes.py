@@ -56,6 +56,26 @@ class Rectangle(Shape):
 
 
 @dataclass
+class Disk(Shape):
+    """A disk in the local XY plane, centred at the origin, its front face towards +Z (as Mitsuba's disk)."""
+
+    type_name: ClassVar[str] = "disk"
+    radius: float = field(default=0.5, metadata={"range": (1e-9, 1e9), "doc": "metres"})
+    segments: int = field(default=128, metadata={"range": (3, 4096), "doc": "edges of the polygon that stands in for it"})
+
+    def mesh(self) -> TriangleMesh:
+        # A polygon with the disk's area (not inscribed in it), so that an emitting disk keeps its power.
+        n = self.segments
+        r = self.radius * np.sqrt(2 * np.pi / (n * np.sin(2 * np.pi / n)))
+        angles = 2 * np.pi * np.arange(n) / n
+        rim = np.stack([r * np.cos(angles), r * np.sin(angles), np.zeros(n)], axis=1)
+        vertices = np.vstack([[0.0, 0.0, 0.0], rim])
+        faces = np.stack([np.zeros(n, int), 1 + np.arange(n), 1 + (np.arange(n) + 1) % n], axis=1)
+        uvs = 0.5 + 0.5 * vertices[:, :2] / max(r, 1e-30)
+        return TriangleMesh(vertices, faces, None, uvs)
+
+
+@dataclass
 class Box(Shape):
     """An axis-aligned box centred at the origin, faces pointing outwards."""
 
@@ -80,4 +100,4 @@ class MeshFile(Shape):
     smooth: bool = field(default=True, metadata={"doc": "interpolate vertex normals (false: flat facets)"})
 
 
-SHAPE_TYPES: dict[str, type[Shape]] = {cls.type_name: cls for cls in (Sphere, Rectangle, Box, MeshFile)}
+SHAPE_TYPES: dict[str, type[Shape]] = {cls.type_name: cls for cls in (Sphere, Rectangle, Disk, Box, MeshFile)}

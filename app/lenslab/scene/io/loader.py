@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import Callable
 
 from lenslab.resources import scenes_dir
 from lenslab.scene.io.native import SCENE_SUFFIX, load_scene
@@ -30,15 +31,18 @@ def resolve_scene_path(text: str | os.PathLike) -> Path:
     raise SceneError(f"{text}: no such scene file (or a shipped scene: {names})")
 
 
-def open_scene(text: str | os.PathLike) -> Scene:
+def open_scene(text: str | os.PathLike, defines: dict[str, str] | None = None,
+               warn: Callable[[str], None] | None = None) -> Scene:
+    """Load a native (.json) or Mitsuba 3 (.xml) scene. ``defines`` are Mitsuba's ``-D name=value``
+    parameters; ``warn`` receives one line per thing an importer approximates or leaves out."""
     path = resolve_scene_path(text)
     suffix = path.suffix.lower()
-    if suffix == SCENE_SUFFIX:
-        return load_scene(path)
     if suffix == ".xml":
-        try:
-            from lenslab.scene.io.mitsuba_xml import load_mitsuba_scene
-        except ImportError:
-            raise SceneError(f"{path}: Mitsuba XML scenes are not supported by this version") from None
-        return load_mitsuba_scene(path)
-    raise SceneError(f"{path}: unknown scene type '{path.suffix}' (expected {SCENE_SUFFIX} or .xml)")
+        from lenslab.scene.io.mitsuba_xml import load_mitsuba_scene  # only Mitsuba users pay for the importer
+
+        return load_mitsuba_scene(path, defines=defines, warn=warn)
+    if suffix != SCENE_SUFFIX:
+        raise SceneError(f"{path}: unknown scene type '{path.suffix}' (expected {SCENE_SUFFIX} or .xml)")
+    if defines:
+        raise SceneError(f"{path}: -D parameters apply to Mitsuba XML scenes only")
+    return load_scene(path)
