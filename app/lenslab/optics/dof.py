@@ -38,7 +38,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .thinlens import MM_PER_M
+from .thinlens import MM_PER_M, require_positive
 
 __all__ = [
     "COC_DIAGONAL_DIVISOR",
@@ -74,21 +74,14 @@ class DepthOfField:
     total_m: float
 
 
-def _positive(name: str, value: float) -> float:
-    value = float(value)
-    if not (value > 0.0 and math.isfinite(value)):
-        raise ValueError(f"{name} must be a positive finite number, got {value!r}")
-    return value
-
-
 def circle_of_confusion_mm(sensor_width_mm: float, sensor_height_mm: float) -> float:
     """Acceptable circle of confusion (mm): sensor diagonal / 1500.
 
     36 x 24 mm -> 0.0288 mm (the familiar "0.029" / "0.03"); APS-C 23.5 x 15.6
     -> 0.0188 mm.  See :data:`COC_DIAGONAL_DIVISOR` for why 1500.
     """
-    w = _positive("sensor_width_mm", sensor_width_mm)
-    h = _positive("sensor_height_mm", sensor_height_mm)
+    w = require_positive("sensor_width_mm", sensor_width_mm)
+    h = require_positive("sensor_height_mm", sensor_height_mm)
     return math.hypot(w, h) / COC_DIAGONAL_DIVISOR
 
 
@@ -99,9 +92,9 @@ def hyperfocal_distance_m(focal_length_mm: float, f_number: float, coc_mm: float
     Example: 50 mm, f/8, c = 0.029 mm -> 10.83 m.  The renderer's planar model
     has ``H0 = H - f`` (use ``depth_of_field(..., model="planar").hyperfocal_m``).
     """
-    f = _positive("focal_length_mm", focal_length_mm)
-    n = _positive("f_number", f_number)
-    c = _positive("coc_mm", coc_mm)
+    f = require_positive("focal_length_mm", focal_length_mm)
+    n = require_positive("f_number", f_number)
+    c = require_positive("coc_mm", coc_mm)
     return (f * f / (n * c) + f) / MM_PER_M
 
 
@@ -120,10 +113,10 @@ def depth_of_field(
     ``model="thin_lens"`` needs ``focus_distance_m`` beyond the focal length
     (nearer than that a real lens forms no image).
     """
-    f = _positive("focal_length_mm", focal_length_mm)
-    n = _positive("f_number", f_number)
-    s = _positive("focus_distance_m", focus_distance_m) * MM_PER_M
-    c = _positive("coc_mm", coc_mm)
+    f = require_positive("focal_length_mm", focal_length_mm)
+    n = require_positive("f_number", f_number)
+    s = require_positive("focus_distance_m", focus_distance_m) * MM_PER_M
+    c = require_positive("coc_mm", coc_mm)
     if model == "thin_lens":
         if s <= f:
             raise ValueError(

@@ -37,7 +37,7 @@ __all__ = [
 MM_PER_M = 1000.0
 
 
-def _require_positive(name: str, value: float) -> float:
+def require_positive(name: str, value: float) -> float:
     value = float(value)
     if not (value > 0.0 and math.isfinite(value)):
         raise ValueError(f"{name} must be a positive finite number, got {value!r}")
@@ -51,8 +51,8 @@ def field_of_view_x(focal_length_mm: float, sensor_width_mm: float) -> float:
     derive from a 35 mm-equivalent focal length.  Example: 50 mm on a 36 mm
     wide sensor gives 39.6 degrees.
     """
-    f = _require_positive("focal_length_mm", focal_length_mm)
-    w = _require_positive("sensor_width_mm", sensor_width_mm)
+    f = require_positive("focal_length_mm", focal_length_mm)
+    w = require_positive("sensor_width_mm", sensor_width_mm)
     return 2.0 * math.atan(w / (2.0 * f))
 
 
@@ -66,7 +66,7 @@ def focal_length_for_fov(fov_x_rad: float, sensor_width_mm: float) -> float:
     fov = float(fov_x_rad)
     if not (0.0 < fov < math.pi):
         raise ValueError(f"fov_x_rad must lie in (0, pi), got {fov!r}")
-    w = _require_positive("sensor_width_mm", sensor_width_mm)
+    w = require_positive("sensor_width_mm", sensor_width_mm)
     return w / (2.0 * math.tan(fov / 2.0))
 
 
@@ -77,8 +77,8 @@ def lens_radius_m(focal_length_mm: float, f_number: float) -> float:
     it, converted from mm to m because the lens disk lives in scene space.
     Example: 50 mm at f/2 -> 0.0125 m.
     """
-    f = _require_positive("focal_length_mm", focal_length_mm)
-    n = _require_positive("f_number", f_number)
+    f = require_positive("focal_length_mm", focal_length_mm)
+    n = require_positive("f_number", f_number)
     return f / (2.0 * n) / MM_PER_M
 
 

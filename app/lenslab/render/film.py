@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from lenslab.atomic import atomic_path
+from lenslab.color import linear_to_srgb
 
 EXPORT_SUFFIXES = (".exr", ".png")
 TONE_MAPS = ("clamp", "reinhard", "filmic")
@@ -31,11 +32,6 @@ def resolve(accumulation: np.ndarray) -> np.ndarray:
 def merge(*accumulations: np.ndarray) -> np.ndarray:
     """Combine partial renders of the same view (different seeds): sums and counts add."""
     return np.sum(accumulations, axis=0)
-
-
-def linear_to_srgb(x: np.ndarray) -> np.ndarray:
-    x = np.clip(x, 0.0, 1.0)
-    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
 
 
 def _filmic(x: np.ndarray) -> np.ndarray:

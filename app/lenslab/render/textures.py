@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lenslab.color import srgb_to_linear
 from lenslab.scene.textures import Checkerboard, ImageTexture, InlineImageTexture, Texture
 
 log = logging.getLogger("lenslab.textures")
@@ -22,10 +23,6 @@ RECORD_ROWS = 4  # vec4 rows per texture record (glsl/textures.glsl)
 MAX_SIDE = 4096  # larger images are downsampled: one storage buffer holds all texels
 MISSING = Checkerboard(color_a=(1.0, 0.0, 1.0), color_b=(0.0, 0.0, 0.0), tiles=(16.0, 16.0))
 FLOAT_FORMATS = ("half", "float", "double")
-
-
-def srgb_to_linear(c: np.ndarray) -> np.ndarray:
-    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
 
 
 def read_texture_image(path: Path, color_space: str = "auto") -> np.ndarray:

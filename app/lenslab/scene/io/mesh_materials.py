@@ -58,6 +58,8 @@ from pathlib import Path
 
 import numpy as np
 
+from lenslab.color import srgb_to_linear
+
 from lenslab.scene.io.meshes import LoadedMesh, MeshLoadError, MeshPart
 from lenslab.scene.materials import Conductor, Dielectric, Diffuse, Emissive, Material, Plastic
 from lenslab.scene.shapes import TriangleMesh
@@ -215,11 +217,6 @@ class NoMaterials:
 # ---------------------------------------------------------------------------------------------------------
 # Shared helpers
 # ---------------------------------------------------------------------------------------------------------
-def srgb_to_linear(c: np.ndarray) -> np.ndarray:
-    c = np.clip(c, 0.0, 1.0)
-    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
-
-
 def conductor_from_f0(f0, roughness: float, roughness_texture: Texture | None = None) -> Conductor:
     """A metal whose reflectance at normal incidence is ``f0``: eta = 1, k = 2 sqrt(F0 / (1 - F0)).
 
