@@ -497,3 +497,16 @@ def test_triangle_halves_are_bounded_tightly_and_conservatively():
             exact_lo, exact_hi = part.min(axis=0), part.max(axis=0)
             assert (lo <= exact_lo).all() and (hi >= exact_hi).all(), f"triangle {k} side {sign}"
             assert np.allclose(lo, exact_lo, atol=1e-4) and np.allclose(hi, exact_hi, atol=1e-4)
+
+
+def test_empty_cuts_lie_on_the_geometry():
+    """Cuts that leave one side empty sit on a primitive's bound, not on a bin boundary nearby."""
+    rng = np.random.default_rng(10)
+    lo = np.concatenate([rng.uniform(0, 1, (200, 3)), rng.uniform(40, 41, (200, 3))])
+    bounds = np.stack([lo, lo + rng.uniform(0.01, 0.1, (400, 3))], 1).astype(np.float32)
+    tree = build_kdtree(bounds)
+    interior = (tree.nodes[:, 1] & 3) != LEAF
+    splits = tree.nodes[interior, 0].view(np.float32)
+    on_geometry = np.concatenate([bounds[:, 0].ravel(), np.nextafter(bounds[:, 1].ravel(), np.float32(np.inf))])
+    assert np.isin(splits, on_geometry).sum() >= 6, "the two clusters are cut free on all sides"
+    check_leaf_contents(tree, bounds)

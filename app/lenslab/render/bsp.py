@@ -44,7 +44,9 @@ operation over (node, axis, bin) keys. The only Python loops run over levels and
 Per level: count references per (node, axis, bin) with ``bincount`` over flat keys, sweep prefix
 sums over the bins for every node at once, pick each node's cheapest plane, make leaves of nodes whose
 best split does not beat the leaf cost, and partition the references into the next level. A node
-with at most ``leaf_prims`` references, or at the depth cap, is a leaf without asking the SAH.
+with at most ``leaf_prims`` references, or at the depth cap, is a leaf without asking the SAH. A
+cut that leaves one side empty is moved from its bin boundary onto the geometry, as an exact-edge
+SAH would place it.
 
 When a triangle straddles a plane, each copy gets the bounds of the part of the triangle on its own
 side, intersected with its previous (already clipped) bounds. That keeps the references tight (a
@@ -89,6 +91,7 @@ INTERSECTION_COST = 1.5
 EMPTY_BONUS = 0.3
 
 MIN_REFS_PER_THREAD = 100_000  # smaller levels are not worth handing to threads
+MIN_EXTENT = np.float32(1e-30)  # nodes thinner than this are not split along that axis
 
 
 @dataclass(frozen=True)
@@ -123,7 +126,7 @@ def build_kdtree(
     empty_bonus: float = EMPTY_BONUS,
     max_bins: int = 64,
     min_bins: int = 4,
-    leaf_prims: int = 4,
+    leaf_prims: int = 6,
     max_depth_limit: int | None = None,
     threads: int | None = None,
 ) -> KdTree:
@@ -389,12 +392,14 @@ def _best_splits(refs: _Refs, node_lo, node_hi, params: _Params):
     ref_first = slots.first[refs.node]
     axis_cost = np.full((3, node_count), np.inf, np.float32)
     axis_bin = np.zeros((3, node_count), np.int64)
+    axis_empty = np.zeros((3, node_count), np.int8)
     for axis in range(3):
         e = extent[axis]
+        splittable = e > MIN_EXTENT
         with np.errstate(divide="ignore", invalid="ignore"):
             # Shrunk by 2^-20 so that the node's far face, where bounds may lie, still falls in the
             # last bin despite rounding: no clamping needed, as bounds never leave their node.
-            bins_per_unit = np.where(e > 0, slots.bins / e * (1 - 2.0**-20), 0).astype(np.float32)
+            bins_per_unit = np.where(splittable, slots.bins / e * (1 - 2.0**-20), 0).astype(np.float32)
         origin, scale = node_lo[axis][refs.node], bins_per_unit[refs.node]
         starts = _bin_histogram(refs.lo[axis], origin, scale, ref_first, slots.count)
         ends = _bin_histogram(refs.hi[axis], origin, scale, ref_first, slots.count)
@@ -403,9 +408,9 @@ def _best_splits(refs: _Refs, node_lo, node_hi, params: _Params):
             u, v = extent[(axis + 1) % 3, nodes], extent[(axis + 2) % 3, nodes]
             with np.errstate(invalid="ignore"):
                 side = u * v * inv_area[nodes]
-                spread = np.where(e[nodes] > 0, e[nodes] * (u + v) * inv_area[nodes], np.nan)
-            cost, bin_ = _cheapest_planes(group, starts, ends, side, spread, costs.empty_bonus)
-            axis_cost[axis, nodes], axis_bin[axis, nodes] = cost, bin_
+                spread = np.where(splittable[nodes], e[nodes] * (u + v) * inv_area[nodes], np.nan)
+            cost, bin_, empty = _cheapest_planes(group, starts, ends, side, spread, costs.empty_bonus)
+            axis_cost[axis, nodes], axis_bin[axis, nodes], axis_empty[axis, nodes] = cost, bin_, empty
 
     axis = np.argmin(np.where(np.isnan(axis_cost), np.inf, axis_cost), axis=0)  # first axis on ties
     nodes = np.arange(node_count)
@@ -415,7 +420,33 @@ def _best_splits(refs: _Refs, node_lo, node_hi, params: _Params):
     # Rounding can put the plane of a tiny node on its face; such a split would be useless.
     inside = (split > lo) & (split < hi) & (slots.bins > 1) & np.isfinite(best)
     cost = costs.traversal + costs.intersection * best.astype(np.float64)
+    split = _snap_empty_cuts(refs, axis, split, axis_empty[axis, nodes], lo, hi, slots.refs_per_node)
     return np.where(inside, cost, np.inf), axis.astype(np.int8), split
+
+
+def _snap_empty_cuts(refs: _Refs, axis, split, empty, lo, hi, refs_per_node):
+    """Move the planes of cuts that leave one side empty onto the geometry.
+
+    A bin boundary leaves a sliver of empty space next to the geometry that a later level would cut
+    away again. Snapped to the references' lowest ``lo`` (below side empty: all of them have
+    ``lo >= split`` and go above) or just past their highest ``hi`` (above side empty), one cut
+    removes all of it: tighter empty cuts leave more of the depth budget for real splits (measured:
+    about 10% fewer traversal steps plus triangle tests per ray). ``empty`` is 1 where the below side
+    is empty, 2 where the above side is, per node.
+    """
+    if not empty.any():
+        return split
+    ref_axis = axis[refs.node]
+    first = np.cumsum(refs_per_node) - refs_per_node
+    has_refs = refs_per_node > 0
+    geometry_lo = np.full(len(split), np.inf, np.float32)
+    geometry_hi = np.full(len(split), -np.inf, np.float32)
+    geometry_lo[has_refs] = np.minimum.reduceat(_pick_rows(refs.lo, ref_axis), first[has_refs])
+    geometry_hi[has_refs] = np.maximum.reduceat(_pick_rows(refs.hi, ref_axis), first[has_refs])
+    past_hi = np.nextafter(geometry_hi, np.float32(np.inf))
+    split = np.where((empty == 1) & (geometry_lo > lo) & (geometry_lo < hi), geometry_lo, split)
+    split = np.where((empty == 2) & (past_hi > lo) & (past_hi < hi), past_hi, split)
+    return split.astype(np.float32)
 
 
 class _SlotGroup:
@@ -445,6 +476,7 @@ class _Slots:
     SIZES = np.array([1, 2, 3, 4, 5, 6, 8, 10, 12, 16, 20, 24, 32, 40, 48, 64, 96, 128, 192, 256])
 
     def __init__(self, refs_per_node: np.ndarray, min_bins: int, max_bins: int):
+        self.refs_per_node = refs_per_node
         sizes = np.unique(np.clip(self.SIZES, min_bins, max_bins))
         wanted = np.clip(refs_per_node, min_bins, max_bins)
         size_index = np.searchsorted(sizes, wanted, side="right") - 1
@@ -463,7 +495,8 @@ class _Slots:
 
 
 def _cheapest_planes(group: _SlotGroup, starts, ends, side, spread, empty_bonus):
-    """Best plane of every node of a group along one axis: (relative cost, bin below the plane).
+    """Best plane of every node of a group along one axis: (relative cost, bin below the plane,
+    1 or 2 where the plane leaves the below or the above side empty, else 0).
 
     The relative cost is ``(cost - C_trav) / C_isect``, i.e. ``P_below n_below + P_above n_above``
     (times ``1 - empty_bonus`` when one side is empty), NaN where the axis cannot be split. With e
@@ -473,7 +506,8 @@ def _cheapest_planes(group: _SlotGroup, starts, ends, side, spread, empty_bonus)
     """
     bins = group.bins
     if bins < 2:
-        return np.full(len(group.nodes), np.nan, np.float32), np.zeros(len(group.nodes), np.int64)
+        nothing = np.zeros(len(group.nodes), np.int64)
+        return np.full(len(group.nodes), np.nan, np.float32), nothing, nothing.astype(np.int8)
     # Running sums over the bins: references starting at or below bin b are below the plane after
     # it, those ending above bin b are above it. Exact in float32 (per-node counts).
     n_below = group.block(starts)
@@ -496,7 +530,9 @@ def _cheapest_planes(group: _SlotGroup, starts, ends, side, spread, empty_bonus)
     at = np.zeros(len(group.nodes), np.int64)
     for b in range(bins - 2, -1, -1):
         np.copyto(at, b, where=x[b] == cheapest)
-    return cheapest, at
+    columns = np.arange(len(at))
+    empty = np.where(n_below[at, columns] == 0, 1, np.where(n_above[at, columns] == 0, 2, 0))
+    return cheapest, at, empty.astype(np.int8)
 
 
 def _bin_histogram(coord, origin, scale, first, slot_count) -> np.ndarray:
