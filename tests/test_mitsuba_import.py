@@ -17,8 +17,9 @@ import pytest
 from lenslab.scene.io import mitsuba_values as mv
 from lenslab.scene.io.mitsuba_xml import BSDF_MAPPINGS, load_mitsuba_scene, load_mitsuba_string
 from lenslab.scene.materials import Conductor, Dielectric, Diffuse, Emissive, Plastic, ThinDielectric
-from lenslab.scene.scene import ConstantEnvironment, SceneError
-from lenslab.scene.shapes import Box, MeshFile, Rectangle, Sphere
+from lenslab.scene.lights import PointLight, SunLight
+from lenslab.scene.scene import ConstantEnvironment, EnvironmentMap, SceneError
+from lenslab.scene.shapes import Box, Disk, MeshFile, Rectangle, Sphere
 from lenslab.scene.transform import Transform
 
 DATA = Path(__file__).parent / "data" / "mitsuba"
@@ -260,21 +261,15 @@ def test_primary_rays_through_the_image_match_mitsubas_convention(tmp_path):
     assert np.allclose(cam.position, (1, 2, 3))
 
 
-def test_a_pinhole_is_f128_focused_where_the_scene_blurs_least(tmp_path):
-    # objects between 2 and 8 m in front of the camera: focus at the harmonic mean 2/(1/2 + 1/8) = 3.2 m
+def test_perspective_is_an_ideal_pinhole(tmp_path):
     body = (camera_xml("perspective", 200, 200, '<float name="fov" value="40"/>')
-            + '<shape type="sphere"><point name="center" x="0" y="0" z="-2"/><float name="radius" value="1"/></shape>'
-            + '<shape type="sphere"><point name="center" x="0" y="0" z="2"/><float name="radius" value="1"/></shape>')
+            + '<shape type="sphere"><point name="center" x="0" y="0" z="-2"/><float name="radius" value="1"/></shape>')
     scene, warnings = load(tmp_path, body)
-    assert scene.camera.f_number == 128
-    assert scene.camera.focus_distance_m == pytest.approx(3.2)
-    assert warnings == []  # blur under half a pixel: nothing to say
-    # a very near object makes the blur visible, and says so
-    body = camera_xml("perspective", 2000, 2000, '<float name="fov" value="10"/>') + (
-        '<shape type="sphere"><point name="center" x="0" y="0" z="4.95"/><float name="radius" value="0.01"/></shape>'
-        '<shape type="sphere"><point name="center" x="0" y="0" z="-1000"/></shape>')
-    scene, warnings = load(tmp_path, body)
-    assert "pixels of blur" in only(warnings, "f/128")
+    assert scene.camera.pinhole and scene.camera.lens_radius == 0.0
+    assert scene.camera.fov_x == pytest.approx(math.radians(40))
+    assert warnings == []
+    scene, _ = load(tmp_path, camera_xml("thinlens", 8, 8, '<float name="aperture_radius" value="0.01"/>'))
+    assert not scene.camera.pinhole and scene.camera.lens_radius == pytest.approx(0.01)
 
 
 def test_camera_with_a_mirror_or_scale_warns(tmp_path):
@@ -302,13 +297,14 @@ def test_mitsubas_defaults_where_values_are_omitted(tmp_path):
     assert scene.camera.resolution == (768, 576)
     assert (scene.render.spp, scene.render.max_depth, scene.render.rr_depth) == (4, 1024, 5)
     assert scene.render.sampler == "independent"
-    assert scene.camera.focus_distance_m == 1e4 or scene.camera.f_number == 128
+    assert scene.camera.pinhole
     ball, lamp = scene.nodes
     assert isinstance(ball.shape, Sphere) and ball.shape.radius == 1 and ball.transform == Transform()
     assert scene.materials[ball.material] == Diffuse((0.5, 0.5, 0.5))
     assert scene.materials[lamp.material] == Emissive((1.0, 1.0, 1.0), two_sided=False)
     assert scene.environment == ConstantEnvironment((0.0, 0.0, 0.0))
-    assert "gaussian" in only(warnings, "no <film>")
+    assert (scene.render.pixel_filter, scene.render.filter_stddev) == ("gaussian", 0.5)  # the default film's
+    assert warnings == []
 
 
 def test_defaults_and_substitution_with_defines_winning(tmp_path):
@@ -383,8 +379,7 @@ def test_include_is_relative_to_the_including_file(tmp_path):
 # ---------------------------------------------------------------------------------------------------------
 # Shapes, BSDFs, emitters
 # ---------------------------------------------------------------------------------------------------------
-def test_builtin_shapes_map_onto_ours(tmp_path, monkeypatch):
-    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))  # where the disk's polygon mesh is written
+def test_builtin_shapes_map_onto_ours(tmp_path):
     body = (camera_xml() + '<shape type="rectangle" id="r"/><shape type="cube" id="c"/>'
             '<shape type="sphere" id="s"><point name="center" x="1" y="2" z="3"/><float name="radius" value="0.5"/>'
             '<transform name="to_world"><scale value="2"/></transform></shape><shape type="disk" id="d"/>')
@@ -398,8 +393,9 @@ def test_builtin_shapes_map_onto_ours(tmp_path, monkeypatch):
     area = 0.5 * np.linalg.norm(np.cross(disk[:, 1] - disk[:, 0], disk[:, 2] - disk[:, 0]), axis=1).sum()
     assert area == pytest.approx(math.pi, rel=1e-6)
     assert np.allclose(disk[:, :, 2], 0)
-    assert "polygon of equal area" in only(warnings, "disk")
-    assert Path(d.shape.file).parent == tmp_path / "cache" / "lenslab" / "generated-meshes"
+    assert d.shape == Disk(radius=1.0, segments=128) and warnings == []
+    _, warnings = load(tmp_path, camera_xml() + '<shape type="disk"><boolean name="flip_normals" value="true"/></shape>')
+    assert warnings == []
 
 
 def test_flip_normals_turns_a_rectangle_light_around(tmp_path):
@@ -476,17 +472,63 @@ def test_emitters_area_constant_and_unsupported(tmp_path):
     body = (camera_xml() + '<emitter type="constant"><rgb name="radiance" value="0.5, 0.6, 0.7"/></emitter>'
             '<shape type="rectangle" id="lamp"><bsdf type="diffuse"/><emitter type="area">'
             '<rgb name="radiance" value="10, 8, 6"/></emitter></shape>'
-            '\n<emitter type="point"><point name="position" x="0" y="1" z="0"/></emitter>'
-            '\n<emitter type="envmap"><string name="filename" value="sky.exr"/></emitter>'
-            '\n<emitter type="directional"><vector name="direction" x="0" y="-1" z="0"/></emitter>'
+            '\n<emitter type="spot"><point name="position" x="0" y="1" z="0"/></emitter>'
             '<shape type="sphere" id="ball"/>')
     scene, warnings = load(tmp_path, body)
     assert scene.environment == ConstantEnvironment((0.5, 0.6, 0.7))
     lamp, ball = scene.nodes
     assert scene.materials[lamp.material] == Emissive((10.0, 8.0, 6.0), two_sided=False)
-    for line, kind in [(4, "point"), (5, "envmap"), (6, "directional")]:
-        assert f':{line}: <emitter type="{kind}">' in only(warnings, f'emitter "{kind}"')
+    assert ':4: <emitter type="spot">' in only(warnings, 'emitter "spot"')
     assert "reflects nothing" in only(warnings, "own BSDF")
+    assert len(warnings) == 2 and scene.lights == []
+
+
+def test_point_and_directional_emitters_become_lights(tmp_path):
+    body = (camera_xml() + '<emitter type="point" id="bulb"><point name="position" x="1" y="2" z="3"/>'
+            '<rgb name="intensity" value="5, 6, 7"/></emitter>'
+            '<emitter type="point"><transform name="to_world"><translate x="-1" y="4"/></transform></emitter>'
+            '<emitter type="directional"><vector name="direction" x="0" y="-2" z="0"/>'
+            '<rgb name="irradiance" value="3, 2, 1"/></emitter>'
+            '<emitter type="directional"><transform name="to_world"><lookat origin="0,0,0" target="1,0,0" up="0,1,0"/>'
+            "</transform></emitter>")
+    scene, warnings = load(tmp_path, body)
+    assert warnings == []
+    bulb, default_point, sun, default_sun = scene.lights
+    assert bulb == PointLight(name="bulb", position=(1.0, 2.0, 3.0), intensity=(5.0, 6.0, 7.0))
+    assert default_point.position == (-1.0, 4.0, 0.0) and default_point.intensity == (1.0, 1.0, 1.0)
+    # Mitsuba's direction is where the light goes; a SunLight's points back at the sun
+    assert isinstance(sun, SunLight) and np.allclose(sun.direction, (0, 1, 0))
+    assert sun.irradiance == (3.0, 2.0, 1.0) and sun.angular_diameter_deg == 0.0
+    assert np.allclose(default_sun.direction, (-1, 0, 0)) and default_sun.irradiance == (1.0, 1.0, 1.0)
+
+
+def test_envmap_is_turned_half_a_turn_onto_our_lat_long_convention(tmp_path):
+    (tmp_path / "sky.exr").write_bytes(b"not read while importing")
+    def env(extra=""):
+        scene, warnings = load(tmp_path, camera_xml() + f'<emitter type="envmap"><string name="filename" '
+                               f'value="sky.exr"/>{extra}</emitter>')
+        return scene.environment, warnings
+
+    environment, warnings = env('<float name="scale" value="2.5"/>')
+    assert environment == EnvironmentMap(file="sky.exr", strength=2.5, rotation_deg=180.0) and warnings == []
+    environment, _ = env('<transform name="to_world"><rotate y="1" angle="30"/></transform>')
+    assert environment.rotation_deg == pytest.approx(150.0)
+    # our mapping with that rotation sends every direction to the texel Mitsuba reads (u = atan2(x, -z) / 2pi
+    # of the direction in the map's frame, the inverse of to_world)
+    from lenslab.render.environment import direction_to_uv
+
+    d = np.random.default_rng(1).normal(size=(50, 3))
+    local = d @ mv.rotate_matrix((0, 1, 0), 30.0)[:3, :3]  # inverse rotation applied to each row
+    u_mitsuba = np.mod(np.arctan2(local[:, 0], -local[:, 2]) / (2 * np.pi), 1.0)
+    u_ours = direction_to_uv(d, math.radians(environment.rotation_deg))[:, 0]
+    assert np.allclose(np.mod(u_ours - u_mitsuba + 0.5, 1.0), 0.5, atol=1e-9)
+    _, warnings = env('<transform name="to_world"><rotate x="1" angle="90"/></transform>')
+    assert "about +Y" in only(warnings, "to_world")
+    _, warnings = load(tmp_path, camera_xml() + '<emitter type="constant"/>\n<emitter type="envmap">'
+                       '<string name="filename" value="sky.exr"/></emitter>')
+    assert only(warnings, "one environment").endswith(":3")
+    with pytest.raises(SceneError, match="line 4: <emitter type=\"envmap\">: environment map not found"):
+        load(tmp_path, camera_xml() + '\n<emitter type="envmap"><string name="filename" value="nope.exr"/></emitter>')
 
 
 def test_instances_of_a_shapegroup(tmp_path):
@@ -566,10 +608,16 @@ def test_integrator_sampler_and_film(tmp_path):
                         '<integer name="seed" value="7"/></sampler>')
     assert (scene.render.spp, scene.render.seed, scene.render.sampler) == (64, 7, "sobol")
     assert scene.camera.resolution == (32, 24)
-    _, warnings = settings("", rfilter='<rfilter type="gaussian"/>')
-    assert "box filter" in only(warnings, 'reconstruction filter "gaussian"')
-    _, warnings = settings("", rfilter="")
-    assert "gaussian" in only(warnings, "default reconstruction filter")
+    assert scene.render.pixel_filter == "box"
+    scene, warnings = settings("", rfilter='<rfilter type="gaussian"/>')
+    assert (scene.render.pixel_filter, scene.render.filter_stddev, warnings) == ("gaussian", 0.5, [])
+    scene, warnings = settings("", rfilter='<rfilter type="gaussian"><float name="stddev" value="0.8"/>'
+                               '<float name="radius" value="3"/></rfilter>')
+    assert (scene.render.pixel_filter, scene.render.filter_stddev, warnings) == ("gaussian", 0.8, [])
+    scene, warnings = settings("", rfilter="")  # Mitsuba's default filter: a gaussian, stddev 0.5
+    assert (scene.render.pixel_filter, scene.render.filter_stddev, warnings) == ("gaussian", 0.5, [])
+    scene, warnings = settings("", rfilter='<rfilter type="tent"/>')
+    assert scene.render.pixel_filter == "box" and "box filter" in only(warnings, 'reconstruction filter "tent"')
 
 
 def test_mitsuba_06_scenes_are_upgraded(tmp_path):

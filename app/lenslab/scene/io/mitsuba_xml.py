@@ -27,7 +27,6 @@ Conventions converted here (checked in ``tests/test_mitsuba_import.py``):
 from __future__ import annotations
 
 import copy
-import hashlib
 import logging
 import math
 import os
@@ -42,8 +41,9 @@ import numpy as np
 from lenslab.optics.thinlens import MM_PER_M, focal_length_for_fov
 from lenslab.scene.camera import ThinLensCamera
 from lenslab.scene.materials import Diffuse, Emissive, Material
-from lenslab.scene.scene import ConstantEnvironment, Node, RenderSettings, Scene, SceneError
-from lenslab.scene.shapes import Box, MeshFile, Rectangle, Sphere
+from lenslab.scene.lights import Light, PointLight, SunLight
+from lenslab.scene.scene import ConstantEnvironment, EnvironmentMap, Node, RenderSettings, Scene, SceneError
+from lenslab.scene.shapes import Box, Disk, MeshFile, Rectangle, Sphere
 from lenslab.scene.transform import transform_points
 
 from . import mitsuba_values as mv
@@ -74,6 +74,7 @@ SILENT = {
     "sampler": {"jitter", "scramble_seed", "seed_offset"},
     "shape": {"flip_tex_coords", "flip_normals", "mesh_attributes"},
     "rfilter": {"radius"},
+    "emitter": {"mis_compensation", "sampling_weight"},
 }
 
 
@@ -454,6 +455,8 @@ class _Importer:
         self._names: set[str] = set()
         self._groups: dict[int, list[Node]] = {}
         self.environment = ConstantEnvironment()
+        self._environment_node: XNode | None = None
+        self.lights: list[Light] = []
         self.render = RenderSettings(spp=4, max_depth=1024, rr_depth=5, seed=0, sampler="independent")
         self.resolution = (768, 576)
         self.camera: _Camera | None = None
@@ -644,12 +647,69 @@ class _Importer:
             rgb = p.color("radiance", 1.0, emission=True)
             scale = p.float("scale", 1.0)
             p.finish()
-            old = self.environment.radiance
-            self.environment = ConstantEnvironment(tuple(float(a + b * scale) for a, b in zip(old, rgb)))  # type: ignore[arg-type]
+            old = self.environment
+            if isinstance(old, EnvironmentMap):
+                self.warn(node, "LensLab has one environment: this constant light is dropped beside the envmap "
+                          f"at {self._environment_node.where()}")
+                return
+            self.environment = ConstantEnvironment(tuple(float(a + b * scale) for a, b in zip(old.radiance, rgb)))  # type: ignore[arg-type]
+            self._environment_node = node
+        elif kind == "envmap":
+            self.envmap(node, p)
+        elif kind == "point":
+            intensity = p.color("intensity", 1.0, emission=True)
+            to_world = p.transform("to_world")
+            position = p.vector("position")
+            p.finish()
+            if position is None:
+                position = to_world[:3, 3]
+            name = self.unique_name(node.attrs.get("id") or "point")
+            self.lights.append(PointLight(name=name, position=tuple(float(v) for v in position),
+                                          intensity=_clip_rgb(intensity)))
+        elif kind == "directional":
+            irradiance = p.color("irradiance", 1.0, emission=True)
+            to_world = p.transform("to_world")
+            direction = p.vector("direction")
+            p.finish()
+            # Mitsuba's direction is the way the light travels (default: its local +Z); ours points at the sun.
+            travel = np.asarray(direction if direction is not None else to_world[:3, :3] @ (0.0, 0.0, 1.0), float)
+            if np.linalg.norm(travel) == 0:
+                raise node.error("the direction must not be zero")
+            name = self.unique_name(node.attrs.get("id") or "directional")
+            self.lights.append(SunLight(name=name, direction=tuple(float(-v) for v in travel / np.linalg.norm(travel)),
+                                        irradiance=_clip_rgb(irradiance), angular_diameter_deg=0.0))
         elif kind == "area":
             self.warn(node, "an area emitter must sit inside a <shape>: ignored")
         else:
+            p.finish(silent=set(p.values))
             self.warn(node, f'emitter "{kind}" is not supported yet: ignored (the scene lacks this light)')
+
+    def envmap(self, node: XNode, p: "Props") -> None:
+        """Mitsuba's envmap: u = atan2(x, -z) / 2pi in its local frame, so its left edge (u = 0) looks down -Z
+        where ours has the centre column: the same picture turned half a turn, ``rotation_deg`` 180. A
+        ``to_world`` turning it by theta about +Y gives ``rotation_deg`` 180 - theta."""
+        filename = p.string("filename")
+        scale = p.float("scale", 1.0)
+        to_world = p.transform("to_world")
+        p.finish()
+        if not filename:
+            raise node.error('needs a "filename"')
+        path = self.resolve_file(node, filename)
+        if not path.is_file():
+            raise node.error(f"environment map not found: {path}")
+        linear = to_world[:3, :3]
+        theta = math.degrees(math.atan2(linear[0, 2], linear[0, 0]))
+        if not np.allclose(linear, mv.rotate_matrix((0, 1, 0), theta)[:3, :3], atol=1e-6):
+            self.warn(node, "to_world other than a turn about +Y is not supported: only its turn about +Y is kept")
+        rotation = (180.0 - theta + 180.0) % 360.0 - 180.0
+        if rotation == -180.0:
+            rotation = 180.0
+        if self._environment_node is not None:
+            self.warn(node, "LensLab has one environment: this envmap replaces the "
+                      f"{self._environment_node.label()} at {self._environment_node.where()}")
+        self.environment = EnvironmentMap(file=self._scene_relative(path), strength=float(max(scale, 0.0)),
+                                          rotation_deg=float(rotation))
+        self._environment_node = node
 
     # -- shapes -------------------------------------------------------------------------------------------
     def shape(self, node: XNode) -> list[Node]:
@@ -677,11 +737,10 @@ class _Importer:
         elif kind == "cube":
             shape = Box(size=(2.0, 2.0, 2.0))
         elif kind == "disk":
-            shape = MeshFile(file=str(_disk_mesh_file()), smooth=False)
+            shape = Disk(radius=1.0, segments=DISK_SEGMENTS)  # a polygon of the disk's area
             if flip:
                 local = mv.rotate_matrix((1, 0, 0), 180.0)
                 flip = False
-            self.warn(node, f"disks are not a LensLab shape yet: a {DISK_SEGMENTS}-sided polygon of equal area used")
         elif kind in ("obj", "ply", "stl"):
             filename = p.string("filename")
             if not filename:
@@ -811,8 +870,7 @@ class _Importer:
         if films:
             self.film(films[0])
         else:
-            self.warn(node, "no <film>: Mitsuba's default hdrfilm 768 x 576 with a gaussian filter; LensLab "
-                      "filters with a box")
+            self.render.pixel_filter, self.render.filter_stddev = "gaussian", 0.5  # Mitsuba's default film
         if samplers:
             self.sampler(samplers[0])
         if kind not in ("perspective", "thinlens"):
@@ -853,13 +911,21 @@ class _Importer:
                 self.warn(node, f"{key}: cropped films are not supported: the whole frame is rendered")
         filters = [n for n in p.objects if n.tag == "rfilter"] + [p.take(k) for k in list(p.values) if p.values[k].tag == "rfilter"]
         p.finish()
-        if not filters:
-            self.warn(node, "Mitsuba's default reconstruction filter is a gaussian; LensLab filters with a box "
-                      "(add <rfilter type=\"box\"/> to match)")
+        if not filters:  # Mitsuba's default: a gaussian of standard deviation 0.5 pixels
+            self.render.pixel_filter, self.render.filter_stddev = "gaussian", 0.5
             return
         rfilter = filters[0]
         rp = Props(self, rfilter)
+        if rfilter.type == "gaussian":
+            stddev = rp.float("stddev", 0.5)
+            rp.finish(silent={"radius"})
+            if not 0.05 <= stddev <= 4.0:
+                self.warn(rfilter, f"stddev {stddev:g} is outside LensLab's 0.05-4 pixels: clamped")
+                stddev = min(max(stddev, 0.05), 4.0)
+            self.render.pixel_filter, self.render.filter_stddev = "gaussian", float(stddev)
+            return
         rp.finish(silent=set(rp.values))
+        self.render.pixel_filter = "box"
         if rfilter.type != "box":
             self.warn(rfilter, f'reconstruction filter "{rfilter.type}" is not supported: a box filter is used')
 
@@ -875,7 +941,7 @@ class _Importer:
         # independent stays independent; every stratified or low-discrepancy sampler maps onto our Sobol.
         self.render.sampler = "independent" if node.type == "independent" else "sobol"
 
-    # -- the camera, last: a pinhole needs the scene's extent ---------------------------------------------
+    # -- the camera, last: without a sensor it needs the scene's extent --------------------------------------------
     def make_camera(self) -> ThinLensCamera:
         width, height = self.resolution
         cam = self.camera
@@ -904,17 +970,17 @@ class _Importer:
                       "outside LensLab's 1-2000 mm: clamped")
             focal_mm = min(max(focal_mm, 1.0), 2000.0)
         focus = cam.focus_distance
-        if cam.aperture_radius is None:
-            f_number, focus = self._pinhole(cam, position, forward, focal_mm, width)
-        else:
+        pinhole = cam.aperture_radius is None
+        f_number = 128.0  # a pinhole ignores it; the nearest a lens gets to one, should it be turned off
+        if not pinhole:
             r = cam.aperture_radius
             f_number = focal_mm / MM_PER_M / (2.0 * r) if r > 0 else math.inf
             if not 0.5 <= f_number <= 128.0:
                 self.warn(where, f"aperture_radius {r:g} gives f/{f_number:.4g}, outside LensLab's f/0.5-f/128: clamped")
                 f_number = min(max(f_number, 0.5), 128.0)
-        if not 0.01 <= focus <= 1e6:
+        if not 0.01 <= focus <= 1e6 and not pinhole:
             self.warn(where, f"focus_distance {focus:g} is outside 0.01-1e6: clamped")
-            focus = min(max(focus, 0.01), 1e6)
+        focus = min(max(focus, 0.01), 1e6)
         return ThinLensCamera(
             position=tuple(float(v) for v in position),
             look_at=tuple(float(v) for v in position + forward),
@@ -924,27 +990,8 @@ class _Importer:
             focus_distance_m=float(focus),
             sensor_mm=(SENSOR_WIDTH_MM, SENSOR_WIDTH_MM * height / width),
             resolution=(width, height),
+            pinhole=pinhole,
         )
-
-    def _pinhole(self, cam: _Camera, position, forward, focal_mm: float, width: int) -> tuple[float, float]:
-        """A pinhole as our smallest aperture, f/128, focused where the scene's depth range blurs least."""
-        f_number = 128.0
-        corners = self._bounds_corners()
-        depths = (corners - position) @ forward if len(corners) else np.zeros(0)
-        depths = depths[depths > 0]
-        if len(depths) == 0:
-            return f_number, cam.focus_distance
-        far = float(depths.max())
-        near = max(float(depths.min()), 1e-3 * far, 1e-3)
-        # blur diameter on the sensor is A f |1/s - 1/d|: the harmonic mean of near and far halves the worst.
-        inv_s = 0.5 * (1 / near + 1 / far)
-        aperture_mm = focal_mm / f_number
-        blur_mm = aperture_mm * focal_mm * (1 / near - inv_s) / MM_PER_M
-        blur_px = blur_mm / SENSOR_WIDTH_MM * width
-        if blur_px > 0.5:
-            self.warn(cam.node or self.root, f"a pinhole is rendered at f/128 focused at {1 / inv_s:.4g}: "
-                      f"up to {blur_px:.2g} pixels of blur between depths {near:.3g} and {far:.3g}")
-        return f_number, 1 / inv_s
 
     def _bounds_corners(self) -> np.ndarray:
         from lenslab.scene.io.meshes import MeshLoadError, load_mesh
@@ -958,7 +1005,7 @@ class _Importer:
                 if isinstance(shape, Sphere):
                     r = shape.radius
                     local = np.array([[x, y, z] for x in (-r, r) for y in (-r, r) for z in (-r, r)])
-                elif isinstance(shape, (Rectangle, Box)):
+                elif isinstance(shape, (Rectangle, Box, Disk)):
                     local = shape.mesh().vertices
                 else:
                     path = Path(shape.file)
@@ -1027,29 +1074,8 @@ def _fmt(rgb) -> str:
     return "(" + ", ".join(f"{c:.3g}" for c in rgb) + ")"
 
 
-def _cache_dir() -> Path:
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return Path(base) / "lenslab" / "generated-meshes"
-
-
-def _disk_mesh_file() -> Path:
-    """A unit disk (z = 0, facing +Z) as a polygon of the same area, written once to the cache folder."""
-    n = DISK_SEGMENTS
-    r = math.sqrt(2 * math.pi / (n * math.sin(2 * math.pi / n)))  # polygon area = pi
-    lines = ["# unit disk for LensLab's Mitsuba importer", "v 0 0 0"]
-    for i in range(n):
-        a = 2 * math.pi * i / n
-        lines.append(f"v {r * math.cos(a):.12f} {r * math.sin(a):.12f} 0")
-    lines += [f"f 1 {i + 2} {(i + 1) % n + 2}" for i in range(n)]
-    text = "\n".join(lines) + "\n"
-    digest = hashlib.sha1(text.encode()).hexdigest()[:10]
-    path = _cache_dir() / f"disk-{n}-{digest}.obj"
-    if not path.is_file():
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_suffix(f".{os.getpid()}.tmp")
-        tmp.write_text(text)
-        os.replace(tmp, path)
-    return path
+def _clip_rgb(rgb) -> RGB:
+    return tuple(float(min(max(c, 0.0), 1e9)) for c in rgb)  # type: ignore[return-value]
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -1076,6 +1102,7 @@ def _load(root_loader, display: str, folder: Path, source_path: Path | None,
         render=importer.render,
         materials=importer.materials,
         nodes=importer.nodes,
+        lights=importer.lights,
         source_path=source_path,
     )
 
