@@ -390,6 +390,7 @@ def _best_splits(refs: _Refs, node_lo, node_hi, params: _Params):
         inv_area = np.where(half_area > 0, 1 / half_area, np.nan).astype(np.float32)
 
     ref_first = slots.first[refs.node]
+    ref_origin = np.take(node_lo, refs.node, axis=1)  # all three axes in one gather
     axis_cost = np.full((3, node_count), np.inf, np.float32)
     axis_bin = np.zeros((3, node_count), np.int64)
     axis_empty = np.zeros((3, node_count), np.int8)
@@ -400,7 +401,7 @@ def _best_splits(refs: _Refs, node_lo, node_hi, params: _Params):
             # Shrunk by 2^-20 so that the node's far face, where bounds may lie, still falls in the
             # last bin despite rounding: no clamping needed, as bounds never leave their node.
             bins_per_unit = np.where(splittable, slots.bins / e * (1 - 2.0**-20), 0).astype(np.float32)
-        origin, scale = node_lo[axis][refs.node], bins_per_unit[refs.node]
+        origin, scale = ref_origin[axis], bins_per_unit[refs.node]
         starts = _bin_histogram(refs.lo[axis], origin, scale, ref_first, slots.count)
         ends = _bin_histogram(refs.hi[axis], origin, scale, ref_first, slots.count)
         for group in slots.groups:
@@ -436,13 +437,12 @@ def _snap_empty_cuts(refs: _Refs, axis, split, empty, lo, hi, refs_per_node):
     """
     if not empty.any():
         return split
-    ref_axis = axis[refs.node]
-    first = np.cumsum(refs_per_node) - refs_per_node
-    has_refs = refs_per_node > 0
+    nodes = np.flatnonzero(refs_per_node > 0)
+    first = (np.cumsum(refs_per_node) - refs_per_node)[nodes]
     geometry_lo = np.full(len(split), np.inf, np.float32)
     geometry_hi = np.full(len(split), -np.inf, np.float32)
-    geometry_lo[has_refs] = np.minimum.reduceat(_pick_rows(refs.lo, ref_axis), first[has_refs])
-    geometry_hi[has_refs] = np.maximum.reduceat(_pick_rows(refs.hi, ref_axis), first[has_refs])
+    geometry_lo[nodes] = np.minimum.reduceat(refs.lo, first, axis=1)[axis[nodes], np.arange(len(nodes))]
+    geometry_hi[nodes] = np.maximum.reduceat(refs.hi, first, axis=1)[axis[nodes], np.arange(len(nodes))]
     past_hi = np.nextafter(geometry_hi, np.float32(np.inf))
     split = np.where((empty == 1) & (geometry_lo > lo) & (geometry_lo < hi), geometry_lo, split)
     split = np.where((empty == 2) & (past_hi > lo) & (past_hi < hi), past_hi, split)
