@@ -510,3 +510,15 @@ def test_empty_cuts_lie_on_the_geometry():
     on_geometry = np.concatenate([bounds[:, 0].ravel(), np.nextafter(bounds[:, 1].ravel(), np.float32(np.inf))])
     assert np.isin(splits, on_geometry).sum() >= 6, "the two clusters are cut free on all sides"
     check_leaf_contents(tree, bounds)
+
+
+def test_bad_input_is_refused():
+    good = np.array([[[0, 0, 0], [1, 1, 1]]], np.float32)
+    with pytest.raises(ValueError):
+        build_kdtree(np.array([[[0, 0, 0], [np.nan, 1, 1]]], np.float32))
+    with pytest.raises(ValueError):
+        build_kdtree(np.array([[[1, 0, 0], [0, 1, 1]]], np.float32))  # min > max
+    with pytest.raises(ValueError):
+        build_kdtree(good, triangles=np.zeros((2, 3, 3), np.float32))
+    with pytest.raises(ValueError):
+        build_kdtree(good, max_depth_limit=65)

@@ -39,7 +39,8 @@ Havran 2006) rather than all primitive edges, so one level costs a handful of wh
 A per-node recursive build in Python costs minutes per million triangles, so the build here works one
 *level* at a time: all references of all nodes of a level live in flat arrays, grouped by node, and
 every step (binning, prefix sums, choosing the best plane, partitioning) is a whole-array numpy
-operation over (node, axis, bin) keys. The only Python loops run over levels and over the three axes.
+operation over (node, axis, bin) keys. Python loops run over levels and axes, and over bins where a
+step is one operation on a whole row of nodes; never over primitives or nodes one at a time.
 
 Per level: count references per (node, axis, bin) with ``bincount`` over flat keys, sweep prefix
 sums over the bins for every node at once, pick each node's cheapest plane, make leaves of nodes whose
@@ -58,8 +59,9 @@ Large levels are cut into runs of whole nodes handled by worker threads (numpy r
 its loops); the result does not depend on the number of threads. Finally the level-order tree is
 renumbered depth first with prefix sums over subtree sizes.
 
-Measured on this project's 2-core machine (``benchmarks/bsp_build.py``): a 1M-triangle terrain
-builds in about 5 s (7.5 s of CPU), with about 3 references per triangle.
+Measured on this project's 2-core machine (``benchmarks/bsp_build.py``, a 1M-triangle terrain and
+a 1M-triangle bumpy torus): 7.5 to 10 s of CPU per build, 3.6 to 4 references per triangle, and in a
+Python replica of the GLSL traversal about 55 traversal steps and 8 triangle tests per ray.
 """
 
 from __future__ import annotations
@@ -79,16 +81,21 @@ LEAF = 3
 # Default SAH constants, in units of one traversal step.
 #
 # INTERSECTION_COST: a triangle test reads three vec4s and does about twenty flops; a traversal step
-# reads one 8-byte node and may touch the stack. On llvmpipe, whose eight lanes run in lockstep like a
-# GPU's, the two cost about the same (docs: GPU-NOTES), so 1.5 rather than pbrt's CPU-tuned 80.
+# reads one 8-byte node, branches and may touch the stack. On llvmpipe, whose eight lanes run in
+# lockstep like a GPU's, a step measured about as dear as two triangle tests (114 M tests/s brute
+# force, about 50 M steps/s in a kd-tree kernel), so 1.5 rather than pbrt's CPU-tuned 80.
 #
 # EMPTY_BONUS: with the depth cap below, pbrt's 0.5 spends the depth on thin empty slices: at 1M
 # triangles its leaves hold dozens of triangles (64 triangle tests per ray against 13 with 0.3, in a
 # Python replica of the GLSL traversal). Wald and Havran's 0.2 saves a few more tests per ray but
 # costs about 50% more references and three times the build time at 1M triangles.
+#
+# LEAF_PRIMS: nodes with this many references or fewer are leaves without asking the SAH. 6 rather
+# than 4: the same steps plus tests per ray (within 1%), 15% fewer references, a faster build.
 TRAVERSAL_COST = 1.0
 INTERSECTION_COST = 1.5
 EMPTY_BONUS = 0.3
+LEAF_PRIMS = 6
 
 MIN_REFS_PER_THREAD = 100_000  # smaller levels are not worth handing to threads
 MIN_EXTENT = np.float32(1e-30)  # nodes thinner than this are not split along that axis
@@ -126,7 +133,7 @@ def build_kdtree(
     empty_bonus: float = EMPTY_BONUS,
     max_bins: int = 64,
     min_bins: int = 4,
-    leaf_prims: int = 6,
+    leaf_prims: int = LEAF_PRIMS,
     max_depth_limit: int | None = None,
     threads: int | None = None,
 ) -> KdTree:
