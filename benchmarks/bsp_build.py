@@ -32,7 +32,8 @@ def terrain(triangle_count: int, seed: int = 0) -> np.ndarray:
     y = np.zeros_like(x)
     for octave in range(7):
         f, phase = 0.3 * 2**octave, rng.uniform(0, 2 * np.pi, 3)
-        y += (np.sin(f * x + phase[0]) * np.cos(1.3 * f * z + phase[1]) + 0.5 * np.sin(0.7 * f * (x + z) + phase[2])) / 2**octave
+        ridges = np.sin(f * x + phase[0]) * np.cos(1.3 * f * z + phase[1]) + 0.5 * np.sin(0.7 * f * (x + z) + phase[2])
+        y += ridges / 2**octave
     vertices = np.stack([x, y, z], -1).reshape(-1, 3)
     i = (np.arange(cells)[:, None] * (cells + 1) + np.arange(cells)[None, :]).ravel()
     faces = np.concatenate([np.stack([i, i + 1, i + cells + 2], 1), np.stack([i, i + cells + 2, i + cells + 1], 1)])
@@ -44,17 +45,19 @@ def bumpy_torus(triangle_count: int, seed: int = 0) -> np.ndarray:
     rng = np.random.default_rng(seed)
     minor = max(3, round((triangle_count / 4) ** 0.5))
     major = max(3, round(triangle_count / (2 * minor)))
-    u, v = np.meshgrid(np.linspace(0, 2 * np.pi, major, endpoint=False), np.linspace(0, 2 * np.pi, minor, endpoint=False), indexing="ij")
+    angles = (np.linspace(0, 2 * np.pi, n, endpoint=False) for n in (major, minor))
+    u, v = np.meshgrid(*angles, indexing="ij")
     bumps = sum(
         np.sin(k * u + rng.uniform(0, 6)) * np.sin(m * v + rng.uniform(0, 6)) / (k + m)
         for k, m in rng.integers(1, 40, (12, 2))
     )
     r = 0.35 * (1 + 0.6 * bumps + 0.01 * rng.uniform(-1, 1, u.shape))
-    vertices = np.stack([(1 + r * np.cos(v)) * np.cos(u), r * np.sin(v), (1 + r * np.cos(v)) * np.sin(u)], -1).reshape(-1, 3)
+    ring = 1 + r * np.cos(v)
+    vertices = np.stack([ring * np.cos(u), r * np.sin(v), ring * np.sin(u)], -1).reshape(-1, 3)
     a = np.arange(major)[:, None] * minor
     b = (np.arange(major)[:, None] + 1) % major * minor
     c, d = np.arange(minor)[None, :], (np.arange(minor)[None, :] + 1) % minor
-    faces = np.concatenate([np.stack([a + c, b + c, b + d], -1).reshape(-1, 3), np.stack([a + c, b + d, a + d], -1).reshape(-1, 3)])
+    faces = np.concatenate([np.stack(f, -1).reshape(-1, 3) for f in ([a + c, b + c, b + d], [a + c, b + d, a + d])])
     return vertices[faces].astype(np.float32)
 
 
@@ -63,7 +66,8 @@ def ray_cost(tree, triangles: np.ndarray, ray_count: int, seed: int = 1):
     rng = np.random.default_rng(seed)
     lo, hi = triangles.reshape(-1, 3).min(0), triangles.reshape(-1, 3).max(0)
     origins = rng.normal(size=(ray_count, 3))
-    origins = (lo + hi) / 2 + 0.75 * np.linalg.norm(hi - lo) * origins / np.linalg.norm(origins, axis=1, keepdims=True)
+    origins *= 0.75 * np.linalg.norm(hi - lo) / np.linalg.norm(origins, axis=1, keepdims=True)
+    origins += (lo + hi) / 2
     directions = lo + (hi - lo) * rng.uniform(size=(ray_count, 3)) - origins
     directions /= np.linalg.norm(directions, axis=1, keepdims=True)
     steps = tests = 0
@@ -127,7 +131,9 @@ def main() -> None:
     parser.add_argument("--threads", type=int, default=None)
     args = parser.parse_args()
 
-    header = f"{'mesh':<8} {'triangles':>9} {'wall s':>7} {'cpu s':>6} {'nodes':>9} {'leaves':>9} {'empty':>8} {'refs/tri':>8} {'SAH':>7} {'depth':>6} {'peak MB':>8}"
+    columns = [("mesh", 8), ("triangles", 9), ("wall s", 7), ("cpu s", 6), ("nodes", 9), ("leaves", 9), ("empty", 8)]
+    columns += [("refs/tri", 8), ("SAH", 7), ("depth", 6), ("peak MB", 8)]
+    header = " ".join(f"{name:<{width}}" if name == "mesh" else f"{name:>{width}}" for name, width in columns)
     if args.rays:
         header += f" {'steps/ray':>9} {'tests/ray':>9}"
     print(header)

@@ -190,6 +190,23 @@ def check_leaf_contents(tree, bounds, triangles=None):
 # Ray casting: brute force and through the tree
 
 
+def cross(a, b):
+    """Cross product over the last axis, with elementwise operations only."""
+    return np.stack(
+        [
+            a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
+            a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+            a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0],
+        ],
+        axis=-1,
+    )
+
+
+def dot(a, b):
+    """Dot product over the last axis, always summed in the same order (unlike np.dot or einsum)."""
+    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
+
+
 def intersect(o, d, tris, spheres, prims):
     """Nearest positive hit distance of one ray with the given primitives (inf where none), float64.
 
@@ -202,15 +219,15 @@ def intersect(o, d, tris, spheres, prims):
     if is_tri.any():
         v = tris[prims[is_tri]].astype(float)
         e1, e2 = v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]
-        px, py, pz = d[1] * e2[:, 2] - d[2] * e2[:, 1], d[2] * e2[:, 0] - d[0] * e2[:, 2], d[0] * e2[:, 1] - d[1] * e2[:, 0]
-        det = e1[:, 0] * px + e1[:, 1] * py + e1[:, 2] * pz
-        with np.errstate(divide="ignore", invalid="ignore"):
+        p = cross(np.broadcast_to(d, e2.shape), e2)
+        det = dot(e1, p)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             inv = 1.0 / det
             s = o - v[:, 0]
-            u = (s[:, 0] * px + s[:, 1] * py + s[:, 2] * pz) * inv
-            qx, qy, qz = s[:, 1] * e1[:, 2] - s[:, 2] * e1[:, 1], s[:, 2] * e1[:, 0] - s[:, 0] * e1[:, 2], s[:, 0] * e1[:, 1] - s[:, 1] * e1[:, 0]
-            w = (d[0] * qx + d[1] * qy + d[2] * qz) * inv
-            th = (e2[:, 0] * qx + e2[:, 1] * qy + e2[:, 2] * qz) * inv
+            u = dot(s, p) * inv
+            q = cross(s, e1)
+            w = dot(np.broadcast_to(d, q.shape), q) * inv
+            th = dot(e2, q) * inv
             ok = (det != 0) & (u >= 0) & (w >= 0) & (u + w <= 1) & (th > 1e-9)
         t[is_tri] = np.where(ok, th, np.inf)
     if (~is_tri).any():
@@ -384,8 +401,10 @@ def test_ground_plane_of_flat_triangles():
     assert tree.leaf_count > 16, "a flat ground plane is still split in x and z"
     check_leaf_contents(tree, bounds, tris)
     rng = np.random.default_rng(3)
-    o = np.concatenate([rng.uniform(-2, 2, (100, 1)), np.full((100, 1), 1.0), rng.uniform(-2, 2, (100, 1))], 1)
-    d = np.concatenate([rng.normal(size=(100, 1)) * 0.3, -np.ones((100, 1)), rng.normal(size=(100, 1)) * 0.3], 1)
+    o = rng.uniform(-2, 2, (100, 3))
+    o[:, 1] = 1.0
+    d = rng.normal(size=(100, 3)) * 0.3
+    d[:, 1] = -1.0
     for oo, dd in zip(o, d):
         t_brute = intersect(oo, dd, tris, np.zeros((0, 4)), np.arange(len(tris))).min()
         assert trace_tree(tree, oo, dd, tris, np.zeros((0, 4)))[0] == t_brute
@@ -507,7 +526,8 @@ def test_empty_cuts_lie_on_the_geometry():
     tree = build_kdtree(bounds)
     interior = (tree.nodes[:, 1] & 3) != LEAF
     splits = tree.nodes[interior, 0].view(np.float32)
-    on_geometry = np.concatenate([bounds[:, 0].ravel(), np.nextafter(bounds[:, 1].ravel(), np.float32(np.inf))])
+    just_past = np.nextafter(bounds[:, 1].ravel(), np.float32(np.inf))
+    on_geometry = np.concatenate([bounds[:, 0].ravel(), just_past])
     assert np.isin(splits, on_geometry).sum() >= 6, "the two clusters are cut free on all sides"
     check_leaf_contents(tree, bounds)
 

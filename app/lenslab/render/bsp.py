@@ -165,7 +165,8 @@ def build_kdtree(
     if not 2 <= min_bins <= max_bins:
         raise ValueError("need 2 <= min_bins <= max_bins")
     costs = _Costs(float(traversal_cost), float(intersection_cost), float(empty_bonus))
-    params = _Params(costs, int(leaf_prims), int(min_bins), int(max_bins), depth_limit, _worker_count(threads))
+    workers = _worker_count(threads)
+    params = _Params(costs, int(leaf_prims), int(min_bins), int(max_bins), depth_limit, workers)
 
     root = root_bounds(prim_bounds)
     refs = _Refs(
@@ -359,9 +360,8 @@ class _Refs:
 
     @staticmethod
     def empty(count: int) -> _Refs:
-        return _Refs(
-            np.empty(count, np.int32), np.empty(count, np.int32), np.empty((3, count), np.float32), np.empty((3, count), np.float32)
-        )
+        bounds = (np.empty((3, count), np.float32), np.empty((3, count), np.float32))
+        return _Refs(np.empty(count, np.int32), np.empty(count, np.int32), *bounds)
 
 
 class _Level:
@@ -605,7 +605,8 @@ class _PartSplit:
             clip_at = np.searchsorted(index, straddle[ok])  # where the straddlers are in ``index``
             self.sides.append([index, node, clip_at, part_lo[:, ok], part_hi[:, ok]])
             lo_child = offset + first_child
-            next_counts[lo_child : offset + end_child] = np.bincount(node - lo_child, minlength=end_child - first_child)
+            counts = np.bincount(node - lo_child, minlength=end_child - first_child)
+            next_counts[lo_child : offset + end_child] = counts
 
     def drop_leaf_refs(self, next_is_leaf: np.ndarray):
         """Set aside the references of children that are leaves; returns how many remain per side."""
@@ -619,7 +620,8 @@ class _PartSplit:
                 kept = ~to_leaf
                 new_position = np.cumsum(kept) - 1
                 clip_kept = kept[clip_at]
-                side[:] = [index[kept], node[kept], new_position[clip_at[clip_kept]], clip_lo[:, clip_kept], clip_hi[:, clip_kept]]
+                clip_at = new_position[clip_at[clip_kept]]
+                side[:] = [index[kept], node[kept], clip_at, clip_lo[:, clip_kept], clip_hi[:, clip_kept]]
             remaining.append(len(side[0]))
         return remaining
 
