@@ -36,7 +36,7 @@ def brute_force(flat: FlatScene, origins: np.ndarray, directions: np.ndarray):
         q = np.cross(s, e1[None])
         b2 = np.einsum("rtk,rtk->rt", np.broadcast_to(d, q.shape), q) * inv
         t = np.einsum("tk,rtk->rt", e2, q) * inv
-    ok = (det != 0) & (b1 >= 0) & (b2 >= 0) & (b1 + b2 <= 1) & (t > 0)
+        ok = (det != 0) & (b1 >= 0) & (b2 >= 0) & (b1 + b2 <= 1) & (t > 0)
     t_tri = np.where(ok, t, np.inf)
 
     c, r = flat.spheres[:, :3].astype(np.float64), flat.spheres[:, 3].astype(np.float64)
