@@ -246,6 +246,11 @@ def run(argv: list[str] | None = None) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
+    args_list = sys.argv[1:] if argv is None else list(argv)
+    if args_list[:1] == ["validate"]:
+        from lenslab.validate.cli import main as validate_main
+
+        return validate_main(args_list[1:])
     from lenslab.optics.presetfiles import PresetError
     from lenslab.render.buffers import SceneTooLarge
     from lenslab.render.film import ExportError
