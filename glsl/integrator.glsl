@@ -53,8 +53,18 @@ vec3 path_radiance(Ray ray, inout Sampler sampler) {
             vec3 f = bsdf_eval(s, ls.wi, bsdf_pdf);
             if (max_component(f) > 0.0) {
                 Ray shadow = spawn_ray(s, ls.wi);
-                float t_max = isinf(ls.dist) ? INFINITY : ls.dist * (1.0 - 1e-4);
-                if (!occluded(shadow, t_max)) {
+                float t_max = INFINITY;
+                if (!isinf(ls.dist)) {
+                    // Aim from the nudged origin at the light's point itself, and stop just short of it by
+                    // the same kind of margin: a surface facing the light head-on is nudged towards it,
+                    // and a margin measured from the un-nudged point would let the ray hit the light.
+                    vec3 q = s.p + ls.wi * ls.dist;
+                    vec3 to_q = q - shadow.o;
+                    float len = length(to_q);
+                    shadow.d = to_q / len;
+                    t_max = len - 1e-4 * (1.0 + max_component(abs(q)));
+                }
+                if (t_max > 0.0 && !occluded(shadow, t_max)) {
                     float w = ls.delta ? 1.0 : power_heuristic(ls.pdf, bsdf_pdf);
                     radiance += throughput * f * ls.radiance * (w / ls.pdf);
                 }

@@ -132,6 +132,7 @@ float sun_pdf() { return sun_one_minus_cos > 0.0 ? sun_pmf / (2.0 * PI * sun_one
 
 // -- sampling any light -------------------------------------------------------------------------------
 bool sample_area_light(int prim, vec3 p, vec2 u, out LightSample ls) {
+    ls.delta = false;  // `out` starts undefined: every field must be written
     vec3 q, nq;
     if (is_sphere(prim)) {
         vec4 sphere = geometry[3 * prim];

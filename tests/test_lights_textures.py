@@ -182,3 +182,26 @@ def test_missing_environment_map_warns_and_still_renders(renderer, tmp_path):
     image, warnings = render(renderer, sphere_under_sky(tmp_path / "nowhere.exr"), 2)
     assert len(warnings) == 1 and "nowhere.exr: environment map not found" in warnings[0]
     assert image.max() > 0
+
+
+def test_area_light_straight_above_a_floor_matches_the_form_factor(renderer):
+    """A floor facing a rectangular lamp head-on (the case a shadow ray nudged towards the lamp gets wrong):
+    Lambertian radiance rho L F, with F the view factor from a point to a parallel rectangle centred above it
+    (four corner rectangles of the classic formula)."""
+    from lenslab.scene.materials import Emissive
+
+    radiance, a, b, h = 10.0, 0.5, 0.3, 1.0
+    x, y = a / 2 / h, b / 2 / h
+    corner = (x / math.sqrt(1 + x * x) * math.atan(y / math.sqrt(1 + x * x))
+              + y / math.sqrt(1 + y * y) * math.atan(x / math.sqrt(1 + y * y))) / (2 * math.pi)
+    expected = ALBEDO * radiance * 4 * corner
+    scene = Scene(
+        camera=ThinLensCamera(position=(0, 0.5, 2), look_at=(0, 0, 0), focal_length_mm=400, f_number=16,
+                              focus_distance_m=2, resolution=(16, 16)),
+        render=RenderSettings(max_depth=2),
+        materials={"floor": Diffuse((ALBEDO,) * 3), "lamp": Emissive((radiance,) * 3)},
+        nodes=[Node("floor", Transform(rotate_deg=(-90, 0, 0)), Rectangle((10, 10)), "floor"),
+               Node("lamp", Transform(translate=(0, h, 0), rotate_deg=(90, 0, 0)), Rectangle((a, b)), "lamp")],
+    )
+    image, _ = render(renderer, scene, 64)
+    assert image[6:10, 6:10].mean() == pytest.approx(expected, rel=0.02)
