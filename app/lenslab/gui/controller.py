@@ -60,6 +60,7 @@ class RenderController(QObject):
         self._pick_callbacks: dict[int, Callable] = {}
         self._size = viewport_size(doc.scene.camera.resolution, self.quality)
         self._error_generation = -1
+        self._shut_down = False
         self.worker = RenderWorker(device_index, dispatch_seconds)
         w = self.worker
         w.device_ready.connect(self._device_ready)
@@ -182,10 +183,12 @@ class RenderController(QObject):
     # -- shutting down -----------------------------------------------------------------------------------------
     def shutdown(self, timeout_ms: int = 15000) -> bool:
         """Stop the worker (within a dispatch) and wait for it to release its GL context."""
-        try:
-            self.doc.changed.disconnect(self._on_change)
-        except (RuntimeError, TypeError):
-            pass
+        if not self._shut_down:
+            self._shut_down = True
+            try:
+                self.doc.changed.disconnect(self._on_change)
+            except (RuntimeError, TypeError):
+                pass
         if not self.worker.isRunning():
             return True
         self.worker.stop()

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 import os
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -61,6 +62,9 @@ def studio_settings() -> QSettings:
 
 class MainWindow(QMainWindow):
     closed = Signal()
+    mesh_imported = Signal(str)  # path, once its node is in the scene
+    mesh_import_failed = Signal(str, str)  # path, reason
+    _mesh_loaded = Signal(object, object, str)  # from the loading thread
 
     def __init__(self, scene=None, path: Path | None = None, *, device_index: int | None = None,
                  settings: QSettings | None = None, dispatch_seconds: float = 0.1, restore_layout: bool = True):
@@ -79,6 +83,8 @@ class MainWindow(QMainWindow):
         self._structure_generation = 0
         self._closing = False
         self._hover: tuple[int, int] | None = None
+        self._pending_imports = 0
+        self._mesh_loaded.connect(self._on_mesh_loaded, Qt.QueuedConnection)
 
         self.viewport = Viewport()
         self.viewport.set_display(float(self.settings.value("viewport/exposure", 0.0)),
@@ -737,43 +743,76 @@ class MainWindow(QMainWindow):
         self.doc.set_selection([("material", name)])
 
     def import_dialog(self) -> None:
+        self._warm_up_mesh_library()
         start = str(self.doc.scene.base_dir())
         pattern = "Meshes (" + " ".join("*" + s for s in MESH_SUFFIXES) + ");;All files (*)"
         names, _ = QFileDialog.getOpenFileNames(self, "Import mesh", start, pattern)
         for name in names:
             self.import_mesh(Path(name))
 
-    def import_mesh(self, path: Path) -> bool:
-        """Add a mesh file as a node, placed at the plane of focus and scaled to fit the view if its units are
-        far off (a model in millimetres would otherwise fill the sky)."""
+    def import_mesh(self, path: Path) -> None:
+        """Add a mesh file as a node. The file is read on a background thread (a large mesh, or the first use of
+        the mesh library, takes seconds); the node appears, as one undo step, when it has been read."""
         path = Path(path).resolve()
-        try:
-            mesh = load_mesh(path, True)
-        except MeshLoadError as exc:
-            QMessageBox.critical(self, "Cannot import mesh", str(exc))
-            return False
+        self._pending_imports += 1
+        self.statusBar().showMessage(f"Reading {path.name}…")
+        self.setCursor(Qt.BusyCursor)
+
+        def load() -> None:
+            try:
+                mesh = load_mesh(path, True)
+            except MeshLoadError as exc:
+                self._mesh_loaded.emit(path, None, str(exc))
+            except Exception as exc:  # a broken file can make trimesh raise anything
+                self._mesh_loaded.emit(path, None, f"{path}: cannot read mesh ({exc})")
+            else:
+                self._mesh_loaded.emit(path, mesh, "")
+
+        threading.Thread(target=load, name=f"load {path.name}", daemon=True).start()
+
+    def _on_mesh_loaded(self, path: Path, mesh, error: str) -> None:
+        self._pending_imports -= 1
+        if self._pending_imports == 0:
+            self.unsetCursor()
+        if mesh is None:
+            self.statusBar().clearMessage()
+            self.mesh_import_failed.emit(str(path), error)
+            if not self._closing:
+                QMessageBox.critical(self, "Cannot import mesh", error)
+            return
+        node, scale = self.mesh_node(path, mesh)
+        self.doc.push(AddNodeCommand(self.doc, node, self._insertion_parent(), text=f"Import {path.name}"))
+        note = f", scaled ×{scale:g} to fit the view" if scale != 1.0 else ""
+        self.statusBar().showMessage(f"Imported {path.name}: {mesh.triangle_count:,} triangles{note}", 6000)
+        self.mesh_imported.emit(str(path))
+
+    def mesh_node(self, path: Path, mesh) -> tuple[Node, float]:
+        """A node for a mesh, standing at the plane of focus, scaled to fit the view if its units are far off
+        (a model in millimetres would otherwise fill the sky)."""
         lo, hi = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
         extent = float(np.max(hi - lo)) or 1.0
         wanted = self.view_width_at_focus() * 0.4
         scale = 1.0 if wanted / 10 <= extent <= wanted * 1.5 else wanted / extent
         scale = float(f"{scale:.3g}")
         centre = (lo + hi) / 2
-        base = np.array([centre[0], lo[1], centre[2]])  # stand it on its lowest point
-        at = self.focus_point() - scale * base
-        at[1] = self.focus_point()[1] - scale * (centre[1] - lo[1])
+        at = self.focus_point() - scale * centre
+        at[1] += scale * (centre[1] - lo[1])  # standing on its lowest point at the focus point's height
         file_text = str(path)
         if self.doc.path is not None:
             try:
                 file_text = os.path.relpath(path, Path(self.doc.path).resolve().parent)
             except ValueError:
                 pass
-        node = Node(self.doc.unique_node_name(path.stem), Transform(translate=tuple(float(round(c, 5)) for c in at),
-                                                                  scale=(scale, scale, scale)),
+        node = Node(self.doc.unique_node_name(path.stem),
+                    Transform(translate=tuple(float(round(c, 5)) for c in at), scale=(scale, scale, scale)),
                     MeshFile(file=file_text, smooth=True))
-        self.doc.push(AddNodeCommand(self.doc, node, self._insertion_parent(), text=f"Import {path.name}"))
-        note = f", scaled ×{scale:g} to fit the view" if scale != 1.0 else ""
-        self.statusBar().showMessage(f"Imported {path.name}: {mesh.triangle_count:,} triangles{note}", 6000)
-        return True
+        return node, scale
+
+    def _warm_up_mesh_library(self) -> None:
+        """Start importing the mesh library (trimesh, scipy: seconds the first time) while the user picks a file."""
+        if not getattr(self, "_mesh_library_warming", False):
+            self._mesh_library_warming = True
+            threading.Thread(target=lambda: __import__("trimesh"), name="import trimesh", daemon=True).start()
 
     def delete_selection(self) -> None:
         nodes = self.doc.selected_node_paths()
@@ -922,6 +961,8 @@ class MainWindow(QMainWindow):
 
     def dragEnterEvent(self, event) -> None:
         paths = self._dropped_paths(event)
+        if any(p.suffix.lower() in MESH_SUFFIXES for p in paths):
+            self._warm_up_mesh_library()
         if any(p.suffix.lower() in MESH_SUFFIXES or p.suffix.lower() == SCENE_SUFFIX or p.is_dir() for p in paths):
             event.acceptProposedAction()
 
@@ -931,10 +972,8 @@ class MainWindow(QMainWindow):
         scenes = [p for p in paths if p.suffix.lower() == SCENE_SUFFIX or p.is_dir()]
         event.acceptProposedAction()
         if meshes:
-            self.doc.undo_stack.beginMacro(f"Import {len(meshes)} meshes" if len(meshes) > 1 else f"Import {meshes[0].name}")
             for p in meshes:
                 self.import_mesh(p)
-            self.doc.undo_stack.endMacro()
         elif scenes:
             QTimer.singleShot(0, lambda: self.open_path(scenes[0]))
 
@@ -970,6 +1009,9 @@ class MainWindow(QMainWindow):
         stopped = self.controller.shutdown()
         if not stopped:  # a very long kd-tree build: do not hang the desktop; the process exit will end it
             self.statusBar().showMessage("The renderer is still busy; closing anyway")
+        # The document outlives the widgets by a little while Qt tears the window down: silence it.
+        self.doc.blockSignals(True)
+        self.doc.undo_stack.blockSignals(True)
         event.accept()
         self.closed.emit()
 

@@ -154,7 +154,7 @@ class PropertyEditor(QWidget):
             self.title.setText("Nothing selected")
             self.subtitle.setText("Select something in the scene tree or click it in the viewport (Q: select tool).")
             layout.addStretch(1)
-            self.scroll.setWidget(container)
+            self._set_container(container)
             return
         obj = self.doc.resolve(target)
         kind = target[0]
@@ -181,6 +181,14 @@ class PropertyEditor(QWidget):
             self._add_fields(form, target, (), obj)
             layout.addWidget(section)
         layout.addStretch(1)
+        self._set_container(container)
+
+    def _set_container(self, container: QWidget) -> None:
+        # The old form may hold the very widget whose signal led here: delete it later, not now.
+        old = self.scroll.takeWidget()
+        if old is not None:
+            old.hide()
+            old.deleteLater()
         self.scroll.setWidget(container)
 
     @staticmethod

@@ -1,0 +1,67 @@
+"""Fixtures for the studio's tests: pytest-qt on the offscreen platform, the render worker on llvmpipe.
+
+Windows render tiny images (64 x 48) so that the whole GUI suite stays well under a minute on two cores.
+Every window is closed at the end of its test, and the test fails if its render thread did not stop.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+
+pytest.importorskip("PySide6")
+pytest.importorskip("pytestqt")
+
+SMALL = (64, 48)
+
+
+@pytest.fixture
+def settings(tmp_path):
+    """A QSettings file of the test's own, so that no test reads or writes the user's layout or recent files."""
+    from PySide6.QtCore import QSettings
+
+    return QSettings(str(tmp_path / "studio.ini"), QSettings.IniFormat)
+
+
+@pytest.fixture
+def small_scene():
+    from lenslab.scene.io.loader import open_scene
+
+    scene = open_scene("cornell_box")
+    scene.camera = dataclasses.replace(scene.camera, resolution=SMALL)
+    return scene
+
+
+@pytest.fixture
+def gl_available(renderer):
+    """Skips (with the reason) where no OpenGL 4.3 context can be made; the shared fixture knows how."""
+    return renderer
+
+
+@pytest.fixture
+def make_window(qtbot, settings, gl_available):
+    from lenslab.gui.app import create_application
+    from lenslab.gui.main_window import MainWindow
+
+    create_application()
+    windows = []
+
+    def make(scene, path=None, **kwargs):
+        window = MainWindow(scene, path, settings=settings, restore_layout=False, **kwargs)
+        window.show()
+        windows.append(window)
+        return window
+
+    yield make
+    for window in windows:
+        window.doc.undo_stack.setClean()
+        if window.isVisible():
+            window.close()
+        window.controller.shutdown()
+        assert window.controller.worker.isFinished(), "the render thread did not stop"
+
+
+@pytest.fixture
+def window(make_window, small_scene):
+    return make_window(small_scene)

@@ -1,0 +1,67 @@
+"""Waiting helpers for the studio tests (never sleeps: each waits on a condition with a timeout)."""
+
+from __future__ import annotations
+
+
+def wait_for_frame(qtbot, window, min_spp: int = 1, generation: int | None = None, timeout: int = 20000):
+    """Wait until the viewport shows a frame with at least ``min_spp`` samples (of ``generation`` if given)."""
+
+    def ready():
+        frame = window.controller.last_frame
+        assert frame is not None and not frame.preview
+        assert frame.samples_per_pixel >= min_spp
+        if generation is not None:
+            assert frame.generation >= generation
+
+    qtbot.waitUntil(ready, timeout=timeout)
+    return window.controller.last_frame
+
+
+def wait_for_gbuffer(qtbot, window, timeout: int = 20000):
+    def ready():
+        g = window.viewport.gbuffer
+        assert g is not None and g.generation >= window._structure_generation
+
+    qtbot.waitUntil(ready, timeout=timeout)
+    return window.viewport.gbuffer
+
+
+def cpu_depth(scene, u: float, v: float) -> tuple[float, int]:
+    """Ground truth for click-to-focus, independent of the GPU: the pinhole ray through image point (u, v)
+    intersected with every triangle and sphere in numpy. Returns (depth along the view axis, node index)."""
+    import numpy as np
+
+    flat = scene.flatten()
+    cam = scene.camera
+    d = cam.primary_ray_direction(2 * u - 1, 1 - 2 * v)
+    o = np.asarray(cam.position, float)
+    best_t, best_prim = np.inf, -1
+    tri = flat.triangles.astype(float)
+    if len(tri):
+        e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+        p = np.cross(d, e2)
+        det = np.einsum("ij,ij->i", e1, p)
+        ok = np.abs(det) > 1e-12
+        inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+        s = o - tri[:, 0]
+        bu = np.einsum("ij,ij->i", s, p) * inv
+        q = np.cross(s, e1)
+        bv = (q @ d) * inv
+        t = np.einsum("ij,ij->i", e2, q) * inv
+        hit = ok & (bu >= 0) & (bv >= 0) & (bu + bv <= 1) & (t > 1e-6)
+        if hit.any():
+            i = int(np.argmin(np.where(hit, t, np.inf)))
+            best_t, best_prim = float(t[i]), i
+    for j, (cx, cy, cz, r) in enumerate(flat.spheres.astype(float)):
+        oc = o - (cx, cy, cz)
+        b = float(oc @ d)
+        disc = b * b - (float(oc @ oc) - r * r)
+        if disc >= 0:
+            for t in (-b - disc**0.5, -b + disc**0.5):
+                if 1e-6 < t < best_t:
+                    best_t, best_prim = t, len(tri) + j
+                    break
+    if best_prim < 0:
+        return np.inf, -1
+    forward = -cam.basis()[2]
+    return best_t * float(d @ forward), int(flat.prim_node[best_prim])

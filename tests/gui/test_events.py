@@ -1,0 +1,39 @@
+"""The scene's event emitter: plain Python, no Qt."""
+
+import subprocess
+import sys
+
+import pytest
+
+from lenslab.scene.events import EventEmitter, SceneChange, SceneEvents
+
+
+def test_emitter_calls_connected_callbacks_in_order_and_can_block():
+    emitter = EventEmitter()
+    seen = []
+    emitter.connect(lambda e: seen.append(("a", e)))
+    second = emitter.connect(lambda e: seen.append(("b", e)))
+    emitter.emit(1)
+    with emitter.blocked():
+        emitter.emit(2)
+    emitter.disconnect(second)
+    emitter.emit(3)
+    assert seen == [("a", 1), ("b", 1), ("a", 3)]
+
+
+def test_scene_change_says_whether_the_view_moved():
+    assert not SceneChange("camera", ("camera",), ("f_number",)).geometry
+    assert not SceneChange("camera", ("camera",), ("focus_distance_m",)).geometry
+    assert SceneChange("camera", ("camera",), ("position",)).geometry
+    assert SceneChange("node", ("node", (0,)), ("transform", "translate")).geometry
+    assert not SceneChange("node", ("node", (0,)), ("material",)).geometry
+    assert not SceneChange("material", ("material", "red"), ("albedo",)).geometry
+    with pytest.raises(ValueError):
+        SceneChange("colour")
+
+
+def test_events_module_does_not_import_qt():
+    code = "import sys, lenslab.scene.events; print(any(m.startswith('PySide6') for m in sys.modules))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "False"
+    assert isinstance(SceneEvents().changed, EventEmitter)

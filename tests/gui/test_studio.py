@@ -1,0 +1,356 @@
+"""The studio, driven as a user would (pytest-qt, offscreen, rendering on llvmpipe in its worker thread).
+
+What issue 4 checks: choosing f/2.8 sets the f-number and restarts accumulation; a lens preset sets the focal
+length and clamps the aperture; clicking an object focuses at its depth within 1 %; undo restores each edit;
+export writes a valid file and cancelling writes none; closing with unsaved changes prompts; the window closes
+cleanly while rendering.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import time
+from pathlib import Path
+
+import pytest
+from PySide6.QtCore import QPoint, Qt, QTimer
+from PySide6.QtWidgets import QApplication, QMessageBox, QPushButton
+
+from .helpers import cpu_depth, wait_for_frame, wait_for_gbuffer
+
+pytestmark = pytest.mark.gl
+
+
+def lens_named(window, name):
+    return next(lens for lens in window.camera_panel.lenses if lens.name == name)
+
+
+def lens_button(window, lens):
+    panel = window.camera_panel
+    return panel.lens_buttons[1 + panel.lenses.index(lens)]
+
+
+def click_image(qtbot, window, x: float, y: float):
+    """Click the viewport at image position (x, y) in pixels."""
+    point = window.viewport.image_to_widget(x, y)
+    qtbot.mouseClick(window.viewport, Qt.LeftButton, pos=QPoint(round(point.x()), round(point.y())))
+
+
+# -- aperture --------------------------------------------------------------------------------------------------
+def test_choosing_f28_sets_the_f_number_and_restarts_accumulation(qtbot, window):
+    frames = []
+    window.controller.frame_ready.connect(lambda f: frames.append((f.generation, f.samples_per_pixel, f.preview)))
+    before = wait_for_frame(qtbot, window, min_spp=12)
+    assert window.doc.scene.camera.f_number == 1.8
+    combo = window.camera_panel.aperture_combo
+    with qtbot.waitSignal(window.controller.restarted, timeout=5000) as restart:
+        combo.setCurrentIndex(combo.findText("f/2.8"))
+    assert window.doc.scene.camera.f_number == 2.8
+    generation = restart.args[0]
+    assert generation > before.generation
+    # The first picture of the new generation starts again from a few samples.
+    qtbot.waitUntil(lambda: any(g == generation for g, _s, _p in frames), timeout=10000)
+    first = next((s, p) for g, s, p in frames if g == generation)
+    assert first[1] or first[0] < before.samples_per_pixel
+    assert combo.currentText() == "f/2.8" and window.viewport.hud_text.find("f/2.8") >= 0
+    # The free field takes values off the scale.
+    combo.lineEdit().setText("f/3")
+    combo.lineEdit().editingFinished.emit()
+    assert window.doc.scene.camera.f_number == 3.0
+    # Stepping goes along the third-stop scale from there.
+    window.camera_panel.step_aperture(+1)
+    assert window.doc.scene.camera.f_number == 3.2
+
+
+# -- lens presets ----------------------------------------------------------------------------------------------
+def test_a_lens_preset_sets_the_focal_length_and_clamps_the_aperture(qtbot, window):
+    cam = window.doc.scene.camera
+    assert (cam.focal_length_mm, cam.f_number) == (50.0, 1.8)
+    lens = lens_named(window, "135 mm f/2")
+    qtbot.mouseClick(lens_button(window, lens), Qt.LeftButton)
+    cam = window.doc.scene.camera
+    assert cam.focal_length_mm == 135.0
+    assert cam.f_number == 2.0  # f/1.8 is wider than the lens opens
+    assert cam.aperture_blades == lens.aperture_blades
+    assert window.doc.lens == lens
+    # The aperture scale now stops at the lens's widest: asking for f/1.4 gives f/2.
+    assert window.camera_panel.aperture_combo.itemText(0) == "f/2"
+    window.camera_panel.set_f_number(1.4)
+    assert window.doc.scene.camera.f_number == 2.0
+    # A prime's focal length cannot be changed; a zoom limits it to its range.
+    window.camera_panel.set_focal_length(35.0, False)
+    assert window.doc.scene.camera.focal_length_mm == 135.0
+    zoom = lens_named(window, "24-70 mm f/2.8")
+    window.lens_actions[window.camera_panel.lenses.index(zoom)].trigger()  # the menu entry (Alt+N)
+    cam = window.doc.scene.camera
+    assert cam.focal_length_mm == 70.0 and cam.f_number == 2.8
+    window.camera_panel.set_focal_length(200.0, False)
+    assert window.doc.scene.camera.focal_length_mm == 70.0
+    # Free: no limits again, and one undo puts the previous lens back.
+    qtbot.mouseClick(window.camera_panel.lens_buttons[0], Qt.LeftButton)
+    assert window.doc.lens is None
+    window.camera_panel.set_f_number(1.4)
+    assert window.doc.scene.camera.f_number == 1.4
+    window.doc.undo_stack.undo()
+    window.doc.undo_stack.undo()
+    assert window.doc.lens == zoom
+
+
+# -- click to focus -----------------------------------------------------------------------------------------------
+def test_clicking_an_object_focuses_at_its_depth(qtbot, window):
+    wait_for_frame(qtbot, window)
+    wait_for_gbuffer(qtbot, window)
+    window.set_tool("focus")
+    clicks = []
+    window.viewport.focus_clicked.connect(lambda u, v: clicks.append((u, v)))
+    scene = copy.deepcopy(window.doc.scene)
+    names = [n.name for _p, n in window.doc.walk_nodes()]
+    for x, y, name in ((24.5, 28.5, "tall box"), (40.5, 40.5, "short box"), (36.5, 12.5, "back wall")):
+        before = window.doc.scene.camera.focus_distance_m
+        with qtbot.waitSignal(window.doc.changed, timeout=10000,
+                              check_params_cb=lambda c: c.field == ("focus_distance_m",)):
+            click_image(qtbot, window, x, y)
+        u, v = clicks[-1]
+        truth, node_index = cpu_depth(scene, u, v)
+        focus = window.doc.scene.camera.focus_distance_m
+        assert math.isfinite(truth) and names[node_index] == name
+        assert abs(focus - truth) <= 0.01 * truth, (name, focus, truth)
+        assert abs(focus - before) > 0.01 * truth
+        assert name in window.doc.undo_stack.undoText()
+        assert window.viewport.overlay_visible()  # the plane of focus is shown on the image
+        assert window.doc.undo_stack.undoText().startswith("Focus on")
+    # The focus tool on the background changes nothing.
+    window.viewport.set_zoom(0.25)
+    focus = window.doc.scene.camera.focus_distance_m
+    w = window.viewport
+    qtbot.mouseClick(w, Qt.LeftButton, pos=QPoint(w.width() // 2, w.height() // 2))
+    assert window.doc.scene.camera.focus_distance_m == focus
+
+
+def test_clicking_selects_and_the_viewport_outlines_the_selection(qtbot, window):
+    wait_for_frame(qtbot, window)
+    g = wait_for_gbuffer(qtbot, window)
+    click_image(qtbot, window, 24.5, 28.5)
+    paths = window.doc.node_paths()
+    index = int(g.node_index[28, 24])
+    assert window.doc.selection == [("node", paths[index])]
+    assert window.doc.node(paths[index]).name == "tall box"
+    assert window.viewport._outline is not None
+    # The outliner follows, and its selection drives the property editor.
+    rows = window.scene_tree.selectionModel().selectedRows()
+    assert [window.scene_tree.tree_model.key(i) for i in rows] == [("node", paths[index])]
+    assert window.properties.title.text() == "tall box"
+
+
+# -- editing and undo ---------------------------------------------------------------------------------------------
+def test_undo_restores_each_edit(qtbot, window, tmp_path):
+    doc = window.doc
+    snapshots = [copy.deepcopy(doc.scene)]
+    lenses = [doc.lens]
+
+    def edited():
+        snapshots.append(copy.deepcopy(doc.scene))
+        lenses.append(doc.lens)
+
+    panel = window.camera_panel
+    combo = panel.aperture_combo
+    combo.setCurrentIndex(combo.findText("f/4"))
+    edited()
+    panel.choose_lens(lens_named(window, "85 mm f/1.4"))
+    edited()
+    # Two slider moves in quick succession are one step.
+    panel.focus_slider.setValue(panel.focus_slider.value() + 40)
+    panel.focus_slider.setValue(panel.focus_slider.value() + 40)
+    edited()
+    steps = doc.undo_stack.count()
+    # Move a node through the property editor's transform fields.
+    tall = next(p for p, n in doc.walk_nodes() if n.name == "tall box")
+    doc.set_selection([("node", tall)])
+    translate = window.properties._editors[("transform", "translate")].widget
+    translate.spins[0].setValue(0.05)
+    edited()
+    # Give it another material through the property editor.
+    material = window.properties._editors[("material",)].widget.findChild(type(combo))
+    material.setCurrentIndex(material.findData("red"))
+    edited()
+    assert doc.node(tall).material == "red"
+    # Add, then delete.
+    window.add_primitive("sphere")
+    edited()
+    window.doc.set_selection([("node", (0,))])
+    window.delete_selection()
+    edited()
+    # Import a mesh file.
+    obj = tmp_path / "tetra.obj"
+    obj.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n")
+    with qtbot.waitSignal(window.mesh_imported, timeout=30000):
+        window.import_mesh(obj)  # read on a background thread
+    assert doc.node((len(doc.scene.nodes) - 1,)).shape.file == str(obj.resolve())
+    edited()
+    # Change a material's type (diffuse to emissive keeps its colour).
+    doc.set_selection([("material", "green")])
+    type_combo = window.properties._editors[("__type__",)].widget
+    type_combo.setCurrentIndex(type_combo.findData("emissive"))
+    edited()
+    assert doc.scene.materials["green"].type_name == "emissive"
+
+    assert doc.undo_stack.count() == steps + 6 and steps == 3
+    assert window.isWindowModified()
+    for i in range(len(snapshots) - 1, 0, -1):
+        assert doc.scene == snapshots[i]
+        doc.undo_stack.undo()
+        assert doc.scene == snapshots[i - 1], f"undo of step {i} ({doc.undo_stack.redoText()})"
+        assert doc.lens == lenses[i - 1]
+    assert not window.isWindowModified()
+    while doc.undo_stack.canRedo():
+        doc.undo_stack.redo()
+    assert doc.scene == snapshots[-1]
+    # Ctrl+Z is wired to the same stack.
+    assert window.actions["undo"].shortcut().toString() == "Ctrl+Z"
+    assert "Ctrl+Shift+Z" in [s.toString() for s in window.actions["redo"].shortcuts()]
+
+
+def test_reparenting_in_the_outliner_keeps_the_world_position(window):
+    from lenslab.gui.scene_tree import move_node, world_matrix
+
+    doc = window.doc
+    short = next(p for p, n in doc.walk_nodes() if n.name == "short box")
+    before = world_matrix(doc, short)
+    walls = next(p for p, n in doc.walk_nodes() if n.name == "walls")
+    window.add_primitive("group")  # a new group at the plane of focus
+    group = doc.selected_node_paths()[0]
+    group_name = doc.node(group).name
+    doc.set_value(("node", group), ("transform", "rotate_deg"), (0.0, 30.0, 0.0))
+    short = next(p for p, n in doc.walk_nodes() if n.name == "short box")
+    assert move_node(doc, short, group, 0)
+    moved = next(p for p, n in doc.walk_nodes() if n.name == "short box")
+    assert doc.node(moved[:-1]).name == group_name  # the group moved up one place as the box left
+    assert abs(world_matrix(doc, moved) - before).max() < 1e-6
+    assert not move_node(doc, walls, walls + (0,), 0)  # never into itself
+    doc.undo_stack.undo()
+    assert doc.node(short).name == "short box"
+
+
+# -- export ---------------------------------------------------------------------------------------------------------
+def export_request(window, path, **kwargs):
+    from lenslab.gui.document import copy_scene
+    from lenslab.gui.worker import ExportRequest
+    import dataclasses
+
+    scene = copy_scene(window.doc.scene)
+    scene.camera = dataclasses.replace(scene.camera, resolution=(32, 24))
+    return ExportRequest(scene=scene, path=Path(path), **kwargs)
+
+
+def test_export_writes_a_valid_file_and_cancelling_writes_none(qtbot, window, tmp_path):
+    from lenslab.render.film import read_image
+
+    out = tmp_path / "shot.exr"
+    with qtbot.waitSignal(window.controller.export_finished, timeout=30000) as done:
+        window.start_export(export_request(window, out, target_spp=4))
+        assert window.export_progress_dialog is not None
+    assert done.args[1] == str(out)
+    pixels, metadata = read_image(out)
+    assert pixels.shape == (24, 32, 3)
+    assert metadata["lenslab:SamplesPerPixel"] == 4
+    assert metadata["Exif:FNumber"] == pytest.approx(1.8)
+    assert pixels.max() > 0
+    assert window.export_progress_dialog is None
+
+    png = tmp_path / "shot.png"
+    with qtbot.waitSignal(window.controller.export_finished, timeout=30000):
+        window.start_export(export_request(window, png, seconds=0.3, tone_map="filmic"))
+    assert read_image(png)[0].shape == (24, 32, 3)
+
+    cancelled = tmp_path / "cancelled.png"
+    with qtbot.waitSignal(window.controller.export_progress, timeout=30000):
+        window.start_export(export_request(window, cancelled, target_spp=1_000_000))
+    with qtbot.waitSignal(window.controller.export_cancelled, timeout=10000):
+        window.export_progress_dialog.findChild(QPushButton).click()  # the progress dialog's Cancel button
+    assert not cancelled.exists()
+    left = sorted(p.name for p in tmp_path.iterdir() if p.name != "studio.ini")
+    assert left == ["shot.exr", "shot.png"]  # and no half-written temporary file
+
+
+def test_export_dialog_builds_the_request(window, tmp_path):
+    from lenslab.gui.export_dialog import ExportDialog
+
+    dialog = ExportDialog(window.doc, exposure=0.5, tone_map="reinhard", samples_per_second=1e5)
+    dialog.path_edit.setText(str(tmp_path / "a.png"))
+    dialog.format_combo.setCurrentIndex(0)  # EXR
+    assert dialog.path_edit.text().endswith("a.exr")
+    dialog.width_spin.setValue(128)
+    assert dialog.height_spin.value() == 96  # aspect kept
+    dialog.by_time.setChecked(True)
+    dialog.seconds_spin.setValue(2.5)
+    request = dialog.request()
+    assert request.scene.camera.resolution == (128, 96)
+    assert (request.target_spp, request.seconds) == (None, 2.5)
+    assert window.doc.scene.camera.resolution == (64, 48)  # the document is untouched
+    dialog.path_edit.setText(str(tmp_path / "missing" / "a.png"))
+    assert "does not exist" in dialog.validate()
+
+
+# -- closing -----------------------------------------------------------------------------------------------------------
+def answer_next_prompt(window, button):
+    seen = []
+
+    def answer():
+        box = window._unsaved_box or QApplication.activeModalWidget()
+        if box is None:
+            QTimer.singleShot(20, answer)
+            return
+        seen.append(box.text())
+        box.button(button).click()
+
+    QTimer.singleShot(0, answer)
+    return seen
+
+
+def test_closing_with_unsaved_changes_prompts(qtbot, make_window, small_scene, tmp_path):
+    from lenslab.scene.io.native import load_scene
+
+    window = make_window(small_scene)
+    window.camera_panel.set_f_number(4.0)
+    assert window.isWindowModified() and "*" not in window.windowTitle().replace("[*]", "")
+    seen = answer_next_prompt(window, QMessageBox.Cancel)
+    assert not window.close()
+    assert seen and "Save the changes" in seen[0]
+    assert window.isVisible() and window.controller.worker.isRunning()
+
+    seen = answer_next_prompt(window, QMessageBox.Discard)
+    assert window.close()
+    assert seen and window.controller.worker.isFinished()
+
+    # Save writes the scene before closing.
+    path = tmp_path / "scene.json"
+    window = make_window(copy.deepcopy(small_scene), None)
+    window.doc.saved_as(path)
+    window.camera_panel.set_f_number(5.6)
+    answer_next_prompt(window, QMessageBox.Save)
+    assert window.close()
+    assert load_scene(path).camera.f_number == 5.6
+
+    # No changes: no question.
+    window = make_window(copy.deepcopy(small_scene))
+    assert window.close()
+
+
+def test_the_window_closes_cleanly_while_rendering(qtbot, make_window, small_scene, tmp_path):
+    import dataclasses
+
+    small_scene.camera = dataclasses.replace(small_scene.camera, resolution=(160, 120))
+    window = make_window(small_scene)
+    wait_for_frame(qtbot, window, min_spp=1)
+    assert window.controller.worker.isRunning() and not window.controller.last_frame.converged
+    # An export in flight too: closing cancels it and leaves no file.
+    out = tmp_path / "never.exr"
+    window.start_export(export_request(window, out, target_spp=1_000_000))
+    qtbot.waitSignal(window.controller.export_progress, timeout=20000).wait()
+    start = time.perf_counter()
+    assert window.close()
+    assert window.controller.worker.isFinished()
+    assert time.perf_counter() - start < 5.0
+    assert not out.exists()
+    assert window.settings.value("window/state") is not None  # the layout is remembered
