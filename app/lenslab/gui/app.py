@@ -20,6 +20,7 @@ def create_application(argv: list[str] | None = None):
 
     from lenslab import __version__
     from lenslab.gui.main_window import app_icon
+    from lenslab.gui.qtcompat import guard_true_refcount
     from lenslab.gui.theme import apply_theme
 
     app = QApplication.instance()
@@ -33,6 +34,7 @@ def create_application(argv: list[str] | None = None):
     QGuiApplication.setDesktopFileName(DESKTOP_ID)
     app.setWindowIcon(app_icon())
     apply_theme(app)
+    guard_true_refcount(app)
     return app
 
 

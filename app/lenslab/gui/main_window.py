@@ -69,6 +69,11 @@ class MainWindow(QMainWindow):
     def __init__(self, scene=None, path: Path | None = None, *, device_index: int | None = None,
                  settings: QSettings | None = None, dispatch_seconds: float = 0.1, restore_layout: bool = True):
         super().__init__()
+        from PySide6.QtWidgets import QApplication
+
+        from lenslab.gui.qtcompat import guard_true_refcount
+
+        guard_true_refcount(QApplication.instance())
         self.setObjectName("LensLabMainWindow")
         self.settings = settings if settings is not None else studio_settings()
         self.doc = Document(scene if scene is not None else studio_scene(), path, self)
@@ -271,7 +276,7 @@ class MainWindow(QMainWindow):
         self.splitDockWidget(self.docks["scene"], self.docks["properties"], Qt.Vertical)
         self.tabifyDockWidget(self.docks["camera"], self.docks["history"])
         self.docks["camera"].raise_()
-        self.resizeDocks([self.docks["scene"], self.docks["camera"]], [270, 340], Qt.Horizontal)
+        self.resizeDocks([self.docks["scene"], self.docks["camera"]], [330, 350], Qt.Horizontal)
         self.resizeDocks([self.docks["scene"], self.docks["properties"]], [300, 520], Qt.Vertical)
 
     def _create_menus(self) -> None:
@@ -431,8 +436,7 @@ class MainWindow(QMainWindow):
 
     def _update_hud(self) -> None:
         cam = self.doc.scene.camera
-        lens = f"{self.doc.lens.name} · " if self.doc.lens else ""
-        self.viewport.hud_text = (f"{lens}{cam.focal_length_mm:g} mm · {format_f_number(cam.f_number)} · "
+        self.viewport.hud_text = (f"{cam.focal_length_mm:g} mm · {format_f_number(cam.f_number)} · "
                                   f"focus {format_distance(cam.focus_distance_m)}")
         self.viewport.update()
 

@@ -276,7 +276,7 @@ class PropertyEditor(QWidget):
         layout.addWidget(section)
         doc = material.__doc__ or ""
         if doc and not doc.startswith(type(material).__name__ + "("):
-            layout.addWidget(hint(" ".join(doc.split())))
+            layout.addWidget(hint(" ".join(doc.replace("``", "").split())))
 
     # -- fields ------------------------------------------------------------------------------------------------
     def _add_type_selector(self, form, target, path, obj, base: type, allow_none: bool = False) -> None:

@@ -59,8 +59,8 @@ def focus_overlay(depth: np.ndarray, focus: float, near: float, far: float) -> n
     # a fifth of the depth of field, so that it reads at f/1.4 and at f/22 alike).
     band = max(0.004 * focus, 0.1 * min(far - near, focus) if math.isfinite(far) else 0.004 * focus)
     plane = finite & (np.abs(depth - focus) <= band)
-    out[plane, :3] = (255, 255, 255)
-    out[plane, 3] = 170
+    out[plane, :3] = (225, 255, 235)
+    out[plane, 3] = 120
     return out
 
 
@@ -269,7 +269,8 @@ class Viewport(QWidget):
         if self.message:
             p.setPen(QColor("#f0c0a0"))
             font = QFont(self.font())
-            font.setPointSizeF(font.pointSizeF() * 1.1)
+            if font.pointSizeF() > 0:
+                font.setPointSizeF(font.pointSizeF() * 1.1)
             p.setFont(font)
             p.drawText(self.rect().adjusted(40, 40, -40, -40), Qt.AlignCenter | Qt.TextWordWrap, self.message)
         elif self.qimage is None:
