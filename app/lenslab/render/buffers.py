@@ -16,7 +16,7 @@ import numpy as np
 
 from lenslab.render.bsp import KdTree, build_kdtree
 from lenslab.render.fresnel import internal_diffuse_reflectance
-from lenslab.render.environment import EnvironmentDistribution, environment_power
+from lenslab.render.environment import EnvironmentDistribution, environment_power, infinite_light_power
 from lenslab.render.textures import TextureTable, read_texture_image
 from lenslab.scene.flatten import FlatScene
 from lenslab.scene.materials import Conductor, Diffuse, Dielectric, Emissive, Material, Plastic, ThinDielectric
@@ -124,8 +124,7 @@ def _environment_uniforms(environment: Environment, textures: TextureTable, scen
                 "env_rotation": 0.0, "env_dist_offset": 0, "env_size": (1, 1)}
     if isinstance(environment, ConstantEnvironment):
         uniforms["env_radiance"] = tuple(float(v) for v in environment.radiance)
-        # pbrt-v4's UniformInfiniteLight::Phi: 4 pi^2 r^2 L for a scene of bounding radius r.
-        return uniforms, 4.0 * math.pi**2 * scene_radius**2 * _luminance(environment.radiance)
+        return uniforms, infinite_light_power(4.0 * math.pi * _luminance(environment.radiance), scene_radius)
     if isinstance(environment, EnvironmentMap):
         path = Path(environment.file)
         path = path if path.is_absolute() else textures.base_dir / path
@@ -135,7 +134,7 @@ def _environment_uniforms(environment: Environment, textures: TextureTable, scen
             message = str(exc) if path.exists() else f"{path}: environment map not found"
             textures.warnings.append(f"{message}; lighting with a dim magenta sky instead")
             uniforms["env_radiance"] = MISSING_SKY
-            return uniforms, 4.0 * math.pi**2 * scene_radius**2 * _luminance(MISSING_SKY)
+            return uniforms, infinite_light_power(4.0 * math.pi * _luminance(MISSING_SKY), scene_radius)
         # Without importance sampling (for comparisons) the tables describe a uniform image.
         distribution = EnvironmentDistribution.from_image(rgb if importance else np.ones_like(rgb))
         uniforms.update(
