@@ -354,3 +354,19 @@ def test_the_window_closes_cleanly_while_rendering(qtbot, make_window, small_sce
     assert time.perf_counter() - start < 5.0
     assert not out.exists()
     assert window.settings.value("window/state") is not None  # the layout is remembered
+
+
+def test_an_unrenderable_edit_shows_why_and_undo_recovers(qtbot, window):
+    wait_for_frame(qtbot, window)
+    doc = window.doc
+    window.add_primitive("sphere")
+    sphere = doc.selected_node_paths()[0]
+    with qtbot.waitSignal(window.controller.render_error, timeout=10000,
+                          check_params_cb=lambda message: bool(message)):
+        doc.set_value(("node", sphere), ("transform", "scale"), (1.0, 2.0, 1.0))
+    assert "non-uniform scale" in window.viewport.message
+    with qtbot.waitSignal(window.controller.render_error, timeout=10000,
+                          check_params_cb=lambda message: message == ""):
+        doc.undo_stack.undo()
+    assert window.viewport.message == ""
+    wait_for_frame(qtbot, window, generation=window.controller.generation)

@@ -20,7 +20,7 @@ def create_application(argv: list[str] | None = None):
 
     from lenslab import __version__
     from lenslab.gui.main_window import app_icon
-    from lenslab.gui.qtcompat import guard_true_refcount
+    from lenslab.gui.qtcompat import guard_singletons
     from lenslab.gui.theme import apply_theme
 
     app = QApplication.instance()
@@ -34,7 +34,7 @@ def create_application(argv: list[str] | None = None):
     QGuiApplication.setDesktopFileName(DESKTOP_ID)
     app.setWindowIcon(app_icon())
     apply_theme(app)
-    guard_true_refcount(app)
+    guard_singletons(app)
     return app
 
 
@@ -87,7 +87,24 @@ def run_studio(args) -> int:
     window.show()
     if problem:
         QMessageBox.critical(window, "Cannot open scene", problem)
+    _close_on_interrupt(window)
     return app.exec()
+
+
+def _close_on_interrupt(window) -> None:
+    """Ctrl+C in the terminal closes the window as the close button would (asking about unsaved changes)."""
+    import signal
+
+    from PySide6.QtCore import QTimer
+
+    def interrupted(_signum, _frame):
+        QTimer.singleShot(0, window.close)
+
+    signal.signal(signal.SIGINT, interrupted)
+    # Python runs signal handlers only between bytecodes: give it a moment several times a second.
+    timer = QTimer(window)
+    timer.timeout.connect(lambda: None)
+    timer.start(250)
 
 
 __all__ = ["run_studio", "create_application", "DESKTOP_ID"]

@@ -561,8 +561,9 @@ class CameraPanel(QWidget):
             index = next((i for i, s in enumerate(scale) if math.isclose(s, cam.f_number, rel_tol=1e-3)), -1)
             self.aperture_combo.setCurrentIndex(index)
             self.aperture_combo.setEditText(format_f_number(cam.f_number))
-            self.stop_slider.set_scale(scale)
-            self.stop_slider.set_f_number(cam.f_number)
+            if not self.stop_slider.slider.isSliderDown():  # never fight the hand on the slider
+                self.stop_slider.set_scale(scale)
+                self.stop_slider.set_f_number(cam.f_number)
             self.open_up.setEnabled(cam.f_number > scale[0] * 1.0001)
             self.stop_down.setEnabled(cam.f_number < scale[-1] * 0.9999)
             diameter = cam.focal_length_mm / cam.f_number
@@ -576,7 +577,8 @@ class CameraPanel(QWidget):
             lo, hi = self._focal_limits()
             prime = lens is not None and not lens.is_zoom
             self.focal.set_quietly(cam.focal_length_mm)
-            self.focal_slider.setValue(log_to_slider(cam.focal_length_mm, lo, hi))
+            if not self.focal_slider.isSliderDown():
+                self.focal_slider.setValue(log_to_slider(cam.focal_length_mm, lo, hi))
             for widget in [self.focal, self.focal_slider] + self.focal_buttons:
                 widget.setEnabled(not prime)
             for b, mm in zip(self.focal_buttons, COMMON_FOCAL_LENGTHS):
@@ -588,7 +590,8 @@ class CameraPanel(QWidget):
                                   + (" · fixed by the prime" if prime else ""))
             # Focus.
             self.focus.set_quietly(cam.focus_distance_m)
-            self.focus_slider.setValue(log_to_slider(cam.focus_distance_m, *FOCUS_RANGE))
+            if not self.focus_slider.isSliderDown():
+                self.focus_slider.setValue(log_to_slider(cam.focus_distance_m, *FOCUS_RANGE))
             # Sensor.
             sw, sh = cam.sensor_mm
             index = next((i for i, s in enumerate(self.sensors)

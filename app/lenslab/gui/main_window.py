@@ -71,9 +71,9 @@ class MainWindow(QMainWindow):
         super().__init__()
         from PySide6.QtWidgets import QApplication
 
-        from lenslab.gui.qtcompat import guard_true_refcount
+        from lenslab.gui.qtcompat import guard_singletons
 
-        guard_true_refcount(QApplication.instance())
+        guard_singletons(QApplication.instance())
         self.setObjectName("LensLabMainWindow")
         self.settings = settings if settings is not None else studio_settings()
         self.doc = Document(scene if scene is not None else studio_scene(), path, self)
@@ -190,15 +190,17 @@ class MainWindow(QMainWindow):
         self.zoom_label.setMinimumWidth(44)
         bar.addWidget(self.zoom_label)
         bar.addSeparator()
-        bar.addWidget(QLabel(" Exposure "))
+        exposure_label = QLabel(" EV ")
+        exposure_label.setToolTip("Display exposure")
+        bar.addWidget(exposure_label)
         self.exposure_slider = QSlider(Qt.Horizontal)
         self.exposure_slider.setRange(-60, 60)
-        self.exposure_slider.setFixedWidth(140)
+        self.exposure_slider.setFixedWidth(110)
         self.exposure_slider.setValue(round(self.viewport.exposure * 10))
         self.exposure_slider.setToolTip("Display exposure in stops (display only: the render is not restarted)")
         self.exposure_label = QLabel()
         self.exposure_label.setObjectName("readout")
-        self.exposure_label.setMinimumWidth(52)
+        self.exposure_label.setMinimumWidth(44)
         bar.addWidget(self.exposure_slider)
         bar.addWidget(self.exposure_label)
         self.tone_combo = QComboBox()
@@ -211,17 +213,15 @@ class MainWindow(QMainWindow):
         spacer = QWidget()
         spacer.setSizePolicy(QSizePolicy.Expanding, QSizePolicy.Preferred)
         bar.addWidget(spacer)
-        bar.addWidget(QLabel("Viewport "))
         self.quality_combo = QComboBox()
-        for name, label in (("auto", "Auto"), ("full", "Full"), ("half", "1/2"), ("quarter", "1/4")):
+        for name, label in (("auto", "Auto res"), ("full", "Full res"), ("half", "½ res"), ("quarter", "¼ res")):
             self.quality_combo.addItem(label, name)
         self.quality_combo.setCurrentIndex(max(0, self.quality_combo.findData(self.controller.quality)))
         self.quality_combo.setToolTip("Viewport resolution relative to the camera's (Auto: at most 800 px wide)")
         bar.addWidget(self.quality_combo)
-        bar.addWidget(QLabel(" Stop at "))
         self.limit_combo = QComboBox()
         for spp in SAMPLE_LIMITS:
-            self.limit_combo.addItem(f"{spp} spp" if spp else "∞", spp)
+            self.limit_combo.addItem(f"{spp} spp" if spp else "∞ spp", spp)
         self.limit_combo.setCurrentIndex(max(0, self.limit_combo.findData(self.controller.target_spp)))
         self.limit_combo.setToolTip("The viewport stops refining at this many samples per pixel")
         bar.addWidget(self.limit_combo)
