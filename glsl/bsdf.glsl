@@ -38,6 +38,7 @@ struct Bsdf {
     vec3 eta3;    // conductors: complex index
     vec3 k;
     float internal_reflectance;  // plastic: diffuse Fresnel reflectance inside the coating
+    int reflectance_table;       // rough plastic: the coating's directional reflectance, 64 entries in image_data
     mat3 frame;   // local shading frame: columns tangent, bitangent, normal
 };
 
@@ -53,6 +54,7 @@ Bsdf bsdf_at(SurfaceHit s) {
     b.tint = r4.xyz;
     b.eta = r2.x;
     b.internal_reflectance = r2.y;
+    b.reflectance_table = floatBitsToInt(r2.z);
     if (r3.w >= 0.0) b.color = texture_rgb(int(r3.w), s.uv);
     if (r4.w >= 0.0) {  // roughness texture: perceptual roughness in the red channel
         float r = texture_rgb(int(r4.w), s.uv).x;
@@ -72,9 +74,21 @@ bool bsdf_is_delta(Bsdf b) {
 vec3 to_local(Bsdf b, vec3 w) { return w * b.frame; }  // = transpose(frame) * w
 vec3 to_world(Bsdf b, vec3 w) { return b.frame * w; }
 
-// -- plastic: the probability of choosing the specular coating when sampling (Mitsuba's heuristic) --------
+// -- plastic ------------------------------------------------------------------------------------------
+// Share of light the coating lets through at this angle: 1 - Fresnel when smooth, 1 - the tabulated
+// directional reflectance of the rough interface otherwise (as Mitsuba's roughplastic).
+float plastic_transmittance(Bsdf b, float cos_theta) {
+    if (b.alpha == 0.0) return 1.0 - fresnel_dielectric(cos_theta, b.eta);
+    float x = clamp(cos_theta, 0.0, 1.0) * 63.0;
+    int i = min(int(x), 62);
+    uint at = uint(b.reflectance_table + i);
+    float r = mix(uintBitsToFloat(image_data[at]), uintBitsToFloat(image_data[at + 1u]), x - float(i));
+    return 1.0 - r;
+}
+
+// The probability of choosing the coating's reflection when sampling (Mitsuba's heuristic).
 float plastic_specular_probability(Bsdf b, float cos_o) {
-    float f = fresnel_dielectric(cos_o, b.eta);
+    float f = 1.0 - plastic_transmittance(b, cos_o);
     float d = (b.color.x + b.color.y + b.color.z) / 3.0;
     float spec_weight = 1.0 / (1.0 + d);
     float p_spec = f * spec_weight;
@@ -83,7 +97,7 @@ float plastic_specular_probability(Bsdf b, float cos_o) {
 }
 
 vec3 plastic_diffuse(Bsdf b, float cos_o, float cos_i) {
-    float t = (1.0 - fresnel_dielectric(cos_i, b.eta)) * (1.0 - fresnel_dielectric(cos_o, b.eta));
+    float t = plastic_transmittance(b, cos_i) * plastic_transmittance(b, cos_o);
     return b.color / (1.0 - b.internal_reflectance) * (t / (b.eta * b.eta)) * INV_PI * cos_i;
 }
 

@@ -175,7 +175,8 @@ def test_rough_materials_never_create_energy(renderer, material):
     assert ball.mean() <= 1.0 + 0.01
     # Single-scattering microfacet models lose the light that would scatter between microfacets: a little
     # at this roughness (a GGX alpha of 0.64 loses 45% at normal incidence; test_rough_conductor_albedo).
-    assert ball.mean() > 0.85
+    # Rough plastic follows Mitsuba's roughplastic, whose diffuse base loses more (about 30% when white).
+    assert ball.mean() > (0.6 if isinstance(material, Plastic) and material.roughness > 0 else 0.85)
 
 
 def test_rough_conductor_albedo_matches_numerical_integration(renderer):

@@ -15,7 +15,7 @@ from typing import Sequence
 import numpy as np
 
 from lenslab.render.bsp import KdTree, build_kdtree
-from lenslab.render.fresnel import internal_diffuse_reflectance
+from lenslab.render.fresnel import internal_diffuse_reflectance, rough_internal_reflectance, rough_reflectance_table
 from lenslab.render.environment import EnvironmentDistribution, environment_power, infinite_light_power
 from lenslab.render.textures import TextureTable, read_texture_image
 from lenslab.scene.flatten import FlatScene
@@ -49,7 +49,7 @@ def _luminance(rgb) -> float:
 
 def pack_material(material: Material, textures: TextureTable) -> np.ndarray:
     """Eight vec4 rows, read by glsl/bsdf.glsl's bsdf_at():
-    0 (albedo, type), 1 (emission, two-sided), 2 (eta rgb | ior, internal reflectance, -, alpha),
+    0 (albedo, type), 1 (emission, two-sided), 2 (eta rgb | ior, internal reflectance, reflectance table, alpha),
     3 (k rgb, albedo texture), 4 (specular tint, roughness texture), 5 (absorption per metre), 6-7 spare."""
     record = np.zeros((MATERIAL_ROWS, 4), np.float32)
     code = MATERIAL_CODES.get(type(material))
@@ -72,7 +72,16 @@ def pack_material(material: Material, textures: TextureTable) -> np.ndarray:
         eta, k = material.complex_ior()
         record[2, :3], record[3, :3], record[4, :3] = eta, k, material.tint
     elif isinstance(material, Plastic):
-        record[2, 0], record[2, 1] = material.ior, internal_diffuse_reflectance(material.ior)
+        alpha = float(record[2, 3])
+        record[2, 0] = material.ior
+        if alpha > 0:
+            # A rough coating reflects a different share than Fresnel alone says: tabulate it (Mitsuba's
+            # roughplastic), so the diffuse base gets exactly what the coating lets through.
+            record[2, 1] = rough_internal_reflectance(material.ior, alpha)
+            table = textures.add_floats(rough_reflectance_table(material.ior, alpha).astype(np.float32))
+            record[2, 2] = np.int32(table).view(np.float32)
+        else:
+            record[2, 1] = internal_diffuse_reflectance(material.ior)
     elif isinstance(material, Dielectric):
         record[2, 0] = material.ior
         record[4, :3] = material.tint

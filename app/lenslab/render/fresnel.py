@@ -30,3 +30,56 @@ def internal_diffuse_reflectance(eta: float) -> float:
     """The same seen from inside a medium of index eta (used by plastic's diffuse base): by reciprocity,
     1 - F_int = (1 - F_ext) / eta^2."""
     return 1.0 - (1.0 - diffuse_fresnel_reflectance(eta)) / eta**2
+
+
+ROUGH_TABLE_SIZE = 64  # entries of a rough interface's transmittance table, over cos theta in [0, 1]
+
+
+def _visible_normals(wo: np.ndarray, alpha: float, u1: np.ndarray, u2: np.ndarray) -> np.ndarray:
+    """GGX visible normals of each wo (Heitz 2018), for a fixed stratified set of (u1, u2); numpy twin of
+    glsl/microfacet.glsl's sampler. wo: (M, 3); returns (M, K, 3)."""
+    wh = np.stack([alpha * wo[:, 0], alpha * wo[:, 1], wo[:, 2]], axis=1)
+    wh /= np.linalg.norm(wh, axis=1, keepdims=True)
+    t1 = np.stack([-wh[:, 1], wh[:, 0], np.zeros(len(wh))], axis=1)
+    length = np.linalg.norm(t1, axis=1, keepdims=True)
+    t1 = np.where(length > 0, t1 / np.maximum(length, 1e-30), [1.0, 0.0, 0.0])
+    t2 = np.cross(wh, t1)
+    r, phi = np.sqrt(u1), 2 * np.pi * u2
+    p1, p2 = r * np.cos(phi), r * np.sin(phi)
+    s = 0.5 * (1 + wh[:, 2:3])
+    p2 = (1 - s) * np.sqrt(np.maximum(0, 1 - p1**2)) + s * p2
+    p3 = np.sqrt(np.maximum(0, 1 - p1**2 - p2**2))
+    n = p1[..., None] * t1[:, None] + p2[..., None] * t2[:, None] + p3[..., None] * wh[:, None]
+    m = np.stack([alpha * n[..., 0], alpha * n[..., 1], np.maximum(1e-6, n[..., 2])], axis=-1)
+    return m / np.linalg.norm(m, axis=-1, keepdims=True)
+
+
+def _smith_lambda(w: np.ndarray, alpha: float) -> np.ndarray:
+    cos2 = np.maximum(w[..., 2] ** 2, 1e-12)
+    return 0.5 * (np.sqrt(1 + alpha**2 * np.maximum(0, 1 - cos2) / cos2) - 1)
+
+
+@lru_cache(maxsize=64)
+def rough_reflectance_table(eta: float, alpha: float, size: int = ROUGH_TABLE_SIZE, grid: int = 96) -> np.ndarray:
+    """Directional albedo of a GGX dielectric interface's reflection, R(mu) at mu = i / (size - 1):
+    the integral of F D G / (4 mu) over outgoing directions, estimated over the visible normals of each
+    incident direction (E = mean of F G / G1) on a stratified grid. As Mitsuba's roughplastic, this is what
+    the coating takes away from the light that reaches the diffuse base."""
+    mu = np.maximum(np.arange(size) / (size - 1), 1e-6)
+    wo = np.stack([np.sqrt(1 - mu**2), np.zeros(size), mu], axis=1)
+    u1, u2 = (np.stack(np.meshgrid(np.arange(grid), np.arange(grid)), axis=-1).reshape(-1, 2).T + 0.5) / grid
+    m = _visible_normals(wo, alpha, u1, u2)
+    wo_dot_m = np.einsum("mk,mnk->mn", wo, m)
+    wi = 2 * wo_dot_m[..., None] * m - wo[:, None, :]
+    lam_o = _smith_lambda(wo, alpha)[:, None]
+    g_over_g1 = (1 + lam_o) / (1 + lam_o + _smith_lambda(wi, alpha))
+    value = np.where(wi[..., 2] > 0, fresnel_dielectric(wo_dot_m, eta) * g_over_g1, 0.0)
+    return value.mean(axis=1)
+
+
+@lru_cache(maxsize=64)
+def rough_internal_reflectance(eta: float, alpha: float) -> float:
+    """Cosine-weighted mean reflectance of the same interface seen from inside (relative index 1/eta):
+    2 * integral of R(mu) mu dmu, by the trapezoid rule over the table."""
+    mu = np.arange(ROUGH_TABLE_SIZE) / (ROUGH_TABLE_SIZE - 1)
+    return float(np.trapezoid(2 * rough_reflectance_table(1.0 / eta, alpha) * mu, mu))
