@@ -111,11 +111,11 @@ def test_interrupted_render_writes_nothing(renderer, tmp_path, monkeypatch, caps
     calls = []
     real_step = RenderSession.step
 
-    def step_then_interrupt(self, *args, **kwargs):
+    def step_then_interrupt(self, seconds, target_spp=None):
         calls.append(1)
         if len(calls) == 2:
             raise KeyboardInterrupt  # what Ctrl-C raises in the main thread
-        return real_step(self, *args, **kwargs)
+        return real_step(self, seconds, 1)  # one pass only, however fast the device: the render is mid-way
 
     monkeypatch.setattr(RenderSession, "step", step_then_interrupt)
     status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.exr", "--spp", "1000",

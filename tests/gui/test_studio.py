@@ -37,6 +37,18 @@ def click_image(qtbot, window, x: float, y: float):
     qtbot.mouseClick(window.viewport, Qt.LeftButton, pos=QPoint(round(point.x()), round(point.y())))
 
 
+def drop_files(window, paths):
+    from PySide6.QtCore import QMimeData, QPoint, QPointF, QUrl
+    from PySide6.QtGui import QDragEnterEvent, QDropEvent
+
+    mime = QMimeData()
+    mime.setUrls([QUrl.fromLocalFile(str(p)) for p in paths])
+    enter = QDragEnterEvent(QPoint(100, 100), Qt.CopyAction, mime, Qt.LeftButton, Qt.NoModifier)
+    window.dragEnterEvent(enter)
+    assert enter.isAccepted()
+    window.dropEvent(QDropEvent(QPointF(100, 100), Qt.CopyAction, mime, Qt.LeftButton, Qt.NoModifier))
+
+
 # -- aperture --------------------------------------------------------------------------------------------------
 def test_choosing_f28_sets_the_f_number_and_restarts_accumulation(qtbot, window):
     frames = []
@@ -185,7 +197,7 @@ def test_undo_restores_each_edit(qtbot, window, tmp_path):
     obj = tmp_path / "tetra.obj"
     obj.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n")
     with qtbot.waitSignal(window.mesh_imported, timeout=30000):
-        window.import_mesh(obj)  # read on a background thread
+        drop_files(window, [obj])  # as if dragged from a file manager; read on a background thread
     assert doc.node((len(doc.scene.nodes) - 1,)).shape.file == str(obj.resolve())
     edited()
     # Change a material's type (diffuse to emissive keeps its colour).
