@@ -1,8 +1,14 @@
 #version 430
 // Entry kernel of the progressive renderer: one invocation per pixel of a tile of consecutive pixels,
-// adding `sample_count` samples (sample indices sample_start ...) to that pixel's running sum.
-// The sum is loaded once and each sample added in index order, so the image is bit-identical however the
-// host splits the work into dispatches.
+// taking `sample_count` samples (sample indices sample_start ...) of that pixel.
+//
+// Two ways to turn samples into pixels (DESIGN.md, "Rendering"):
+// * splat_pixels == 0: each sample lands in its own pixel. The sum is loaded once and each sample added in
+//   index order, so the image is bit-identical however the host splits the work into dispatches. A box
+//   filter, or a gaussian by filter importance sampling.
+// * splat_pixels > 0: a gaussian filter by splatting (as Mitsuba and pbrt-v3). Samples are uniform over their
+//   pixel and their radiance is written to a slot of their own; splat.comp then spreads every sample over
+//   the pixels its filter reaches. Every sample serves several pixels, so the noise per pixel is lower.
 
 layout(local_size_x = LOCAL_SIZE_X) in;
 
@@ -19,7 +25,8 @@ layout(local_size_x = LOCAL_SIZE_X) in;
 #include "lights.glsl"
 #include "integrator.glsl"
 
-// rgb: sum of radiance samples; a: number of samples.
+// splat_pixels == 0: rgb = sum of radiance samples, a = their count (the film's accumulation).
+// splat_pixels > 0: one radiance sample per slot, slot = (sample index - sample_start) * splat_pixels + pixel.
 layout(std430, binding = 6) buffer Accumulation { vec4 accumulation[]; };
 
 uniform int tile_start;   // first pixel (row-major index) of this dispatch
@@ -29,6 +36,7 @@ uniform int sample_count;
 uniform uint seed;
 uniform float filter_stddev; // 0: box filter over the pixel; else a gaussian truncated at 4 stddev (Mitsuba's)
 uniform float clamp_max;  // 0: off. Otherwise the most radiance one sample may add (a biased firefly filter)
+uniform int splat_pixels; // 0: accumulate here; else write each sample to its slot (pixels in the image)
 
 // Filter importance sampling (pbrt-v4, section 8.8): draw the offset from the pixel centre in proportion to
 // the reconstruction filter and give every sample weight 1, so the filtered image is estimated unbiased.
@@ -52,7 +60,7 @@ float inverse_erf(float x) {  // Giles 2010, single precision
 }
 
 vec2 pixel_offset(vec2 u) {
-    if (filter_stddev <= 0.0) return u - 0.5;  // box
+    if (filter_stddev <= 0.0 || splat_pixels > 0) return u - 0.5;  // uniform over the pixel
     // Each axis: a normal distribution truncated at +-4 stddev, by inverting its CDF.
     const float edge = 0.99993666;  // erf(4 / sqrt(2))
     vec2 x = (2.0 * u - 1.0) * edge;
@@ -65,16 +73,20 @@ void main() {
     int pixel_index = tile_start + local;
     uvec2 pixel = uvec2(pixel_index % image_size.x, pixel_index / image_size.x);
 
-    vec4 sum = accumulation[pixel_index];
+    vec4 sum = splat_pixels > 0 ? vec4(0.0) : accumulation[pixel_index];
     for (int k = 0; k < sample_count; k++) {
         Sampler sampler = sampler_start(pixel, sample_start + uint(k), seed);
-        vec4 u = sample4(sampler);  // pixel jitter (box filter) and lens position, jointly stratified
+        vec4 u = sample4(sampler);  // pixel position and lens position, jointly stratified
         Ray ray = camera_ray(vec2(pixel) + 0.5 + pixel_offset(u.xy), u.zw);
         vec3 l = path_radiance(ray, sampler);
         // A NaN or infinity (a degenerate triangle, say) would poison the pixel forever: count it as black.
         if (any(isnan(l)) || any(isinf(l))) l = vec3(0.0);
         if (clamp_max > 0.0 && max_component(l) > clamp_max) l *= clamp_max / max_component(l);
-        sum += vec4(l, 1.0);
+        if (splat_pixels > 0) {
+            accumulation[k * splat_pixels + pixel_index] = vec4(l, 1.0);
+        } else {
+            sum += vec4(l, 1.0);
+        }
     }
-    accumulation[pixel_index] = sum;
+    if (splat_pixels == 0) accumulation[pixel_index] = sum;
 }

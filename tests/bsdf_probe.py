@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from lenslab.render.buffers import MATERIAL_ROWS, pack_material
+from lenslab.render.gl import make_current
 from lenslab.render.textures import TextureTable
 
 
@@ -23,6 +24,7 @@ class BsdfProbe:
     def __init__(self, renderer, material, tmp_dir="."):
         self.renderer = renderer
         ctx = renderer.ctx
+        make_current(ctx)
         textures = TextureTable(base_dir=tmp_dir)
         rows = pack_material(material, textures)
         self.materials = ctx.buffer(np.concatenate([rows, textures.records()]).astype(np.float32).tobytes())
@@ -34,6 +36,7 @@ class BsdfProbe:
 
     def _run(self, items: np.ndarray) -> np.ndarray:
         ctx, n = self.renderer.ctx, len(items)
+        make_current(ctx)
         inp = ctx.buffer(items.astype(np.float32).tobytes())
         out = ctx.buffer(reserve=n * 32)
         self.materials.bind_to_storage_buffer(4)

@@ -25,16 +25,27 @@ def render(renderer, scene, spp, **session_args):
     return accumulation
 
 
+def with_settings(scene, **changes):
+    return dataclasses.replace(scene, render=dataclasses.replace(scene.render, **changes))
+
+
+GAUSSIAN = dict(pixel_filter="gaussian", filter_stddev=0.5)
+
+
 @pytest.mark.parametrize("sampler", ["sobol", "independent"])
-def test_white_furnace_renders_one_everywhere(renderer, sampler):
+@pytest.mark.parametrize("pixel_filter", ["box", "gaussian-expected", "gaussian-sampled"])
+def test_white_furnace_renders_one_everywhere(renderer, sampler, pixel_filter):
     # Albedo-1 diffuse surfaces under a uniform sky of radiance 1: every path ends in the sky with weight 1
     # however it bounces (the floor, ball and box light each other), so every pixel must be 1 within noise.
-    scene = furnace_scene()
-    scene = dataclasses.replace(scene, render=dataclasses.replace(scene.render, sampler=sampler))
+    # A splatted gaussian filter must keep it so up to the image's edges, where fewer samples reach a pixel.
+    scene = with_settings(furnace_scene(), sampler=sampler)
+    if pixel_filter != "box":
+        scene = with_settings(scene, **GAUSSIAN, filter_weights=pixel_filter.split("-")[1])
     spp = 64
     accumulation = render(renderer, scene, spp)
     image = accumulation[..., :3] / accumulation[..., 3:4]
-    assert np.all(accumulation[..., 3] == spp)
+    if pixel_filter == "box":
+        assert np.all(accumulation[..., 3] == spp)
     assert image.mean() == pytest.approx(1.0, abs=0.005)
     # Russian roulette and MIS make single samples differ from 1, but 4x4-pixel blocks of 64 samples each
     # stay close; a lost or doubled bounce would shift whole regions (contact shadows, the sky-lit tops).
@@ -50,8 +61,11 @@ def test_furnace_with_short_paths_loses_energy_as_expected(renderer):
     assert blocks.max() < 1.03
 
 
-def test_same_seed_gives_the_same_image_however_the_work_is_split(renderer):
+@pytest.mark.parametrize("pixel_filter", ["box", "gaussian"])
+def test_same_seed_gives_the_same_image_however_the_work_is_split(renderer, pixel_filter):
     scene = furnace_scene(max_depth=8)
+    if pixel_filter == "gaussian":
+        scene = with_settings(scene, **GAUSSIAN)
     coarse = render(renderer, scene, 8, dispatch_seconds=10.0)
     fine = render(renderer, scene, 8, dispatch_seconds=1e-4)  # many tiny dispatches
     assert np.array_equal(coarse, fine)
@@ -82,3 +96,41 @@ def test_firefly_clamp_is_off_by_default_and_caps_samples_when_asked(renderer):
     clamped_scene = dataclasses.replace(bright, render=dataclasses.replace(bright.render, clamp=2.0))
     clamped = render(renderer, clamped_scene, 2)
     assert (clamped[..., :3] / clamped[..., 3:4]).max() == pytest.approx(2.0)
+
+
+# -- the gaussian pixel filter ---------------------------------------------------------------------------------
+@pytest.mark.parametrize("weights", ["expected", "sampled"])
+def test_splatting_lowers_the_noise_per_pixel(renderer, monkeypatch, weights):
+    # Each sample serves the pixels its filter reaches, so at equal samples the splatted image of a noisy
+    # scene (the Cornell box: small light, many bounces) is smoother than the same filter by importance
+    # sampling (both estimate the same image: see the edge test).
+    from lenslab.render import tracer
+    from lenslab.scene.io.loader import open_scene
+
+    scene = open_scene("cornell_box")
+    scene = dataclasses.replace(scene, camera=dataclasses.replace(scene.camera, resolution=(48, 48)))
+    scene = with_settings(scene, **GAUSSIAN, filter_weights=weights, sampler="independent")
+
+    def seed_difference():
+        images = [render(renderer, with_settings(scene, seed=seed), 8) for seed in (1, 2)]
+        a, b = (acc[..., :3] / acc[..., 3:4] for acc in images)
+        return float(np.var(a - b))
+
+    splatted = seed_difference()
+    monkeypatch.setattr(tracer, "SPLAT_MEMORY_BYTES", 0)
+    importance = seed_difference()
+    assert splatted < 0.6 * importance
+
+
+def test_a_renderer_keeps_its_context_when_another_is_made_in_the_same_thread(renderer):
+    # A standalone GL context is current only until the next one is made; `lenslab --info` or a second
+    # renderer in the same process must not leave this one rendering black.
+    from lenslab.render.tracer import Renderer
+
+    scene = furnace_scene(max_depth=2)
+    before = render(renderer, scene, 2)
+    other = Renderer()
+    render(other, scene, 1)
+    other.release()
+    assert np.array_equal(render(renderer, scene, 2), before)
+    assert before[..., :3].mean() > 0.5

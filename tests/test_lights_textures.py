@@ -155,7 +155,7 @@ def test_image_texture_is_linearised_and_oriented(renderer, tmp_path):
     out.write_image(pixels)
     out.close()
     image, warnings = render(renderer, textured_card(ImageTexture(file=str(tmp_path / "quad.png"))), 64)
-    assert warnings == ()
+    assert warnings == []
     top_left, top_right, bottom_left, bottom_right = quarters(image)
     assert top_left.argmax() == 0 and top_right.argmax() == 1 and bottom_left.argmax() == 2
     grey = ((128 / 255 + 0.055) / 1.055) ** 2.4  # sRGB 128 in linear light: 0.216, not 0.5

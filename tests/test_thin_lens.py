@@ -157,11 +157,22 @@ def test_six_blade_aperture_gives_a_hexagonal_bokeh(renderer):
     assert abs(harmonic(aperture_blades=0)) < 0.1 * ideal
 
 
-@pytest.mark.parametrize("pixel_filter, left, right", [("box", 0.0, 1.0), ("gaussian", 0.1587, 0.8413)])
-def test_pixel_filter_spreads_an_edge_as_the_filter_says(renderer, pixel_filter, left, right):
+@pytest.mark.parametrize("pixel_filter, method, left, right", [
+    ("box", "", 0.0, 1.0),
+    ("gaussian", "splat, expected weights", 0.1587, 0.8413),
+    ("gaussian", "splat, sampled weights", 0.1587, 0.8413),
+    ("gaussian", "importance", 0.1587, 0.8413),  # the fallback for images too large to splat on the device
+])
+def test_pixel_filter_spreads_an_edge_as_the_filter_says(renderer, monkeypatch, pixel_filter, method, left, right):
     """A sharp edge of light on a pixel boundary: a box filter keeps it, a gaussian of 0.5 px spreads it into
-    the neighbouring pixels as its CDF at -+1 stddev (0.159 and 0.841)."""
+    the neighbouring pixels as its CDF at -+1 stddev (0.159 and 0.841), however its samples are spread."""
     import dataclasses
+
+    from lenslab.render import tracer
+
+    if method == "importance":
+        monkeypatch.setattr(tracer, "SPLAT_MEMORY_BYTES", 0)
+    weights = "sampled" if "sampled" in method else "expected"
 
     from lenslab.scene.materials import Emissive
     from lenslab.scene.scene import Node, RenderSettings, Scene
@@ -170,10 +181,14 @@ def test_pixel_filter_spreads_an_edge_as_the_filter_says(renderer, pixel_filter,
 
     camera = axis_camera(focal_length_mm=50.0, sensor_mm=(36.0, 36.0), resolution=(32, 32), pinhole=True)
     half_width = 10.0 * 18.0 / 50.0  # the image half-width at 10 m
-    scene = Scene(camera=camera, render=RenderSettings(max_depth=1, pixel_filter=pixel_filter),
+    scene = Scene(camera=camera, render=RenderSettings(max_depth=1, pixel_filter=pixel_filter, filter_weights=weights),
                   materials={"lamp": Emissive((1.0, 1.0, 1.0))},
                   nodes=[Node("right half", Transform(translate=(half_width, 0.0, -10.0)),
                               Rectangle((2 * half_width, 4 * half_width)), "lamp")])
+    session = RenderSession(renderer, scene, width=32, height=32)
+    assert (session.splat_layers > 0) == method.startswith("splat")
+    assert any("too large to splat" in w for w in session.warnings) == (method == "importance")
+    session.release()
     image = render(renderer, scene, spp=256, width=32, height=32)
     assert camera.lens_radius == 0.0
     columns = image[8:24].mean(axis=0)

@@ -17,6 +17,7 @@ import numpy as np
 from lenslab.render.bsp import KdTree, build_kdtree
 from lenslab.render.fresnel import internal_diffuse_reflectance, rough_internal_reflectance, rough_reflectance_table
 from lenslab.render.environment import EnvironmentDistribution, environment_power, infinite_light_power
+from lenslab.render.gl import make_current
 from lenslab.render.textures import TextureTable, read_texture_image
 from lenslab.scene.flatten import FlatScene
 from lenslab.scene.materials import Conductor, Diffuse, Dielectric, Emissive, Material, Plastic, ThinDielectric
@@ -279,13 +280,18 @@ class GpuScene:
                 f"simplify the meshes ({packed.uniforms['triangle_count']:,} triangles now)"
             )
         self.packed = packed
+        self.ctx = ctx
+        make_current(ctx)
         self.buffers = {name: ctx.buffer(a.tobytes()) for name, a in packed.arrays.items()}
 
     def bind(self) -> None:
+        make_current(self.ctx)
         for name, buffer in self.buffers.items():
             buffer.bind_to_storage_buffer(BINDINGS[name])
 
     def release(self) -> None:
+        if self.buffers:
+            make_current(self.ctx)
         for buffer in self.buffers.values():
             buffer.release()
         self.buffers = {}

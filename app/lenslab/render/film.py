@@ -24,9 +24,12 @@ class ExportError(RuntimeError):
 
 
 def resolve(accumulation: np.ndarray) -> np.ndarray:
-    """Mean radiance per pixel from (sum rgb, count); pixels with no samples yet are black."""
-    count = accumulation[..., 3:4]
-    return np.where(count > 0, accumulation[..., :3] / np.maximum(count, 1), 0.0).astype(np.float32)
+    """Radiance per pixel from (weighted sum rgb, weight); pixels with no samples yet are black. The weight is
+    the sample count, or with a splatted gaussian filter the expected sum of filter weights (render/tracer.py)."""
+    weight = accumulation[..., 3:4]
+    image = np.zeros(accumulation.shape[:-1] + (3,), np.float32)
+    np.divide(accumulation[..., :3], weight, out=image, where=weight > 0)
+    return image
 
 
 def merge(*accumulations: np.ndarray) -> np.ndarray:

@@ -56,6 +56,15 @@ def create_context(device_index: int | None = None):
                             f"through EGL ({text}); {INSTALL_HINT}") from None
 
 
+def make_current(ctx) -> None:
+    """Make ``ctx`` the current context of this thread, and leave it so. A standalone context is current in the
+    thread that made it only until another is made there (a second Renderer: the CLI, a test); GL calls would
+    then go to that one, or nowhere once it is released, and images would silently stay black. moderngl's
+    ``with ctx:`` is no help: on leaving, it restores what was current on entering, which with EGL is often
+    no context at all."""
+    ctx.__enter__()
+
+
 def device_limits(ctx) -> DeviceLimits:
     info = ctx.info
     return DeviceLimits(

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from lenslab.render.buffers import GpuScene
+from lenslab.render.gl import make_current
 
 LOCAL_SIZE_X = 64
 
@@ -31,6 +32,7 @@ def cast_rays(renderer, gpu_scene: GpuScene, origins: np.ndarray, directions: np
     if n == 0:
         return RayHits(np.zeros(0, np.float32), np.zeros(0, np.int32), np.zeros((0, 2), np.float32))
     ctx = renderer.ctx
+    make_current(ctx)  # whatever context was made in this thread since (see gl.make_current)
     stack = max(1, gpu_scene.packed.kdtree.max_depth)
     program = renderer.program("raycast.comp", LOCAL_SIZE_X=LOCAL_SIZE_X, KD_STACK_SIZE=stack)
     packed = np.zeros((n, 2, 4), np.float32)

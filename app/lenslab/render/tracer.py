@@ -6,14 +6,15 @@ about a given time and returns, so a caller can show, save or stop the image bet
 Every dispatch is sized from the measured cost of the last one to stay near a target duration, well under
 any GPU watchdog.
 
-Each pixel's running sum is kept with its own sample count (alpha channel): the image is the sum divided by
-the count, partial renders can be merged by adding, and the same seed gives the same image however the work
-was split.
+Each pixel's running sum is kept with its own weight (alpha channel: the sample count, or with a splatted
+gaussian filter the expected sum of filter weights): the image is the sum divided by the weight, partial
+renders can be merged by adding, and the same seed gives the same image however the work was split.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import time
 from dataclasses import dataclass
 
@@ -27,6 +28,21 @@ from lenslab.scene.scene import RenderSettings, Scene
 
 LOCAL_SIZE_X = 32  # GPU-NOTES: 32x1 work groups traversed the kd-tree fastest on llvmpipe
 DEFAULT_DISPATCH_SECONDS = 0.1
+# A splatted gaussian keeps one pass of samples (16 bytes each) until splat.comp has spread them: at most
+# this much memory, and never more than one storage block; passes take fewer samples per pixel to fit.
+SPLAT_MEMORY_BYTES = 64 << 20
+SPLAT_GATHER_TERMS = 1 << 22  # neighbour terms per splat.comp dispatch, to keep it short on any device
+
+
+def in_context(method):
+    """Run a method with its object's GL context current (see gl.make_current)."""
+
+    @functools.wraps(method)
+    def with_context(self, *args, **kwargs):
+        gl.make_current(self.ctx)
+        return method(self, *args, **kwargs)
+
+    return with_context
 
 
 class Renderer:
@@ -37,6 +53,7 @@ class Renderer:
         self.limits = gl.device_limits(self.ctx)
         self._programs: dict[tuple, object] = {}
 
+    @in_context
     def program(self, shader: str, **defines):
         """The compute shader glsl/<shader> compiled with these #defines (compiled once, then cached)."""
         key = (shader, tuple(sorted(defines.items())))
@@ -50,10 +67,17 @@ class Renderer:
             defines["SAMPLER_INDEPENDENT"] = 1
         return self.program("trace.comp", **defines)
 
+    def splat_program(self, sampler: str):
+        defines = {"LOCAL_SIZE_X": LOCAL_SIZE_X, "SOBOL_DIRECTIONS": glsl_array_literal()}
+        if sampler == "independent":
+            defines["SAMPLER_INDEPENDENT"] = 1
+        return self.program("splat.comp", **defines)
+
     def describe(self) -> dict[str, str]:
         return gl.describe_device(self.ctx)
 
     def release(self) -> None:
+        gl.make_current(self.ctx)
         for program in self._programs.values():
             program.release()
         self._programs.clear()
@@ -102,9 +126,11 @@ class RenderSession:
         self.dispatch_seconds = dispatch_seconds
         self._gpu_scene: GpuScene | None = None
         self._accumulation = None
+        self._splat_samples = None  # one pass of radiance samples, while a gaussian filter is splatted
         self.set_scene(scene, width=width, height=height, settings=settings)
 
     # -- scene and camera ---------------------------------------------------------------------------------
+    @in_context
     def set_scene(self, scene: Scene, *, width: int | None = None, height: int | None = None,
                   settings: RenderSettings | None = None) -> None:
         """Upload a (new or edited) scene and restart accumulation."""
@@ -114,7 +140,8 @@ class RenderSession:
         packed = pack_scene(self.flat_scene, scene.environment, base_dir=scene.base_dir(), lights=scene.lights,
                             environment_importance=self.environment_importance)
         # What the render survives but the user should hear about: unmapped mesh materials, missing textures.
-        self.warnings = self.flat_scene.warnings + packed.warnings
+        self.warnings = [*self.flat_scene.warnings, *packed.warnings]
+        self._splat_warning = None
         gpu_scene = GpuScene(self.ctx, packed, self.renderer.limits.max_storage_block_bytes)
         if self._gpu_scene is not None:
             self._gpu_scene.release()
@@ -124,12 +151,14 @@ class RenderSession:
         self.program = self.renderer.trace_program(self.program_stack_size, self.settings.sampler)
         self.set_camera(scene.camera)
 
+    @in_context
     def set_camera(self, camera: ThinLensCamera) -> None:
         """A camera-only edit: no re-upload of geometry, just restart accumulation."""
         camera.validate()
         self.camera = camera
         self.reset()
 
+    @in_context
     def set_settings(self, settings: RenderSettings) -> None:
         if settings.sampler != self.settings.sampler:
             self.program = self.renderer.trace_program(self.program_stack_size, settings.sampler)
@@ -137,10 +166,21 @@ class RenderSession:
         self.reset()
 
     @property
+    def splat_layers(self) -> int:
+        """Samples per pixel one pass may take while splatting a gaussian filter; 0: samples are not splatted
+        (a box filter, or a gaussian by filter importance sampling where a pass would not fit in memory)."""
+        if self.settings.pixel_filter != "gaussian":
+            return 0
+        layer_bytes = 16 * self.width * self.height
+        limit = min(SPLAT_MEMORY_BYTES, self.renderer.limits.max_storage_block_bytes)
+        return max(0, min(64, limit // layer_bytes))
+
+    @property
     def program_stack_size(self) -> int:
         # The traversal stack holds at most one far child per level below the root.
         return max(1, self._gpu_scene.packed.kdtree.max_depth)
 
+    @in_context
     def reset(self) -> None:
         """Discard the accumulated samples (after any edit)."""
         pixels = self.width * self.height
@@ -149,6 +189,16 @@ class RenderSession:
                 self._accumulation.release()
             self._accumulation = self.ctx.buffer(reserve=pixels * 16)
         self._accumulation.clear()
+        layers = self.splat_layers
+        if layers and (self._splat_samples is None or self._splat_samples.size != 16 * pixels * layers):
+            self._release_splat_samples()
+            self._splat_samples = self.ctx.buffer(reserve=16 * pixels * layers)
+        elif not layers:
+            self._release_splat_samples()
+        if self.settings.pixel_filter == "gaussian" and not layers and self._splat_warning is None:
+            self._splat_warning = (f"a {self.width}x{self.height} image is too large to splat its gaussian pixel filter "
+                                   "on this device: it is sampled by importance instead (the same image, more noise)")
+            self.warnings.append(self._splat_warning)
         self._pixels_done = 0  # pixels of the current pass that have their samples
         self.samples_per_pixel = 0  # completed passes, in samples
         self._pass_samples = 1
@@ -162,7 +212,7 @@ class RenderSession:
         values = dict(self._gpu_scene.packed.uniforms)
         values.update(camera_uniforms(self.camera, self.width, self.height))
         values.update(max_depth=self.settings.max_depth, rr_depth=self.settings.rr_depth, seed=self.settings.seed,
-                      clamp_max=self.settings.clamp,
+                      clamp_max=self.settings.clamp, splat_pixels=self.width * self.height if self._splat_samples is not None else 0,
                       filter_stddev=self.settings.filter_stddev if self.settings.pixel_filter == "gaussian" else 0.0)
         for name, value in values.items():
             if name in program:  # the GLSL compiler drops uniforms a kernel never reads
@@ -180,6 +230,8 @@ class RenderSession:
             samples = max(1, int(budget // pixels_total))
             if target_spp is not None:
                 samples = min(samples, target_spp - self.samples_per_pixel)
+            if self._splat_samples is not None:
+                samples = min(samples, self.splat_layers)
             self._pass_samples = samples
             return pixels_total, samples
         if self._pixels_done == 0:
@@ -206,13 +258,38 @@ class RenderSession:
         self._seconds_per_pixel_sample = measured if previous is None else 0.5 * (previous + measured)
         self._pixels_done += pixels
         if self._pixels_done >= self.width * self.height:
+            if self._splat_samples is not None:
+                self._splat_pass(samples)
             self._pixels_done = 0
             self.samples_per_pixel += samples
 
+    def _splat_pass(self, samples: int) -> None:
+        """Spread a finished pass of samples over the pixels their gaussian filter reaches (splat.comp)."""
+        program = self.renderer.splat_program(self.settings.sampler)
+        reach = int(np.ceil(4.0 * self.settings.filter_stddev + 0.5))
+        terms_per_pixel = samples * (2 * reach + 1) ** 2
+        pixels_total = self.width * self.height
+        chunk = max(LOCAL_SIZE_X, SPLAT_GATHER_TERMS // terms_per_pixel // LOCAL_SIZE_X * LOCAL_SIZE_X)
+        self._accumulation.bind_to_storage_buffer(0)
+        for name, value in (("image_size", (self.width, self.height)), ("sample_start", self.samples_per_pixel),
+                            ("sample_count", samples), ("seed", self.settings.seed),
+                            ("filter_stddev", self.settings.filter_stddev),
+                            ("sampled_weights", self.settings.filter_weights == "sampled")):
+            program[name].value = value
+        start = time.perf_counter()
+        for first in range(0, pixels_total, chunk):
+            count = min(chunk, pixels_total - first)
+            program["tile_start"].value = first
+            program["tile_pixels"].value = count
+            program.run((count + LOCAL_SIZE_X - 1) // LOCAL_SIZE_X, 1, 1)
+            self.ctx.finish()
+        self.elapsed_seconds += time.perf_counter() - start
+        self._bind_trace_buffers()  # binding 0 is the kd-tree's again
+
+    @in_context
     def step(self, seconds: float, target_spp: int | None = None) -> Progress:
         """Render for about ``seconds`` (at least one dispatch) or until ``target_spp`` is reached."""
-        self._gpu_scene.bind()
-        self._accumulation.bind_to_storage_buffer(ACCUMULATION_BINDING)
+        self._bind_trace_buffers()
         self._set_uniforms()
         deadline = time.perf_counter() + seconds
         while target_spp is None or self.samples_per_pixel < target_spp:
@@ -220,6 +297,11 @@ class RenderSession:
             if time.perf_counter() >= deadline:
                 break
         return self.progress(target_spp)
+
+    def _bind_trace_buffers(self) -> None:
+        self._gpu_scene.bind()
+        target = self._splat_samples if self._splat_samples is not None else self._accumulation
+        target.bind_to_storage_buffer(ACCUMULATION_BINDING)
 
     def done(self, target_spp: int) -> bool:
         return self.samples_per_pixel >= target_spp
@@ -229,6 +311,7 @@ class RenderSession:
         return Progress(self.samples_per_pixel, target_spp, self.elapsed_seconds, rate)
 
     # -- ray queries --------------------------------------------------------------------------------------
+    @in_context
     def pick(self, x: float, y: float) -> "Pick | None":
         """The surface seen through the lens centre at image position (x, y) in pixels, (0, 0) top left."""
         from lenslab.render.raycast import cast_rays
@@ -248,6 +331,7 @@ class RenderSession:
         return Pick(point=point, depth=float(np.dot(point - origin, forward)), prim=prim, node=node)
 
     # -- reading the image --------------------------------------------------------------------------------
+    @in_context
     def accumulation(self) -> np.ndarray:
         """(H, W, 4) float32: radiance sums and sample counts; rows top to bottom."""
         data = np.frombuffer(self._accumulation.read(), dtype=np.float32)
@@ -259,7 +343,14 @@ class RenderSession:
 
         return resolve(self.accumulation())
 
+    def _release_splat_samples(self) -> None:
+        if self._splat_samples is not None:
+            self._splat_samples.release()
+            self._splat_samples = None
+
+    @in_context
     def release(self) -> None:
+        self._release_splat_samples()
         if self._gpu_scene is not None:
             self._gpu_scene.release()
             self._gpu_scene = None

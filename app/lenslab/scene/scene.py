@@ -86,6 +86,10 @@ class RenderSettings:
     pixel_filter: str = field(default="box", metadata={"choices": ("box", "gaussian"),
                                                       "doc": "how samples are spread over a pixel"})
     filter_stddev: float = field(default=0.5, metadata={"range": (0.05, 4.0), "doc": "gaussian: standard deviation in pixels"})
+    filter_weights: str = field(default="expected", metadata={
+        "choices": ("expected", "sampled"),
+        "doc": "gaussian: divide each pixel's weighted sum by the weight it expects (unbiased), or by the weights "
+               "its samples drew (as Mitsuba: a little less noise, biased by O(1/spp))"})
     clamp: float = field(default=0.0, metadata={"range": (0.0, 1e9), "doc": "0 = off (unbiased); else the most "
                                                  "radiance one sample may add, to tame fireflies (biased)"})
 

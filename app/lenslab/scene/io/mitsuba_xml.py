@@ -870,7 +870,7 @@ class _Importer:
         if films:
             self.film(films[0])
         else:
-            self.render.pixel_filter, self.render.filter_stddev = "gaussian", 0.5  # Mitsuba's default film
+            self._gaussian_filter(0.5)  # Mitsuba's default film
         if samplers:
             self.sampler(samplers[0])
         if kind not in ("perspective", "thinlens"):
@@ -898,6 +898,12 @@ class _Importer:
         p.finish()
         self.camera = _Camera(node, to_world, fov_x, radius, focus)
 
+    def _gaussian_filter(self, stddev: float) -> None:
+        """Mitsuba's gaussian rfilter: samples splatted over the pixels within 4 stddev, each pixel divided by
+        the weights its samples drew, as Mitsuba's film does (RenderSettings.filter_weights = "sampled")."""
+        self.render.pixel_filter, self.render.filter_stddev = "gaussian", stddev
+        self.render.filter_weights = "sampled"
+
     def film(self, node: XNode) -> None:
         p = Props(self, node)
         if node.type not in ("hdrfilm", "specfilm"):
@@ -912,7 +918,7 @@ class _Importer:
         filters = [n for n in p.objects if n.tag == "rfilter"] + [p.take(k) for k in list(p.values) if p.values[k].tag == "rfilter"]
         p.finish()
         if not filters:  # Mitsuba's default: a gaussian of standard deviation 0.5 pixels
-            self.render.pixel_filter, self.render.filter_stddev = "gaussian", 0.5
+            self._gaussian_filter(0.5)
             return
         rfilter = filters[0]
         rp = Props(self, rfilter)
@@ -922,7 +928,7 @@ class _Importer:
             if not 0.05 <= stddev <= 4.0:
                 self.warn(rfilter, f"stddev {stddev:g} is outside LensLab's 0.05-4 pixels: clamped")
                 stddev = min(max(stddev, 0.05), 4.0)
-            self.render.pixel_filter, self.render.filter_stddev = "gaussian", float(stddev)
+            self._gaussian_filter(float(stddev))
             return
         rp.finish(silent=set(rp.values))
         self.render.pixel_filter = "box"
