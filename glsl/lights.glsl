@@ -16,6 +16,7 @@ uniform int env_texture;        // the map's texture record
 uniform float env_rotation;     // radians about +Y
 uniform int env_dist_offset;    // sampling tables in image_data (render/environment.py)
 uniform ivec2 env_size;
+uniform int env_rows_pole_to_pole; // 1: image row i lies at polar angle pi i / (H - 1) (Mitsuba's layout)
 uniform vec3 sun_direction;     // towards the sun
 uniform float sun_one_minus_cos; // 1 - cos of the disk's angular radius (host-computed: precise); 0: delta
 uniform vec3 sun_radiance;
@@ -84,6 +85,14 @@ float env_table(int i) { return uintBitsToFloat(image_data[env_dist_offset + i])
 vec3 environment_radiance(vec3 dir) {
     if (env_type == 0) return env_radiance;
     vec2 uv = environment_uv(dir);
+    float h = float(env_size.y);
+    if (env_rows_pole_to_pole != 0) {
+        uv.y = (uv.y * (h - 1.0) + 0.5) / h;  // the texture lookup puts row i at (i + 1/2) / H: move there
+    } else {
+        uv.y = clamp(uv.y, 0.5 / h, 1.0 - 0.5 / h);  // textures repeat; a pole must not blend in the other
+    }
+    // The sampling tables stay on the centred rows: their pdf reaches one row beyond each pixel (see
+    // render/environment.py), which covers the half-row shift, so sampling stays unbiased.
     return env_strength * texture_rgb(env_texture, vec2(uv.x, 1.0 - uv.y));  // row 0 is the top
 }
 

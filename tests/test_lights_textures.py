@@ -205,3 +205,25 @@ def test_area_light_straight_above_a_floor_matches_the_form_factor(renderer):
     )
     image, _ = render(renderer, scene, 64)
     assert image[6:10, 6:10].mean() == pytest.approx(expected, rel=0.02)
+
+
+@pytest.mark.parametrize("rows", ["centred", "pole_to_pole"])
+def test_environment_map_rows_meet_the_sphere_as_their_layout_says(renderer, tmp_path, rows):
+    # A map whose row i holds the value i, seen straight up, at 45 degrees and straight down through a
+    # narrow pinhole: the bilinear lookup must read the row coordinate the layout puts at that polar angle.
+    # Centred rows sit at pi (i + 1/2) / H and clamp at the poles (no blend with the other pole); Mitsuba's
+    # pole-to-pole rows sit at pi i / (H - 1).
+    h = 8
+    write_image(tmp_path / "rows.exr", np.repeat(np.arange(h, dtype=np.float32)[:, None, None], 16, axis=1)
+                .repeat(3, axis=2))
+    for theta_deg, up in ((0.0, (0, 0, -1)), (45.0, (0, 1, 0)), (180.0, (0, 0, -1))):
+        theta = math.radians(theta_deg)
+        look = (0.0, math.cos(theta), -math.sin(theta))
+        camera = ThinLensCamera(position=(0, 0, 0), look_at=look, up=up, focal_length_mm=2000.0, pinhole=True,
+                                resolution=(1, 1))
+        scene = Scene(camera=camera, environment=EnvironmentMap(file=str(tmp_path / "rows.exr"), rows=rows),
+                      render=RenderSettings(max_depth=1))
+        image, _ = render(renderer, scene, 4)
+        polar = theta / math.pi
+        row = polar * (h - 1) if rows == "pole_to_pole" else min(max(polar * h - 0.5, 0.0), h - 1.0)
+        assert image[0, 0, 0] == pytest.approx(row, abs=0.02), theta_deg

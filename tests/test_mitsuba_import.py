@@ -510,7 +510,7 @@ def test_envmap_is_turned_half_a_turn_onto_our_lat_long_convention(tmp_path):
         return scene.environment, warnings
 
     environment, warnings = env('<float name="scale" value="2.5"/>')
-    assert environment == EnvironmentMap(file="sky.exr", strength=2.5, rotation_deg=180.0) and warnings == []
+    assert environment == EnvironmentMap(file="sky.exr", strength=2.5, rotation_deg=180.0, rows="pole_to_pole") and warnings == []
     environment, _ = env('<transform name="to_world"><rotate y="1" angle="30"/></transform>')
     assert environment.rotation_deg == pytest.approx(150.0)
     # our mapping with that rotation sends every direction to the texel Mitsuba reads (u = atan2(x, -z) / 2pi

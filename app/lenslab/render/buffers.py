@@ -131,7 +131,7 @@ def _environment_uniforms(environment: Environment, textures: TextureTable, scen
                           importance: bool = True):
     """(uniform values, power for light selection, sampling tables to append to image_data)."""
     uniforms = {"env_type": 0, "env_radiance": (0.0, 0.0, 0.0), "env_strength": 1.0, "env_texture": -1,
-                "env_rotation": 0.0, "env_dist_offset": 0, "env_size": (1, 1)}
+                "env_rotation": 0.0, "env_dist_offset": 0, "env_size": (1, 1), "env_rows_pole_to_pole": 0}
     if isinstance(environment, ConstantEnvironment):
         uniforms["env_radiance"] = tuple(float(v) for v in environment.radiance)
         return uniforms, infinite_light_power(4.0 * math.pi * _luminance(environment.radiance), scene_radius)
@@ -152,6 +152,7 @@ def _environment_uniforms(environment: Environment, textures: TextureTable, scen
             env_texture=textures.index_of(InlineImageTexture(pixels=rgb, name=str(path))),
             env_rotation=math.radians(environment.rotation_deg),
             env_dist_offset=textures.add_floats(distribution.packed()), env_size=(rgb.shape[1], rgb.shape[0]),
+            env_rows_pole_to_pole=int(environment.rows == "pole_to_pole"),
         )
         return uniforms, environment_power(rgb, environment.strength, scene_radius)
     raise TypeError(f"no GPU packing for environment type {type(environment).__name__}")

@@ -69,6 +69,11 @@ class EnvironmentMap(Environment):
     file: str = field(default="", metadata={"required": True, "doc": "lat-long image, relative to the scene"})
     strength: float = field(default=1.0, metadata={"range": (0.0, 1e6)})
     rotation_deg: float = field(default=0.0, metadata={"range": (-360.0, 360.0)})
+    rows: str = field(default="centred", metadata={
+        "choices": ("centred", "pole_to_pole"),
+        "doc": "how the image's rows meet the sphere: 'centred' (H rows of equal height, row i centred at polar "
+               "angle pi (i + 1/2) / H: the usual layout) or 'pole_to_pole' (row i at pi i / (H - 1), the first "
+               "and last rows on the poles: Mitsuba's envmap, which its importer sets)"})
 
 
 ENVIRONMENT_TYPES = {cls.type_name: cls for cls in (ConstantEnvironment, EnvironmentMap)}

@@ -708,7 +708,7 @@ class _Importer:
             self.warn(node, "LensLab has one environment: this envmap replaces the "
                       f"{self._environment_node.label()} at {self._environment_node.where()}")
         self.environment = EnvironmentMap(file=self._scene_relative(path), strength=float(max(scale, 0.0)),
-                                          rotation_deg=float(rotation))
+                                          rotation_deg=float(rotation), rows="pole_to_pole")
         self._environment_node = node
 
     # -- shapes -------------------------------------------------------------------------------------------
