@@ -61,7 +61,8 @@ void main() {
     int pixels = image_size.x * image_size.y;
     int reach = int(ceil(4.0 * filter_stddev + 0.5));
     ivec2 lo = max(pixel - reach, ivec2(0)), hi = min(pixel + reach, image_size - 1);
-    float expected_weight = covered_weight(centre.x, float(image_size.x)) * covered_weight(centre.y, float(image_size.y));
+    float expected_weight = covered_weight(centre.x, float(image_size.x)) *
+                            covered_weight(centre.y, float(image_size.y));
 
     vec4 sum = accumulation[q];
     for (int k = 0; k < sample_count; k++) {

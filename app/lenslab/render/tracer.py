@@ -31,6 +31,7 @@ DEFAULT_DISPATCH_SECONDS = 0.1
 # A splatted gaussian keeps one pass of samples (16 bytes each) until splat.comp has spread them: at most
 # this much memory, and never more than one storage block; passes take fewer samples per pixel to fit.
 SPLAT_MEMORY_BYTES = 64 << 20
+SPLAT_MAX_LAYERS = 64  # samples per pixel in one splatted pass
 SPLAT_GATHER_TERMS = 1 << 22  # neighbour terms per splat.comp dispatch, to keep it short on any device
 
 
@@ -141,7 +142,6 @@ class RenderSession:
                             environment_importance=self.environment_importance)
         # What the render survives but the user should hear about: unmapped mesh materials, missing textures.
         self.warnings = [*self.flat_scene.warnings, *packed.warnings]
-        self._splat_warning = None
         gpu_scene = GpuScene(self.ctx, packed, self.renderer.limits.max_storage_block_bytes)
         if self._gpu_scene is not None:
             self._gpu_scene.release()
@@ -173,7 +173,7 @@ class RenderSession:
             return 0
         layer_bytes = 16 * self.width * self.height
         limit = min(SPLAT_MEMORY_BYTES, self.renderer.limits.max_storage_block_bytes)
-        return max(0, min(64, limit // layer_bytes))
+        return max(0, min(SPLAT_MAX_LAYERS, limit // layer_bytes))
 
     @property
     def program_stack_size(self) -> int:
@@ -195,10 +195,11 @@ class RenderSession:
             self._splat_samples = self.ctx.buffer(reserve=16 * pixels * layers)
         elif not layers:
             self._release_splat_samples()
-        if self.settings.pixel_filter == "gaussian" and not layers and self._splat_warning is None:
-            self._splat_warning = (f"a {self.width}x{self.height} image is too large to splat its gaussian pixel filter "
-                                   "on this device: it is sampled by importance instead (the same image, more noise)")
-            self.warnings.append(self._splat_warning)
+        if self.settings.pixel_filter == "gaussian" and not layers:
+            warning = (f"a {self.width}x{self.height} image is too large to splat its gaussian pixel filter on this "
+                       "device: it is sampled by importance instead (the same image, more noise)")
+            if warning not in self.warnings:
+                self.warnings.append(warning)
         self._pixels_done = 0  # pixels of the current pass that have their samples
         self.samples_per_pixel = 0  # completed passes, in samples
         self._pass_samples = 1
@@ -211,8 +212,9 @@ class RenderSession:
         program = self.program
         values = dict(self._gpu_scene.packed.uniforms)
         values.update(camera_uniforms(self.camera, self.width, self.height))
+        splat_pixels = self.width * self.height if self._splat_samples is not None else 0
         values.update(max_depth=self.settings.max_depth, rr_depth=self.settings.rr_depth, seed=self.settings.seed,
-                      clamp_max=self.settings.clamp, splat_pixels=self.width * self.height if self._splat_samples is not None else 0,
+                      clamp_max=self.settings.clamp, splat_pixels=splat_pixels,
                       filter_stddev=self.settings.filter_stddev if self.settings.pixel_filter == "gaussian" else 0.0)
         for name, value in values.items():
             if name in program:  # the GLSL compiler drops uniforms a kernel never reads
