@@ -117,6 +117,18 @@ def test_environment_importance_sampling_lowers_the_error_at_equal_samples(rende
     assert uniform.mean() == pytest.approx(reference.mean(), rel=0.25)
 
 
+def test_a_sun_brighter_than_half_floats_hold_still_lights_the_scene(renderer, tmp_path):
+    # Real HDR panoramas put their sun at 1e5 or more, beyond half floats (65504). The same sky written at a
+    # millionth of its brightness and scaled back up by `strength` must give the same picture.
+    sky = write_sky(tmp_path / "dim.exr")
+    write_image(tmp_path / "bright.exr", sky * 1e6)
+    assert sky.max() * 1e6 > 65504
+    images = [render(renderer, sphere_under_sky(tmp_path / name, strength=strength), 16)[0]
+              for name, strength in (("bright.exr", 1.0), ("dim.exr", 1e6))]
+    assert np.isfinite(images[0]).all() and images[0].mean() > 1e4
+    assert np.allclose(images[0], images[1], rtol=2e-3, atol=0.0)
+
+
 def test_environment_rotation_turns_the_lighting(renderer, tmp_path):
     write_sky(tmp_path / "sky.exr")
     lit_side = []
@@ -227,3 +239,15 @@ def test_environment_map_rows_meet_the_sphere_as_their_layout_says(renderer, tmp
         polar = theta / math.pi
         row = polar * (h - 1) if rows == "pole_to_pole" else min(max(polar * h - 0.5, 0.0), h - 1.0)
         assert image[0, 0, 0] == pytest.approx(row, abs=0.02), theta_deg
+
+
+def test_nan_and_infinite_texels_read_as_black_with_a_warning(tmp_path, caplog):
+    from lenslab.render.textures import read_texture_image
+
+    pixels = np.full((4, 4, 3), 0.5, np.float32)
+    pixels[1, 2] = (np.nan, np.inf, -np.inf)
+    write_image(tmp_path / "broken.exr", pixels)
+    with caplog.at_level("WARNING", logger="lenslab.textures"):
+        rgb = read_texture_image(tmp_path / "broken.exr")
+    assert np.isfinite(rgb).all() and np.all(rgb[1, 2] == 0.0) and rgb[0, 0, 0] == 0.5
+    assert "broken.exr: 1 texel is NaN or infinite" in caplog.text

@@ -1,4 +1,5 @@
-"""Textures for the GPU: image files read through OpenImageIO, linearised, packed as half floats.
+"""Textures for the GPU: image files read through OpenImageIO, linearised, packed as half floats (or as
+32-bit floats where a value is beyond the half-float range, as the sun in an HDR panorama can be).
 
 A texture that cannot be read is not fatal: the render goes on with a magenta-and-black checkerboard in its
 place (hard to miss in a picture) and a warning naming the file, so one broken path never costs the user
@@ -20,6 +21,8 @@ log = logging.getLogger("lenslab.textures")
 
 TEXTURE_IMAGE, TEXTURE_CHECKER = 0, 1
 RECORD_ROWS = 4  # vec4 rows per texture record (glsl/textures.glsl)
+TEXELS_HALF, TEXELS_FLOAT = 0, 1  # how an image's texels are packed (record row 1, z)
+HALF_MAX = 65504.0
 MAX_SIDE = 4096  # larger images are downsampled: one storage buffer holds all texels
 MISSING = Checkerboard(color_a=(1.0, 0.0, 1.0), color_b=(0.0, 0.0, 0.0), tiles=(16.0, 16.0))
 FLOAT_FORMATS = ("half", "float", "double")
@@ -46,6 +49,10 @@ def read_texture_image(path: Path, color_space: str = "auto") -> np.ndarray:
     is_float = str(spec.format) in FLOAT_FORMATS
     if color_space == "srgb" or (color_space == "auto" and not is_float):
         rgb = srgb_to_linear(np.clip(rgb, 0.0, 1.0))
+    if not np.isfinite(rgb).all():  # NaN or infinity in a float file: black, or every path that sees it is lost
+        bad = int((~np.isfinite(rgb)).any(axis=2).sum())
+        log.warning("%s: %d texel%s NaN or infinite: read as black", path, bad, " is" if bad == 1 else "s are")
+        rgb = np.where(np.isfinite(rgb), rgb, 0.0)
     return np.ascontiguousarray(rgb, dtype=np.float32)
 
 
@@ -95,11 +102,17 @@ class TextureTable:
 
     def _add_texels(self, record: np.ndarray, rgb: np.ndarray, tiles) -> None:
         height, width = rgb.shape[:2]
-        halves = np.zeros((height, width, 4), np.float16)
-        halves[..., :3] = rgb
-        packed = halves.view(np.uint32).reshape(-1)  # two uints per texel: (r, g), (b, 0)
+        rgb = np.asarray(rgb, np.float32)
+        if np.abs(rgb).max(initial=0.0) <= HALF_MAX:
+            halves = np.zeros((height, width, 4), np.float16)
+            halves[..., :3] = rgb
+            packed = halves.view(np.uint32).reshape(-1)  # two uints per texel: (r, g), (b, 0)
+            texel_format = TEXELS_HALF
+        else:  # an HDR sun brighter than half floats hold (65504) would turn infinite, and then black
+            packed = np.ascontiguousarray(rgb).view(np.uint32).reshape(-1)  # three uints per texel: r, g, b
+            texel_format = TEXELS_FLOAT
         record[0] = (TEXTURE_IMAGE, np.int32(self._texel_count).view(np.float32), width, height)
-        record[1, :2] = tiles
+        record[1, :3] = (*tiles, texel_format)
         self._texels.append(packed)
         self._texel_count += packed.size
 
