@@ -15,7 +15,8 @@ uniform float env_strength;
 uniform int env_texture;        // the map's texture record
 uniform float env_rotation;     // radians about +Y
 uniform int env_dist_offset;    // sampling tables in image_data (render/environment.py)
-uniform ivec2 env_size;
+uniform ivec2 env_size;           // the map's pixels
+uniform ivec2 env_table_size;     // cells of its sampling tables (at most 1024 x 512)
 uniform int env_rows_pole_to_pole; // 1: image row i lies at polar angle pi i / (H - 1) (Mitsuba's layout)
 uniform vec3 sun_direction;     // towards the sun
 uniform float sun_one_minus_cos; // 1 - cos of the disk's angular radius (host-computed: precise); 0: delta
@@ -102,7 +103,7 @@ float environment_pdf(vec3 dir) {
     vec2 uv = environment_uv(dir);
     float sin_theta = sin(uv.y * PI);
     if (sin_theta <= 0.0) return 0.0;
-    int w = env_size.x, h = env_size.y;
+    int w = env_table_size.x, h = env_table_size.y;
     int row = min(int(uv.y * float(h)), h - 1), col = min(int(uv.x * float(w)), w - 1);
     float pdf_uv = env_table((h + 1) + h * (w + 1) + row * w + col);
     return env_select_pmf * pdf_uv / (2.0 * PI * PI * sin_theta);
@@ -120,7 +121,7 @@ int search_cdf(int first, int count, float u) {
 
 vec3 sample_environment_direction(vec2 u) {
     if (env_type == 0) return sample_uniform_sphere(u);
-    int w = env_size.x, h = env_size.y;
+    int w = env_table_size.x, h = env_table_size.y;
     int row = search_cdf(0, h, u.y);
     float r0 = env_table(row), r1 = env_table(row + 1);
     float v = (float(row) + (u.y - r0) / max(r1 - r0, 1e-12)) / float(h);

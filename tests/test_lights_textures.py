@@ -251,3 +251,26 @@ def test_nan_and_infinite_texels_read_as_black_with_a_warning(tmp_path, caplog):
         rgb = read_texture_image(tmp_path / "broken.exr")
     assert np.isfinite(rgb).all() and np.all(rgb[1, 2] == 0.0) and rgb[0, 0, 0] == 0.5
     assert "broken.exr: 1 texel is NaN or infinite" in caplog.text
+
+
+def test_a_large_panorama_is_sampled_through_coarser_tables_without_bias(renderer, tmp_path, monkeypatch):
+    # Sampling tables are capped in size (a 4096 x 2048 map's full tables would fill llvmpipe's storage
+    # block); a cell takes the brightest of its pixels, so no lit direction gets zero density: the estimate
+    # agrees with full-size tables' and keeps most of importance sampling's advantage over uniform sampling.
+    from lenslab.render import environment
+
+    sky = write_sky(tmp_path / "sky.exr")
+    coarse = environment.EnvironmentDistribution.from_image(sky, max_size=(40, 24))
+    assert coarse.pdf.shape == (24, 40)
+    assert np.trapezoid(np.trapezoid(coarse.pdf, dx=1 / 40, axis=1), dx=1 / 24) == pytest.approx(1.0, rel=0.05)
+    rows, cols = np.nonzero(sky[..., 0] > 1000)  # the sun: its cells carry the most density
+    assert coarse.pdf[(rows * 24) // 64, (cols * 40) // 128].min() > 0.5 * coarse.pdf.max()
+
+    scene = sphere_under_sky(tmp_path / "sky.exr", rotation_deg=30.0)
+    reference, _ = render(renderer, scene, 1024)  # full-size tables
+    monkeypatch.setattr(environment, "TABLE_MAX_SIZE", (40, 24))
+    importance, _ = render(renderer, dataclasses.replace(scene, render=RenderSettings(max_depth=2, seed=5)), 16)
+    uniform, _ = render(renderer, dataclasses.replace(scene, render=RenderSettings(max_depth=2, seed=5)), 16,
+                        environment_importance=False)
+    assert importance.mean() == pytest.approx(reference.mean(), rel=0.02)
+    assert np.mean((importance - reference) ** 2) < 0.3 * np.mean((uniform - reference) ** 2)

@@ -131,7 +131,8 @@ def _environment_uniforms(environment: Environment, textures: TextureTable, scen
                           importance: bool = True):
     """(uniform values, power for light selection, sampling tables to append to image_data)."""
     uniforms = {"env_type": 0, "env_radiance": (0.0, 0.0, 0.0), "env_strength": 1.0, "env_texture": -1,
-                "env_rotation": 0.0, "env_dist_offset": 0, "env_size": (1, 1), "env_rows_pole_to_pole": 0}
+                "env_rotation": 0.0, "env_dist_offset": 0, "env_size": (1, 1), "env_table_size": (1, 1),
+                "env_rows_pole_to_pole": 0}
     if isinstance(environment, ConstantEnvironment):
         uniforms["env_radiance"] = tuple(float(v) for v in environment.radiance)
         return uniforms, infinite_light_power(4.0 * math.pi * _luminance(environment.radiance), scene_radius)
@@ -152,6 +153,7 @@ def _environment_uniforms(environment: Environment, textures: TextureTable, scen
             env_texture=textures.index_of(InlineImageTexture(pixels=rgb, name=str(path))),
             env_rotation=math.radians(environment.rotation_deg),
             env_dist_offset=textures.add_floats(distribution.packed()), env_size=(rgb.shape[1], rgb.shape[0]),
+            env_table_size=(distribution.pdf.shape[1], distribution.pdf.shape[0]),
             env_rows_pole_to_pole=int(environment.rows == "pole_to_pole"),
         )
         return uniforms, environment_power(rgb, environment.strength, scene_radius)
@@ -278,7 +280,8 @@ class GpuScene:
             raise SceneTooLarge(
                 f"the scene needs {_size(size)} of {name.replace('_', ' ')} in one storage buffer, "
                 f"more than this GL device allows ({_size(max_block_bytes)}); "
-                f"simplify the meshes ({packed.uniforms['triangle_count']:,} triangles now)"
+                + ("use smaller image textures or environment map" if name == "image_data" else
+                   f"simplify the meshes ({packed.uniforms['triangle_count']:,} triangles now)")
             )
         self.packed = packed
         self.ctx = ctx

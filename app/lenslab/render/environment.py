@@ -32,23 +32,36 @@ def luminance(rgb: np.ndarray) -> np.ndarray:
     return rgb[..., 0] * 0.2126 + rgb[..., 1] * 0.7152 + rgb[..., 2] * 0.0722
 
 
+TABLE_MAX_SIZE = (1024, 512)  # cells of the sampling tables: a quarter of a degree near the horizon
+
+
 @dataclass(frozen=True)
 class EnvironmentDistribution:
     """Sampling tables for an (H, W) lat-long image: the pdf per pixel over (u, v), cumulative tables."""
 
-    pdf: np.ndarray  # (H, W) density over [0,1]^2 (integrates to 1)
+    pdf: np.ndarray  # (H, W) density over [0,1]^2 (integrates to 1), per table cell
     marginal_cdf: np.ndarray  # (H + 1,) over rows
     conditional_cdf: np.ndarray  # (H, W + 1) over columns of each row
 
     @classmethod
-    def from_image(cls, rgb: np.ndarray) -> "EnvironmentDistribution":
-        h, w = rgb.shape[:2]
+    def from_image(cls, rgb: np.ndarray, max_size: tuple[int, int] | None = None) -> "EnvironmentDistribution":
+        """Tables over at most ``max_size`` (width, height) cells: a larger image shares a cell between several
+        pixels, whose brightest sets the cell's weight (a 4096 x 2048 panorama's full-size tables alone would
+        need 64 MiB of GPU memory, for no visible gain in noise)."""
+        h_img, w_img = rgb.shape[:2]
         lum = np.maximum(luminance(rgb.astype(np.float64)), 0.0)
         # Bilinear lookups reach into neighbouring pixels: weight each pixel by the brightest it can show,
         # so that the pdf is never zero where the radiance is not (that would bias the estimate).
         padded = np.pad(lum, 1, mode="edge")
         padded[:, 0], padded[:, -1] = padded[:, -2], padded[:, 1]  # u wraps around
-        func = np.max([padded[1 + dy : 1 + dy + h, 1 + dx : 1 + dx + w] for dy in (-1, 0, 1) for dx in (-1, 0, 1)], axis=0)
+        func = np.max([padded[1 + dy : 1 + dy + h_img, 1 + dx : 1 + dx + w_img] for dy in (-1, 0, 1) for dx in (-1, 0, 1)],
+                      axis=0)
+        max_size = max_size or TABLE_MAX_SIZE
+        w, h = min(w_img, max_size[0]), min(h_img, max_size[1])
+        # Cell j spans pixels [floor(j n / cells), floor((j + 1) n / cells)); the one-pixel reach above covers the
+        # pixel a cell only partly overlaps at its far end.
+        func = np.maximum.reduceat(func, (np.arange(h) * h_img) // h, axis=0)
+        func = np.maximum.reduceat(func, (np.arange(w) * w_img) // w, axis=1)
         sin_theta = np.sin(np.pi * (np.arange(h) + 0.5) / h)[:, None]
         func = func * sin_theta
         func += 1e-6 * max(func.mean(), 1e-12)  # never exactly zero: every direction stays reachable
