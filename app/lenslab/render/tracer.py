@@ -28,9 +28,11 @@ from lenslab.scene.scene import RenderSettings, Scene
 
 LOCAL_SIZE_X = 32  # GPU-NOTES: 32x1 work groups traversed the kd-tree fastest on llvmpipe
 DEFAULT_DISPATCH_SECONDS = 0.1
-# A splatted gaussian keeps one pass of samples (16 bytes each) until splat.comp has spread them: at most
-# this much memory, and never more than one storage block; passes take fewer samples per pixel to fit.
-SPLAT_MEMORY_BYTES = 64 << 20
+# A splatted gaussian keeps one pass of samples (16 bytes each) until splat.comp has spread them. One sample
+# per pixel may take up to SPLAT_MEMORY_BYTES (a 3840 x 2160 image: 127 MiB; never more than one storage
+# block); passes of several samples per pixel, which pay off on small images, stay within SPLAT_LAYERS_BYTES.
+SPLAT_MEMORY_BYTES = 128 << 20
+SPLAT_LAYERS_BYTES = 32 << 20
 SPLAT_MAX_LAYERS = 64  # samples per pixel in one splatted pass
 SPLAT_GATHER_TERMS = 1 << 22  # neighbour terms per splat.comp dispatch, to keep it short on any device
 
@@ -172,8 +174,9 @@ class RenderSession:
         if self.settings.pixel_filter != "gaussian":
             return 0
         layer_bytes = 16 * self.width * self.height
-        limit = min(SPLAT_MEMORY_BYTES, self.renderer.limits.max_storage_block_bytes)
-        return max(0, min(SPLAT_MAX_LAYERS, limit // layer_bytes))
+        if layer_bytes > min(SPLAT_MEMORY_BYTES, self.renderer.limits.max_storage_block_bytes):
+            return 0
+        return max(1, min(SPLAT_MAX_LAYERS, SPLAT_LAYERS_BYTES // layer_bytes))
 
     @property
     def program_stack_size(self) -> int:
