@@ -5,8 +5,8 @@
 // trace.comp has written one radiance sample per slot for samples sample_start ... of every pixel, each taken
 // at a position uniform over its pixel. A sample at x lends its radiance to every pixel q whose filter
 // reaches it, weighted by g(x - centre of q) with g(d) = exp(-|d|^2 / 2 stddev^2) truncated at 4 stddev per
-// axis (Mitsuba's gaussian). Pixel q gathers those terms from its neighbours' samples; a sample's position
-// is not stored but drawn again from the same sampler, which is cheap and exact.
+// axis (Mitsuba's gaussian). Pixel q gathers those terms from its neighbours' samples, whose positions in
+// their pixels trace.comp stored beside their radiance.
 //
 // The estimate of the filtered image at q is sum(g L) / (N * G(q)), where G(q) is the integral of g over the
 // part of the image the filter covers (all of it inside, less at the borders, where no samples are taken):
@@ -18,17 +18,13 @@
 
 layout(local_size_x = LOCAL_SIZE_X) in;
 
-#include "rng.glsl"
-
 layout(std430, binding = 6) readonly buffer Samples { vec4 samples[]; };  // trace.comp's slots
 layout(std430, binding = 0) buffer Accumulation { vec4 accumulation[]; };
 
 uniform ivec2 image_size;
 uniform int tile_start;  // first pixel (row-major index) of this dispatch
 uniform int tile_pixels;
-uniform uint sample_start;  // sample index of the first slot layer
-uniform int sample_count;   // slot layers
-uniform uint seed;
+uniform int sample_count;  // slot layers
 uniform float filter_stddev;
 uniform bool sampled_weights;
 
@@ -47,6 +43,9 @@ float covered_weight(float centre, float size) {
     float s = filter_stddev * sqrt(2.0);
     return filter_stddev * SQRT_HALF_PI * (erf_approx(hi / s) - erf_approx(lo / s));
 }
+
+// The inverse of trace.comp's encode_pixel_position, at the centre of the 1/4096-pixel bucket in x.
+vec2 decode_pixel_position(float e) { return vec2((floor(e) + 0.5) / 4096.0, fract(e)); }
 
 float filter_1d(float d) {
     return abs(d) <= 4.0 * filter_stddev ? exp(-d * d / (2.0 * filter_stddev * filter_stddev)) : 0.0;
@@ -70,12 +69,11 @@ void main() {
         float drawn_weight = 0.0;
         for (int y = lo.y; y <= hi.y; y++) {
             for (int x = lo.x; x <= hi.x; x++) {
-                Sampler sampler = sampler_start(uvec2(x, y), sample_start + uint(k), seed);
-                vec2 position = vec2(x, y) + sample4(sampler).xy;  // where trace.comp took this sample
-                vec2 d = position - centre;
+                vec4 s = samples[k * pixels + y * image_size.x + x];
+                vec2 d = vec2(x, y) + decode_pixel_position(s.w) - centre;
                 float w = filter_1d(d.x) * filter_1d(d.y);
                 if (w > 0.0) {
-                    gathered += w * samples[k * pixels + y * image_size.x + x].xyz;
+                    gathered += w * s.xyz;
                     drawn_weight += w;
                 }
             }

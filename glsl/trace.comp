@@ -7,7 +7,7 @@
 //   index order, so the image is bit-identical however the host splits the work into dispatches. A box
 //   filter, or a gaussian by filter importance sampling.
 // * splat_pixels > 0: a gaussian filter by splatting (as Mitsuba and pbrt-v3). Samples are uniform over their
-//   pixel and their radiance is written to a slot of their own; splat.comp then spreads every sample over
+//   pixel and their radiance and position are written to a slot of their own; splat.comp then spreads every sample over
 //   the pixels its filter reaches. Every sample serves several pixels, so the noise per pixel is lower.
 
 layout(local_size_x = LOCAL_SIZE_X) in;
@@ -26,7 +26,8 @@ layout(local_size_x = LOCAL_SIZE_X) in;
 #include "integrator.glsl"
 
 // splat_pixels == 0: rgb = sum of radiance samples, a = their count (the film's accumulation).
-// splat_pixels > 0: one radiance sample per slot, slot = (sample index - sample_start) * splat_pixels + pixel.
+// splat_pixels > 0: one sample per slot, slot = (sample index - sample_start) * splat_pixels + pixel: its
+// radiance, and where in the pixel it was taken (encode_pixel_position).
 layout(std430, binding = 6) buffer Accumulation { vec4 accumulation[]; };
 
 uniform int tile_start;   // first pixel (row-major index) of this dispatch
@@ -67,6 +68,10 @@ vec2 pixel_offset(vec2 u) {
     return filter_stddev * sqrt(2.0) * vec2(inverse_erf(x.x), inverse_erf(x.y));
 }
 
+// Where in its pixel a splatted sample was taken, in one float for splat.comp: 12 bits of x as the integer
+// part, y in the fraction (both to 1/4096 of a pixel; plain float values, safe from NaN and denormal flushing).
+float encode_pixel_position(vec2 u) { return floor(u.x * 4096.0) + min(u.y, 0.99975586); }
+
 void main() {
     int local = int(gl_GlobalInvocationID.x);
     if (local >= tile_pixels) return;
@@ -83,7 +88,7 @@ void main() {
         if (any(isnan(l)) || any(isinf(l))) l = vec3(0.0);
         if (clamp_max > 0.0 && max_component(l) > clamp_max) l *= clamp_max / max_component(l);
         if (splat_pixels > 0) {
-            accumulation[k * splat_pixels + pixel_index] = vec4(l, 1.0);
+            accumulation[k * splat_pixels + pixel_index] = vec4(l, encode_pixel_position(u.xy));
         } else {
             sum += vec4(l, 1.0);
         }

@@ -70,11 +70,8 @@ class Renderer:
             defines["SAMPLER_INDEPENDENT"] = 1
         return self.program("trace.comp", **defines)
 
-    def splat_program(self, sampler: str):
-        defines = {"LOCAL_SIZE_X": LOCAL_SIZE_X, "SOBOL_DIRECTIONS": glsl_array_literal()}
-        if sampler == "independent":
-            defines["SAMPLER_INDEPENDENT"] = 1
-        return self.program("splat.comp", **defines)
+    def splat_program(self):
+        return self.program("splat.comp", LOCAL_SIZE_X=LOCAL_SIZE_X)
 
     def describe(self) -> dict[str, str]:
         return gl.describe_device(self.ctx)
@@ -270,14 +267,13 @@ class RenderSession:
 
     def _splat_pass(self, samples: int) -> None:
         """Spread a finished pass of samples over the pixels their gaussian filter reaches (splat.comp)."""
-        program = self.renderer.splat_program(self.settings.sampler)
+        program = self.renderer.splat_program()
         reach = int(np.ceil(4.0 * self.settings.filter_stddev + 0.5))
         terms_per_pixel = samples * (2 * reach + 1) ** 2
         pixels_total = self.width * self.height
         chunk = max(LOCAL_SIZE_X, SPLAT_GATHER_TERMS // terms_per_pixel // LOCAL_SIZE_X * LOCAL_SIZE_X)
         self._accumulation.bind_to_storage_buffer(0)
-        for name, value in (("image_size", (self.width, self.height)), ("sample_start", self.samples_per_pixel),
-                            ("sample_count", samples), ("seed", self.settings.seed),
+        for name, value in (("image_size", (self.width, self.height)), ("sample_count", samples),
                             ("filter_stddev", self.settings.filter_stddev),
                             ("sampled_weights", self.settings.filter_weights == "sampled")):
             program[name].value = value
