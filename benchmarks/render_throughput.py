@@ -1,8 +1,8 @@
 """Path-tracing throughput of the shipped scenes on this machine's GL device.
 
-Prints samples per second for each scene and path length, and the Sobol sampler's cost relative to
-independent random numbers, measured in one run (ratios are what to compare across machines: these are
-shared and noisy). Usage: python benchmarks/render_throughput.py [--seconds 3] [--size 192]
+Prints samples per second for each scene and path length, the Sobol sampler's cost relative to
+independent random numbers, and what splatting a gaussian pixel filter costs against a box filter, measured
+in one run (ratios are what to compare across machines: these are shared and noisy). Usage: python benchmarks/render_throughput.py [--seconds 3] [--size 192]
 """
 
 from __future__ import annotations
@@ -42,6 +42,17 @@ def main() -> None:
                 rates[sampler] = samples_per_second(renderer, dataclasses.replace(scene, render=settings), args.size, args.seconds)
             print(f"{name:<12} {depth:>9} {rates['sobol'] / 1e6:>17.3f} {rates['independent'] / 1e6:>12.3f} "
                   f"{rates['sobol'] / rates['independent']:>12.2f}")
+    print(f"\n{'scene':<12} {'max_depth':>9} {'box Msamples/s':>15} {'gaussian splat':>15} {'splat/box':>10}")
+    for name in ("cornell_box", "dof_chart"):
+        scene = open_scene(name)
+        for depth in (2, scene.render.max_depth):
+            rates = {}
+            for pixel_filter in ("box", "gaussian"):
+                settings = dataclasses.replace(scene.render, max_depth=depth, pixel_filter=pixel_filter)
+                rates[pixel_filter] = samples_per_second(renderer, dataclasses.replace(scene, render=settings), args.size,
+                                                         args.seconds)
+            print(f"{name:<12} {depth:>9} {rates['box'] / 1e6:>15.3f} {rates['gaussian'] / 1e6:>15.3f} "
+                  f"{rates['gaussian'] / rates['box']:>10.2f}")
     renderer.release()
 
 
