@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -33,6 +35,7 @@ def test_headless_exr_is_linear_float_with_camera_metadata(renderer, tmp_path, c
     assert meta["Exif:FocalLength"] == pytest.approx(35.0)
     assert meta["Exif:SubjectDistance"] == pytest.approx(1.5)
     assert meta["lenslab:SensorWidthMM"] == pytest.approx(36.0) and meta["lenslab:SensorHeightMM"] == pytest.approx(24.0)
+    assert meta["lenslab:ImageHeightMM"] == pytest.approx(36.0 * 24 / 32)  # the picture: 32 x 24 pixels
     assert meta["lenslab:SamplesPerPixel"] == 2 and meta["lenslab:Seed"] == 7
     assert meta["Software"].startswith("LensLab ")
     assert "wrote" in err and "\n" == err[-1]
@@ -58,10 +61,12 @@ def test_time_limit_alone_renders_what_fits(renderer, tmp_path, capsys):
 @pytest.mark.parametrize(
     "argv, message",
     [
-        (["cornell_box", "--headless", "-o", "x.png", "--f-stop", "0"], r"--f-stop 0 is out of range \[0\.5, 128\]"),
-        (["cornell_box", "--headless", "-o", "x.png", "--spp", "many"], r"--spp must be a number, not 'many'"),
-        (["cornell_box", "--headless", "-o", "x.png", "--focus-distance", "-2"], r"--focus-distance -2 is out of range"),
-        (["cornell_box", "--headless", "-o", "x.png", "--width", "0"], r"--width 0 is out of range"),
+        (["cornell_box", "--headless", "-o", "x.png", "--f-stop", "0"], r"argument --f-stop: 0 is out of range \[0\.5, 128\]"),
+        (["cornell_box", "--headless", "-o", "x.png", "--spp", "many"], r"--spp: expected a whole number, not 'many'"),
+        (["cornell_box", "--headless", "-o", "x.png", "--spp", "-1"], r"--spp: -1 is out of range \[1, 16777216\]"),
+        (["cornell_box", "--headless", "-o", "x.png", "--focus-distance", "-2"], r"--focus-distance: -2 is out of range"),
+        (["cornell_box", "--headless", "-o", "x.png", "--width", "0"], r"--width: 0 is out of range"),
+        (["cornell_box", "--headless", "-o", "."], r"\. is a folder: name the image file, e.g\. render\.exr"),
         (["cornell_box", "--headless", "-o", "x.png", "--bokeh"], r"unrecognized arguments: --bokeh"),
         (["cornell_box", "--headless"], r"--headless needs an output file"),
         (["--headless", "-o", "x.png"], r"--headless needs a scene"),
@@ -79,6 +84,42 @@ def test_bad_arguments_exit_non_zero_with_one_line(tmp_path, monkeypatch, capsys
     assert err.count("\n") == 1 and err.startswith("lenslab: error: ")
     assert re.search(message, err), err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_output_problems_name_the_file_the_user_asked_for(tmp_path, capsys):
+    (tmp_path / "file.png").write_bytes(b"")
+    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "file.png" / "x.png")
+    assert status == 1 and f"'{tmp_path / 'file.png'}' is a file, not a folder" in err
+    locked = tmp_path / "locked"
+    locked.mkdir(mode=0o500)
+    if os.access(locked, os.W_OK):  # root writes anywhere: let the temporary file fail to be made instead
+        target = Path("/proc/x.png")
+    else:
+        target = locked / "x.png"
+    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", target, "--spp", "1", "--width", "8")
+    assert status == 1 and err.count("\n") == 1
+    assert str(target) in err and f"{target.parent}" in err and "/." not in err  # not our temporary name
+
+
+def test_scene_errors_found_when_packing_name_the_scene_file(tmp_path, capsys):
+    for name, changes, message in (
+        ("two_suns.json", {"lights": [{"type": "sun", "name": "a"}, {"type": "sun", "name": "b"}]},
+         "lights: only one sun per scene (found 'a', 'b')"),
+        ("ellipsoid.json", {"nodes": [{"name": "egg", "shape": {"type": "sphere", "radius": 0.5},
+                                       "transform": {"scale": [1, 2, 1]}}]},
+         "node 'egg': a sphere needs a uniform scale, not (1, 2, 1)"),
+    ):
+        scene = tmp_path / name
+        scene.write_text(json.dumps({"lenslab_scene": 1} | changes))
+        status, _, err = run_cli(capsys, scene, "--headless", "-o", tmp_path / "x.png")
+        assert status == 1 and err.startswith(f"lenslab: error: {scene}: {message}"), err
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_exposure_on_an_exr_is_a_warning(tmp_path, capsys):
+    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.exr", "--exposure", "1",
+                             "--spp", "1", "--width", "8")
+    assert status == 0 and "lenslab: warning: --exposure applies to PNG only" in err
 
 
 def test_broken_scene_exits_with_file_and_key(tmp_path, capsys):
@@ -187,3 +228,18 @@ def test_bad_define_is_a_usage_error(tmp_path, capsys):
     assert status == 2 and "-D nonsense: expected NAME=VALUE" in err
     status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.png", "-D", "a=1")
     assert status == 1 and "-D parameters apply to Mitsuba XML scenes only" in err
+
+
+def test_a_missing_texture_is_one_warning_and_the_render_goes_on(tmp_path, capsys):
+    scene = tmp_path / "textured.json"
+    scene.write_text(json.dumps({
+        "lenslab_scene": 1,
+        "materials": {"card": {"type": "diffuse", "albedo_texture": {"type": "image", "file": "nosuch.png"}}},
+        "nodes": [{"name": "card", "shape": {"type": "rectangle"}, "material": "card",
+                   "transform": {"translate": [0, 0, -3]}}],
+    }))
+    status, _, err = run_cli(capsys, scene, "--headless", "-o", tmp_path / "x.png", "--spp", "1", "--width", "8")
+    assert status == 0 and (tmp_path / "x.png").exists()
+    lines = [line for line in err.splitlines() if "nosuch.png" in line]
+    assert lines == [f"lenslab: warning: {tmp_path / 'nosuch.png'}: texture file not found; "
+                     "showing a magenta checkerboard instead"]

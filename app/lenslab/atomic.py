@@ -24,7 +24,10 @@ def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
     """Yield a temporary path beside ``path`` (same suffix, so format-sniffing writers still work);
     on success it replaces ``path`` with the permissions a newly created file would have."""
     path = Path(path)
-    fd, name = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
+    try:
+        fd, name = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
+    except OSError as exc:  # name the file the user asked for, not our temporary one
+        raise OSError(f"{path}: cannot write in {path.parent} ({exc.strerror or exc})") from None
     os.close(fd)
     tmp = Path(name)
     try:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import logging
 import os
 import sys
 import time
@@ -32,17 +33,28 @@ class _Parser(argparse.ArgumentParser):
         raise CliError(f"{message} (see lenslab --help)", EXIT_USAGE)
 
 
-def _number(kind, low: float, high: float, what: str):
+def _bound(value: float) -> str:
+    return str(int(value)) if float(value).is_integer() else f"{value:g}"
+
+
+def _number(kind, low: float, high: float):
     def parse(text: str):
         try:
             value = kind(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"{what} must be a number, not '{text}'") from None
+            raise argparse.ArgumentTypeError(f"expected {'a whole number' if kind is int else 'a number'}, "
+                                             f"not '{text}'") from None
         if not low <= value <= high or value != value:
-            raise argparse.ArgumentTypeError(f"{what} {text} is out of range [{low:g}, {high:g}]")
+            raise argparse.ArgumentTypeError(f"{text} is out of range [{_bound(low)}, {_bound(high)}]")
         return value
 
     return parse
+
+
+def _shipped_scenes() -> list[str]:
+    from lenslab.scene.io.loader import shipped_scene_names
+
+    return shipped_scene_names()
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -54,38 +66,40 @@ def build_parser() -> argparse.ArgumentParser:
         "  lenslab cornell_box --headless -o cornell.png --spp 64\n"
         "  lenslab my_scene.json --headless -o shot.exr --f-stop 1.4 --focus-distance 2.5 --time-limit 60\n"
         "Focal length, f-number and focus distance override the scene's camera for this render only; "
-        "brightness does not change with the f-number. Shipped scenes: cornell_box, dof_chart.",
+        "brightness does not change with the f-number. Shipped scenes: " + ", ".join(_shipped_scenes()) + ".\n"
+        "Compare with Mitsuba 3: lenslab validate --help.\n",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("scene", nargs="?", help="a scene file (.json), a folder holding scene.json, or a shipped scene name")
     p.add_argument("--headless", action="store_true", help="render to a file without opening a window")
     p.add_argument("-o", "--output", metavar="FILE", help="where to write the image: .exr (linear, float) or .png (sRGB)")
-    p.add_argument("--spp", type=_number(int, 1, 1 << 24, "--spp"), metavar="N",
+    p.add_argument("--spp", type=_number(int, 1, 1 << 24), metavar="N",
                    help="samples per pixel (default: the scene's; with --time-limit alone, as many as fit)")
-    p.add_argument("--time-limit", type=_number(float, 0.001, 1e7, "--time-limit"), metavar="SECONDS",
+    p.add_argument("--time-limit", type=_number(float, 0.001, 1e7), metavar="SECONDS",
                    help="stop after this long, keeping what has been rendered")
-    p.add_argument("--width", type=_number(int, 1, 16384, "--width"), metavar="W", help="image width in pixels")
-    p.add_argument("--height", type=_number(int, 1, 16384, "--height"), metavar="H", help="image height in pixels")
-    p.add_argument("--f-stop", type=_number(float, 0.5, 128, "--f-stop"), metavar="N",
+    p.add_argument("--width", type=_number(int, 1, 16384), metavar="W", help="image width in pixels")
+    p.add_argument("--height", type=_number(int, 1, 16384), metavar="H", help="image height in pixels")
+    p.add_argument("--f-stop", type=_number(float, 0.5, 128), metavar="N",
                    help="aperture as an f-number (1.4 is wide open and blurry, 16 is deep focus)")
-    p.add_argument("--focal-length", type=_number(float, 1, 2000, "--focal-length"), metavar="MM",
+    p.add_argument("--focal-length", type=_number(float, 1, 2000), metavar="MM",
                    help="lens focal length in millimetres (sets the field of view with the sensor width)")
-    p.add_argument("--focus-distance", type=_number(float, 0.01, 1e6, "--focus-distance"), metavar="M",
+    p.add_argument("--focus-distance", type=_number(float, 0.01, 1e6), metavar="M",
                    help="distance to the plane of focus, in metres")
-    p.add_argument("--seed", type=_number(int, 0, 2**31 - 1, "--seed"), metavar="S",
+    p.add_argument("--seed", type=_number(int, 0, 2**31 - 1), metavar="S",
                    help="random seed: the same seed gives the same image")
-    p.add_argument("--max-depth", type=_number(int, 1, 1024, "--max-depth"), metavar="D",
+    p.add_argument("--max-depth", type=_number(int, 1, 1024), metavar="D",
                    help="longest light path in segments (2 = direct light only)")
     p.add_argument("--sampler", choices=("sobol", "independent"), help="sample pattern (default: the scene's)")
-    p.add_argument("--clamp", type=_number(float, 0, 1e9, "--clamp"), metavar="L",
+    p.add_argument("--clamp", type=_number(float, 0, 1e9), metavar="L",
                    help="tame fireflies: cap the radiance one sample may add (biased; 0 = off, the default)")
-    p.add_argument("--exposure", type=_number(float, -30, 30, "--exposure"), default=0.0, metavar="STOPS",
+    p.add_argument("--exposure", type=_number(float, -30, 30), default=0.0, metavar="STOPS",
                    help="PNG only: brighten (+) or darken (-) by this many stops")
     p.add_argument("--tone-map", choices=("clamp", "reinhard", "filmic"), default="clamp",
-                   help="PNG only: how radiance above 1 is brought into the displayable range")
+                   help="PNG only: how radiance above 1 is brought into the displayable range (default: clamp; the "
+                        "studio shows and exports filmic unless told otherwise)")
     p.add_argument("-D", dest="defines", action="append", default=[], metavar="NAME=VALUE",
                    help="Mitsuba XML scenes: set the parameter $NAME, as mitsuba -D does (repeatable)")
-    p.add_argument("--device", type=_number(int, 0, 64, "--device"), metavar="N", help="which GPU to use (EGL device index)")
+    p.add_argument("--device", type=_number(int, 0, 64), metavar="N", help="which GPU to use (EGL device index)")
     p.add_argument("--info", action="store_true", help="print the OpenGL device and the limits in use, then exit")
     p.add_argument("--version", action="version", version=f"lenslab {__version__}")
     return p
@@ -109,9 +123,13 @@ def _check_output(path_text: str | None) -> Path:
     if not path_text:
         raise CliError("--headless needs an output file: -o OUT.exr or -o OUT.png", EXIT_USAGE)
     path = Path(path_text)
+    if path.is_dir():
+        raise CliError(f"{path} is a folder: name the image file, e.g. {path / 'render.exr'}", EXIT_USAGE)
     if path.suffix.lower() not in EXPORT_SUFFIXES:
         raise CliError(f"{path}: unsupported output type '{path.suffix}' (use .exr or .png)", EXIT_USAGE)
     folder = path.parent if str(path.parent) else Path(".")
+    if folder.exists() and not folder.is_dir():
+        raise CliError(f"{path}: '{folder}' is a file, not a folder")
     if not folder.is_dir():
         raise CliError(f"{path}: folder '{folder}' does not exist")
     if not os.access(folder, os.W_OK):
@@ -173,6 +191,8 @@ def image_metadata(scene, spp: int) -> dict[str, object]:
         "Exif:FocalPlaneResolutionUnit": 3,
         "lenslab:SensorWidthMM": float(sensor_w),
         "lenslab:SensorHeightMM": float(sensor_h),
+        # The picture spans the sensor's width; its height follows the image's shape (square pixels).
+        "lenslab:ImageHeightMM": float(sensor_w * height / width),
         "lenslab:FocusDistanceM": float(cam.focus_distance_m),
         "lenslab:ApertureBlades": int(cam.aperture_blades),
         "lenslab:SamplesPerPixel": int(spp),
@@ -199,12 +219,18 @@ def render_headless(args) -> int:
     from lenslab.render.film import write_image
     from lenslab.render.tracer import Renderer, RenderSession
     from lenslab.scene.io.loader import open_scene
+    from lenslab.scene.scene import SceneError
 
     output = _check_output(args.output)
+    if args.exposure and output.suffix.lower() == ".exr":
+        _warn("--exposure applies to PNG only: an EXR keeps the linear radiance")
     scene = _apply_overrides(open_scene(args.scene, defines=parse_defines(args.defines), warn=_warn), args)
     target_spp = args.spp if args.spp is not None else (None if args.time_limit else scene.render.spp)
     renderer = Renderer(args.device)
-    session = RenderSession(renderer, scene, dispatch_seconds=HEADLESS_DISPATCH_SECONDS)
+    try:
+        session = RenderSession(renderer, scene, dispatch_seconds=HEADLESS_DISPATCH_SECONDS)
+    except (SceneError, ValueError) as exc:  # found only when the scene is packed for the GPU: name its file
+        raise SceneError(f"{scene.source_path or args.scene}: {exc}") from None
     for warning in session.warnings:
         _warn(warning)
     start = time.perf_counter()
@@ -245,8 +271,24 @@ def run(argv: list[str] | None = None) -> int:
     return run_studio(args)
 
 
+class _WarningLine(logging.Handler):
+    """Prints a logged warning as the CLI's own warning line, to whatever stderr is at the time."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        _warn(record.getMessage())
+
+
+def _report_library_warnings() -> None:
+    """Warnings LensLab's modules log (a texture reduced in size, NaN texels) read as the CLI's own lines,
+    instead of Python's bare last-resort output."""
+    logger = logging.getLogger("lenslab")
+    if not any(isinstance(h, _WarningLine) for h in logger.handlers):
+        logger.addHandler(_WarningLine(logging.WARNING))
+
+
 def main(argv: list[str] | None = None) -> int:
     args_list = sys.argv[1:] if argv is None else list(argv)
+    _report_library_warnings()
     if args_list[:1] == ["validate"]:
         from lenslab.validate.cli import main as validate_main
 

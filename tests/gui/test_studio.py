@@ -376,9 +376,46 @@ def test_an_unrenderable_edit_shows_why_and_undo_recovers(qtbot, window):
     with qtbot.waitSignal(window.controller.render_error, timeout=10000,
                           check_params_cb=lambda message: bool(message)):
         doc.set_value(("node", sphere), ("transform", "scale"), (1.0, 2.0, 1.0))
-    assert "non-uniform scale" in window.viewport.message
+    assert "needs a uniform scale, not (1, 2, 1)" in window.viewport.message
     with qtbot.waitSignal(window.controller.render_error, timeout=10000,
                           check_params_cb=lambda message: message == ""):
         doc.undo_stack.undo()
     assert window.viewport.message == ""
     wait_for_frame(qtbot, window, generation=window.controller.generation)
+
+
+# -- point lights and suns -------------------------------------------------------------------------------------
+def test_point_lights_and_suns_are_in_the_outliner_editable_and_undoable(qtbot, make_window, small_scene):
+    from lenslab.gui.scene_tree import LIGHTS
+    from lenslab.scene.lights import SunLight
+
+    small_scene.lights = [SunLight(name="late sun", direction=(1.0, 1.0, 0.5))]
+    window = make_window(small_scene)
+    doc, model = window.doc, window.scene_tree.tree_model
+    group = model.index_of(LIGHTS)
+    assert model.data(group) == "Lights" and model.rowCount(group) == 1
+    assert model.data(model.index(0, 0, group)) == "late sun"
+    wait_for_frame(qtbot, window)
+
+    # Selecting it in the outliner shows its fields; an edit there re-renders.
+    window.scene_tree.setCurrentIndex(model.index(0, 0, group))
+    assert doc.selection == [("light", 0)] and window.properties.title.text() == "late sun"
+    generation = window.controller.generation
+    irradiance = window.properties._editors[("irradiance",)].widget
+    irradiance.spins[0].setValue(7.5)
+    assert doc.scene.lights[0].irradiance[0] == 7.5 and window.controller.generation > generation
+    # Renamed in place, deleted, then both undone.
+    assert model.setData(model.index(0, 0, group), "noon sun")
+    assert doc.scene.lights[0].name == "noon sun"
+    window.delete_selection()
+    assert doc.scene.lights == [] and model.rowCount(model.index_of(LIGHTS)) == 0
+    for _ in range(3):
+        doc.undo_stack.undo()
+    assert doc.scene.lights == [SunLight(name="late sun", direction=(1.0, 1.0, 0.5))]
+
+    # Edit > Add > Point Light puts one above the point of focus and selects it.
+    window.actions["add_point_light"].trigger()
+    assert [type(light).__name__ for light in doc.scene.lights] == ["SunLight", "PointLight"]
+    assert doc.selection == [("light", 1)] and window.properties.title.text() == "point light"
+    doc.undo_stack.undo()
+    assert len(doc.scene.lights) == 1

@@ -17,6 +17,7 @@ from PySide6.QtGui import QUndoCommand
 
 from lenslab.optics import LensPreset
 from lenslab.scene.events import SceneChange
+from lenslab.scene.lights import Light
 from lenslab.scene.scene import Node
 
 MERGE_SECONDS = 1.5
@@ -149,6 +150,49 @@ class RemoveNodesCommand(QUndoCommand):
     def undo(self) -> None:
         for path, node in sorted(self.removed):
             self.doc.children_of(path[:-1]).insert(path[-1], copy.deepcopy(node))
+        self.doc.set_selection(self.old_selection)
+        self.doc.notify(SceneChange("structure"))
+
+
+class AddLightCommand(QUndoCommand):
+    """Add a point light or a sun (lights that are not shapes: the scene's list of lights)."""
+
+    def __init__(self, doc, light: Light):
+        super().__init__(f"Add {light.name}")
+        self.doc = doc
+        self.light = copy.deepcopy(light)
+        self.index = len(doc.scene.lights)
+        self.old_selection = list(doc.selection)
+
+    def redo(self) -> None:
+        self.doc.scene.lights.insert(self.index, copy.deepcopy(self.light))
+        self.doc.notify(SceneChange("structure", ("light", self.index)))
+        self.doc.set_selection([("light", self.index)])
+
+    def undo(self) -> None:
+        del self.doc.scene.lights[self.index]
+        self.doc.set_selection([t for t in self.old_selection if self.doc.exists(t)])
+        self.doc.notify(SceneChange("structure"))
+
+
+class RemoveLightsCommand(QUndoCommand):
+    def __init__(self, doc, indices: list[int]):
+        indices = sorted(set(indices))
+        names = [doc.scene.lights[i].name for i in indices]
+        super().__init__("Delete " + (names[0] if len(names) == 1 else f"{len(names)} lights"))
+        self.doc = doc
+        self.removed = [(i, copy.deepcopy(doc.scene.lights[i])) for i in indices]
+        self.old_selection = list(doc.selection)
+
+    def redo(self) -> None:
+        for index, _light in reversed(self.removed):  # last first: the other indices stay valid
+            del self.doc.scene.lights[index]
+        self.doc.set_selection([t for t in self.doc.selection if t[0] != "light"])
+        self.doc.notify(SceneChange("structure"))
+
+    def undo(self) -> None:
+        for index, light in self.removed:
+            self.doc.scene.lights.insert(index, copy.deepcopy(light))
         self.doc.set_selection(self.old_selection)
         self.doc.notify(SceneChange("structure"))
 

@@ -33,7 +33,7 @@ ENVIRONMENT = ("environment",)
 RENDER = ("render",)
 
 _KIND_OF_TARGET = {"camera": "camera", "environment": "environment", "render": "render", "material": "material",
-                   "node": "node"}
+                   "node": "node", "light": "light"}
 
 
 def node_target(path) -> tuple:
@@ -44,9 +44,13 @@ def material_target(name: str) -> tuple:
     return ("material", name)
 
 
+def light_target(index: int) -> tuple:
+    return ("light", int(index))
+
+
 def describe_target(target: tuple) -> str:
-    if target[0] == "node":
-        return "node"
+    if target[0] in ("node", "light"):
+        return target[0]
     if target[0] == "material":
         return f"material '{target[1]}'"
     return target[0]
@@ -152,6 +156,8 @@ class Document(QObject):
             return self.scene.materials[target[1]]
         if kind == "node":
             return self.node(target[1])
+        if kind == "light":
+            return self.scene.lights[target[1]]
         raise KeyError(f"unknown target {target!r}")
 
     def exists(self, target: tuple) -> bool:
@@ -179,6 +185,8 @@ class Document(QObject):
             elif kind == "node":
                 parent, index = target[1][:-1], target[1][-1]
                 self.children_of(parent)[index] = value
+            elif kind == "light":
+                self.scene.lights[target[1]] = value
         else:
             obj = self.resolve(target)
             for name in field[:-1]:
@@ -218,6 +226,9 @@ class Document(QObject):
 
     def unique_material_name(self, base: str) -> str:
         return _unique(base, set(self.scene.materials))
+
+    def unique_light_name(self, base: str) -> str:
+        return _unique(base, {light.name for light in self.scene.lights})
 
     # -- selection -------------------------------------------------------------------------------------------
     def set_selection(self, targets: list[tuple]) -> None:

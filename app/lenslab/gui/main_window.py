@@ -34,7 +34,8 @@ from PySide6.QtWidgets import (
 from lenslab import __version__
 from lenslab.gui import theme
 from lenslab.gui.camera_panel import CameraPanel, format_distance
-from lenslab.gui.commands import AddMaterialCommand, AddNodeCommand, RemoveMaterialCommand, RemoveNodesCommand
+from lenslab.gui.commands import (AddLightCommand, AddMaterialCommand, AddNodeCommand, RemoveLightsCommand,
+                                  RemoveMaterialCommand, RemoveNodesCommand)
 from lenslab.gui.controller import QUALITIES, SAMPLE_LIMITS, RenderController, elapsed_text, rate_text, samples_text
 from lenslab.gui.defaults import studio_scene
 from lenslab.gui.document import Document, is_shipped
@@ -47,6 +48,7 @@ from lenslab.render.film import TONE_MAPS
 from lenslab.scene.io.loader import open_scene, resolve_scene_path, shipped_scene_names
 from lenslab.scene.io.meshes import MESH_SUFFIXES, MeshLoadError, load_mesh
 from lenslab.scene.io.native import SCENE_SUFFIX, save_scene
+from lenslab.scene.lights import PointLight, SunLight
 from lenslab.scene.materials import Diffuse, Emissive
 from lenslab.scene.scene import Node, SceneError
 from lenslab.scene.shapes import Box, MeshFile, Rectangle, Sphere
@@ -152,6 +154,8 @@ class MainWindow(QMainWindow):
         act["add_box"] = a("Box", lambda: self.add_primitive("box"), icon="box")
         act["add_rectangle"] = a("Rectangle", lambda: self.add_primitive("rectangle"), icon="rectangle")
         act["add_light"] = a("Area Light", lambda: self.add_primitive("light"), icon="light")
+        act["add_point_light"] = a("Point Light", lambda: self.add_light("point"), icon="light")
+        act["add_sun"] = a("Sun", lambda: self.add_light("sun"), icon="light")
         act["new_material"] = a("New Material", self.new_material, icon="material")
         act["duplicate"] = a("&Duplicate", self.duplicate_selection, "Ctrl+D")
         act["rename"] = a("Re&name", self.rename_selection, "F2")
@@ -276,7 +280,7 @@ class MainWindow(QMainWindow):
         self.splitDockWidget(self.docks["scene"], self.docks["properties"], Qt.Vertical)
         self.tabifyDockWidget(self.docks["camera"], self.docks["history"])
         self.docks["camera"].raise_()
-        self.resizeDocks([self.docks["scene"], self.docks["camera"]], [330, 350], Qt.Horizontal)
+        self.resizeDocks([self.docks["scene"], self.docks["camera"]], [360, 350], Qt.Horizontal)
         self.resizeDocks([self.docks["scene"], self.docks["properties"]], [300, 520], Qt.Vertical)
 
     def _create_menus(self) -> None:
@@ -304,7 +308,7 @@ class MainWindow(QMainWindow):
         edit.addAction(act["redo"])
         edit.addSeparator()
         add = edit.addMenu("&Add")
-        for name in ("add_group", "add_sphere", "add_box", "add_rectangle", "add_light"):
+        for name in ("add_group", "add_sphere", "add_box", "add_rectangle", "add_light", "add_point_light", "add_sun"):
             add.addAction(act[name])
         add.addSeparator()
         add.addAction(act["import_mesh"])
@@ -740,6 +744,21 @@ class MainWindow(QMainWindow):
             raise ValueError(kind)
         self.doc.push(AddNodeCommand(self.doc, node, self._insertion_parent()))
 
+    def add_light(self, kind: str) -> None:
+        """A point light above the point of focus, or a sun from behind the camera's right shoulder."""
+        name = self.doc.unique_light_name("sun" if kind == "sun" else "point light")
+        if kind == "sun":
+            cam = self.doc.scene.camera
+            right, up, back = cam.basis()
+            direction = tuple(float(round(c, 4)) for c in (0.5 * right + up + 0.7 * back))
+            light = SunLight(name=name, direction=direction)
+        else:
+            size = max(0.05, self.view_width_at_focus() * 0.12)
+            up = self.doc.scene.camera.basis()[1]
+            at = tuple(float(round(c, 4)) for c in self.focus_point() + up * size * 4)
+            light = PointLight(name=name, position=at, intensity=(size * 40.0,) * 3)
+        self.doc.push(AddLightCommand(self.doc, light))
+
     def new_material(self) -> None:
         name = self.doc.unique_material_name("material")
         assign = self.doc.selected_node_paths()
@@ -821,10 +840,13 @@ class MainWindow(QMainWindow):
     def delete_selection(self) -> None:
         nodes = self.doc.selected_node_paths()
         materials = [t[1] for t in self.doc.selection if t[0] == "material"]
-        if not nodes and not materials:
+        lights = [t[1] for t in self.doc.selection if t[0] == "light" and self.doc.exists(t)]
+        if not nodes and not materials and not lights:
             return
         stack = self.doc.undo_stack
         stack.beginMacro("Delete")
+        if lights:
+            self.doc.push(RemoveLightsCommand(self.doc, lights))
         if nodes:
             self.doc.push(RemoveNodesCommand(self.doc, nodes))
         for name in materials:

@@ -34,6 +34,7 @@ from PySide6.QtWidgets import (
 from lenslab.gui import theme
 from lenslab.gui.commands import AddMaterialCommand, RenameMaterialCommand
 from lenslab.gui.widgets import ColorEdit, IntEdit, NumberEdit, Section, VectorEdit, hint
+from lenslab.scene.lights import LIGHT_TYPES, Light
 from lenslab.scene.materials import MATERIAL_TYPES, Diffuse, Material
 from lenslab.scene.io.meshes import MESH_SUFFIXES
 from lenslab.scene.scene import ENVIRONMENT_TYPES, Environment, Node
@@ -41,7 +42,7 @@ from lenslab.scene.shapes import SHAPE_TYPES, MeshFile, Shape
 
 #: Polymorphic slots: the base class picks the registry of concrete types to choose from.
 TAGGED_TYPES: dict[type, dict[str, type]] = {Shape: SHAPE_TYPES, Material: MATERIAL_TYPES,
-                                             Environment: ENVIRONMENT_TYPES}
+                                             Environment: ENVIRONMENT_TYPES, Light: LIGHT_TYPES}
 
 #: Fields whose RGB triple is a colour (the scene model's RGB alias is a plain tuple, so the name tells).
 COLOUR_FIELDS = {"albedo", "radiance", "color", "colour", "reflectance", "transmittance", "specular", "tint",
@@ -117,7 +118,7 @@ class PropertyEditor(QWidget):
         self.subtitle = hint("")
         self.scroll = QScrollArea()
         self.scroll.setWidgetResizable(True)
-        self.scroll.setHorizontalScrollBarPolicy(Qt.ScrollBarAlwaysOff)
+        self.scroll.setHorizontalScrollBarPolicy(Qt.ScrollBarAsNeeded)  # never clip a field
         layout = QVBoxLayout(self)
         layout.setContentsMargins(8, 6, 8, 4)
         layout.addWidget(self.title)
@@ -168,6 +169,16 @@ class PropertyEditor(QWidget):
             users = len(self.doc.material_users(target[1]))
             self.subtitle.setText(f"Material · {type_name_of(obj)} · used by {users} node{'s' * (users != 1)}")
             self._build_material(layout, obj)
+        elif kind == "light":
+            self.title.setText(obj.name)
+            self.subtitle.setText("Sun: parallel light from a direction, irradiance in W/m²" if obj.type_name == "sun"
+                                  else "Point light: intensity in W/sr, the same in every direction")
+            section = Section("Light")
+            form = self._form()
+            section.add(form)
+            self._add_type_selector(form, target, (), obj, Light)
+            self._add_fields(form, target, (), obj)
+            layout.addWidget(section)
         else:
             self.title.setText({"camera": "Camera", "environment": "Environment", "render": "Render settings"}[kind])
             self.subtitle.setText({"camera": "Placement and film back; the photographic controls are in the Camera panel.",
@@ -196,6 +207,7 @@ class PropertyEditor(QWidget):
         form = QFormLayout()
         form.setLabelAlignment(Qt.AlignRight | Qt.AlignVCenter)
         form.setFieldGrowthPolicy(QFormLayout.AllNonFixedFieldsGrow)
+        form.setRowWrapPolicy(QFormLayout.WrapLongRows)  # a narrow panel puts labels above their fields
         form.setHorizontalSpacing(8)
         form.setVerticalSpacing(5)
         return form
@@ -451,7 +463,7 @@ class PropertyEditor(QWidget):
                 except (AttributeError, KeyError):
                     self.rebuild()
                     return
-            if target[0] == "node":
+            if target[0] in ("node", "light"):
                 self.title.setText(self.doc.resolve(target).name)
 
 

@@ -1,7 +1,7 @@
-"""The outliner: a Qt item model over the scene (camera, environment, the node tree, materials, render settings)
-and the tree view that shows it. Selecting here selects in the viewport and the property editor and back;
-nodes can be renamed in place (F2 or double click) and dragged onto another node to parent them, keeping where
-they are in the world, as in Blender's outliner."""
+"""The outliner: a Qt item model over the scene (camera, environment, the node tree, materials, point lights and
+suns, render settings) and the tree view that shows it. Selecting here selects in the viewport and the property
+editor and back; nodes can be renamed in place (F2 or double click) and dragged onto another node to parent them,
+keeping where they are in the world, as in Blender's outliner."""
 
 from __future__ import annotations
 
@@ -23,6 +23,8 @@ NODE_MIME = "application/x-lenslab-node-paths"
 
 OBJECTS = ("objects",)
 MATERIALS = ("materials",)
+LIGHTS = ("lights",)  # point lights and suns; area lights are objects with an emissive material
+GROUPS = {OBJECTS: "Objects", MATERIALS: "Materials", LIGHTS: "Lights"}
 
 
 class _Item:
@@ -73,6 +75,9 @@ class SceneTreeModel(QAbstractItemModel):
         materials = add(root, MATERIALS)
         for name in self.doc.scene.materials:
             add(materials, ("material", name))
+        lights = add(root, LIGHTS)
+        for i in range(len(self.doc.scene.lights)):
+            add(lights, ("light", i))
         add(root, ("render",))
         self._root, self._by_key = root, by_key
 
@@ -84,7 +89,7 @@ class SceneTreeModel(QAbstractItemModel):
     def _on_change(self, change) -> None:
         if change.kind in ("structure", "scene"):
             self.rebuild()
-        elif change.kind == "node":
+        elif change.kind in ("node", "light"):
             item = self._by_key.get(change.target)
             if item is not None:
                 index = self.createIndex(item.row, 0, item)
@@ -140,28 +145,32 @@ class SceneTreeModel(QAbstractItemModel):
         key = index.internalPointer().key
         kind = key[0]
         try:
-            obj = self.doc.resolve(key) if kind in ("camera", "environment", "render", "material", "node") else None
+            obj = self.doc.resolve(key) if kind in ("camera", "environment", "render", "material", "node", "light") else None
         except (KeyError, IndexError):
             return None
+        group = key in GROUPS
         if role in (Qt.DisplayRole, Qt.EditRole):
-            if kind == "node":
+            if kind in ("node", "light"):
                 return obj.name
             if kind == "material":
                 return key[1]
-            return {"camera": "Camera", "environment": "Environment", "render": "Render settings",
-                    "objects": "Objects", "materials": "Materials"}[kind]
+            if group:
+                return GROUPS[key]
+            return {"camera": "Camera", "environment": "Environment", "render": "Render settings"}[kind]
         if role == Qt.DecorationRole:
             if kind == "node":
                 return theme.icon(self._node_icon(obj))
             if kind == "material":
                 return theme.swatch(display_rgb(obj))
+            if group:
+                return theme.icon("folder")
             return theme.icon({"camera": "camera", "environment": "environment", "render": "render",
-                               "objects": "folder", "materials": "folder"}[kind])
+                               "light": "light"}[kind])
         if role == Qt.ToolTipRole:
             return self._tooltip(kind, key, obj)
-        if role == Qt.ForegroundRole and kind in ("objects", "materials"):
+        if role == Qt.ForegroundRole and group:
             return QColor(theme.DIM_TEXT)
-        if role == Qt.FontRole and kind in ("objects", "materials"):
+        if role == Qt.FontRole and group:
             font = QFont()
             font.setBold(True)
             return font
@@ -184,6 +193,10 @@ class SceneTreeModel(QAbstractItemModel):
                 parts.append(obj.shape.file)
             parts.append(f"material: {obj.material or 'default grey'}")
             return "<br>".join(parts)
+        if kind == "light":
+            return f"<b>{obj.name}</b><br>{'sun' if obj.type_name == 'sun' else 'point light'}"
+        if key == LIGHTS:
+            return "Point lights and suns. Area lights are objects with an emissive material."
         if kind == "material":
             users = len(self.doc.material_users(key[1]))
             return f"<b>{key[1]}</b><br>{obj.type_name} · used by {users} node{'s' * (users != 1)}"
@@ -201,7 +214,7 @@ class SceneTreeModel(QAbstractItemModel):
         flags = Qt.ItemIsEnabled | Qt.ItemIsSelectable
         if key[0] == "node":
             flags |= Qt.ItemIsEditable | Qt.ItemIsDragEnabled | Qt.ItemIsDropEnabled
-        elif key[0] == "material":
+        elif key[0] in ("material", "light"):
             flags |= Qt.ItemIsEditable
         elif key == OBJECTS:
             flags |= Qt.ItemIsDropEnabled
@@ -214,8 +227,8 @@ class SceneTreeModel(QAbstractItemModel):
         text = str(value).strip()
         if not text:
             return False
-        if key[0] == "node":
-            if text != self.doc.node(key[1]).name:
+        if key[0] in ("node", "light"):
+            if text != self.doc.resolve(key).name:
                 self.doc.set_value(key, ("name",), text, text=f"Rename to {text}")
             return True
         if key[0] == "material" and text != key[1]:
@@ -333,7 +346,7 @@ class SceneTreeView(QTreeView):
         self.setContextMenuPolicy(Qt.CustomContextMenu)
         self.customContextMenuRequested.connect(lambda pos: self.context_menu_requested.emit(self.viewport().mapToGlobal(pos)))
         self._syncing = False
-        self._expanded: set[tuple] = {OBJECTS, MATERIALS}
+        self._expanded: set[tuple] = {OBJECTS, MATERIALS, LIGHTS}
         self.expanded.connect(lambda i: self._expanded.add(self.tree_model.key(i)))
         self.collapsed.connect(lambda i: self._expanded.discard(self.tree_model.key(i)))
         self.tree_model.modelAboutToBeReset.connect(self._remember)
@@ -363,7 +376,7 @@ class SceneTreeView(QTreeView):
         if self._syncing:
             return
         keys = [self.tree_model.key(i) for i in self.selectionModel().selectedRows()]
-        keys = [k for k in keys if k and k[0] in ("camera", "environment", "render", "material", "node")]
+        keys = [k for k in keys if k and k[0] in ("camera", "environment", "render", "material", "node", "light")]
         self._syncing = True
         try:
             self.doc.set_selection(keys)
@@ -400,7 +413,8 @@ class SceneTreeView(QTreeView):
 
 def node_context_menu(parent, actions: dict) -> QMenu:
     menu = QMenu(parent)
-    for name in ("add_group", "add_sphere", "add_box", "add_rectangle", "add_light", "import_mesh", None,
+    for name in ("add_group", "add_sphere", "add_box", "add_rectangle", "add_light", "add_point_light", "add_sun",
+                 "import_mesh", None,
                  "new_material", None, "focus_on_selection", "rename", "duplicate", "delete"):
         if name is None:
             menu.addSeparator()

@@ -195,7 +195,7 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
     sun_uniforms = {"sun_direction": (0.0, 1.0, 0.0), "sun_one_minus_cos": 0.0, "sun_radiance": (0.0, 0.0, 0.0)}
     suns = [light.name for light in lights if isinstance(light, SunLight)]
     if len(suns) > 1:
-        raise ValueError(f"only one sun per scene (found {', '.join(suns)})")
+        raise ValueError(f"lights: only one sun per scene (found {', '.join(repr(name) for name in suns)})")
     for light in lights:
         if isinstance(light, PointLight):
             entries.append(_LightEntry(LIGHT_POINT, 4.0 * math.pi * _luminance(light.intensity),

@@ -85,8 +85,7 @@ class TextureTable:
                 rgb = read_texture_image(path, texture.color_space)
             except OSError as exc:
                 message = str(exc) if path.exists() else f"{path}: texture file not found"
-                self.warnings.append(f"{message}; showing a magenta checkerboard instead")
-                log.warning("%s", self.warnings[-1])
+                self.warnings.append(f"{message}; showing a magenta checkerboard instead")  # the caller reports it
                 return self._add(MISSING)
             self._add_texels(record, rgb, texture.tiles)
         elif isinstance(texture, InlineImageTexture):

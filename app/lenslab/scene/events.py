@@ -18,9 +18,10 @@ from typing import Any, Callable, Iterator
 
 #: What a change touched, from cheapest to dearest to re-render:
 #: ``camera`` (restart only), ``render`` (sampler settings), ``material`` (re-pack materials),
-#: ``environment``, ``node`` (a node's fields: transform, shape, material), ``structure`` (nodes or
-#: materials added, removed, renamed or moved) and ``scene`` (the whole scene replaced).
-CHANGE_KINDS = ("camera", "render", "material", "environment", "node", "structure", "scene")
+#: ``environment``, ``light`` (a point light's or a sun's fields), ``node`` (a node's fields: transform,
+#: shape, material), ``structure`` (nodes, materials or lights added, removed, renamed or moved) and
+#: ``scene`` (the whole scene replaced).
+CHANGE_KINDS = ("camera", "render", "material", "environment", "light", "node", "structure", "scene")
 
 
 @dataclass(frozen=True)

@@ -140,7 +140,9 @@ def flatten_scene(scene: Scene, mesh_loader=None) -> FlatScene:
             mat = material_index(node)
             scale = np.linalg.norm(matrix[:3, :3], axis=0)
             if np.ptp(scale) > 1e-6 * scale.max():
-                raise SceneError(f"node '{node.name}': a sphere cannot take a non-uniform scale {tuple(scale.round(6))}")
+                scale_text = ", ".join(f"{float(v):.6g}" for v in scale)
+                raise SceneError(f"node '{node.name}': a sphere needs a uniform scale, not ({scale_text}); "
+                                 "use a mesh for an ellipsoid")
             spheres.append([*matrix[:3, 3], node.shape.radius * scale[0]])
             sph_mat.append(mat)
             sph_node.append(node_index)
