@@ -54,7 +54,14 @@ SKIP_FIELDS = {"children", "source_path"}
 _UNITS = {"_mm": " (mm)", "_m": " (m)", "_deg": " (°)"}
 
 
+#: Field names that read badly when merely capitalised.
+_NAMES = {"spp": "Samples per pixel", "max_depth": "Max path length", "rr_depth": "Russian roulette from",
+          "filter_stddev": "Filter std. dev. (px)", "filter_weights": "Filter weights", "clamp": "Clamp radiance"}
+
+
 def pretty(name: str) -> str:
+    if name in _NAMES:
+        return _NAMES[name]
     for suffix, unit in _UNITS.items():
         if name.endswith(suffix):
             return name[: -len(suffix)].replace("_", " ").capitalize() + unit
@@ -183,7 +190,9 @@ class PropertyEditor(QWidget):
             self.title.setText({"camera": "Camera", "environment": "Environment", "render": "Render settings"}[kind])
             self.subtitle.setText({"camera": "Placement and film back; the photographic controls are in the Camera panel.",
                                    "environment": "Light arriving from far away, where rays leave the scene.",
-                                   "render": "How the image is sampled. The viewport and exports both use these."}[kind])
+                                   "render": "How the image is sampled, in the viewport and in exports. Samples per "
+                                             "pixel is the export default; the viewport refines up to the toolbar's "
+                                             "limit."}[kind])
             section = Section("Parameters")
             form = self._form()
             section.add(form)
