@@ -44,10 +44,6 @@ def material_target(name: str) -> tuple:
     return ("material", name)
 
 
-def light_target(index: int) -> tuple:
-    return ("light", int(index))
-
-
 def describe_target(target: tuple) -> str:
     if target[0] in ("node", "light"):
         return target[0]

@@ -25,6 +25,7 @@ OBJECTS = ("objects",)
 MATERIALS = ("materials",)
 LIGHTS = ("lights",)  # point lights and suns; area lights are objects with an emissive material
 GROUPS = {OBJECTS: "Objects", MATERIALS: "Materials", LIGHTS: "Lights"}
+TARGET_KINDS = ("camera", "environment", "render", "material", "node", "light")  # rows that select something
 
 
 class _Item:
@@ -145,7 +146,7 @@ class SceneTreeModel(QAbstractItemModel):
         key = index.internalPointer().key
         kind = key[0]
         try:
-            obj = self.doc.resolve(key) if kind in ("camera", "environment", "render", "material", "node", "light") else None
+            obj = self.doc.resolve(key) if kind in TARGET_KINDS else None
         except (KeyError, IndexError):
             return None
         group = key in GROUPS
@@ -376,7 +377,7 @@ class SceneTreeView(QTreeView):
         if self._syncing:
             return
         keys = [self.tree_model.key(i) for i in self.selectionModel().selectedRows()]
-        keys = [k for k in keys if k and k[0] in ("camera", "environment", "render", "material", "node", "light")]
+        keys = [k for k in keys if k and k[0] in TARGET_KINDS]
         self._syncing = True
         try:
             self.doc.set_selection(keys)

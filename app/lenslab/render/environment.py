@@ -32,7 +32,7 @@ def luminance(rgb: np.ndarray) -> np.ndarray:
     return rgb[..., 0] * 0.2126 + rgb[..., 1] * 0.7152 + rgb[..., 2] * 0.0722
 
 
-TABLE_MAX_SIZE = (1024, 512)  # cells of the sampling tables: a quarter of a degree near the horizon
+TABLE_MAX_SIZE = (1024, 512)  # cells of the sampling tables: a third of a degree on a side at the horizon
 
 
 @dataclass(frozen=True)
@@ -54,8 +54,8 @@ class EnvironmentDistribution:
         # so that the pdf is never zero where the radiance is not (that would bias the estimate).
         padded = np.pad(lum, 1, mode="edge")
         padded[:, 0], padded[:, -1] = padded[:, -2], padded[:, 1]  # u wraps around
-        func = np.max([padded[1 + dy : 1 + dy + h_img, 1 + dx : 1 + dx + w_img] for dy in (-1, 0, 1) for dx in (-1, 0, 1)],
-                      axis=0)
+        shifted = [padded[1 + dy : 1 + dy + h_img, 1 + dx : 1 + dx + w_img] for dy in (-1, 0, 1) for dx in (-1, 0, 1)]
+        func = np.max(shifted, axis=0)
         max_size = max_size or TABLE_MAX_SIZE
         w, h = min(w_img, max_size[0]), min(h_img, max_size[1])
         # Cell j spans pixels [floor(j n / cells), floor((j + 1) n / cells)); the one-pixel reach above covers the
