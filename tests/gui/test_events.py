@@ -64,3 +64,14 @@ def test_qt_calls_do_not_exhaust_none_and_true(qtbot):
         emitter.setObjectName("y")
     assert len(seen) == 20000
     assert sys.getrefcount(True) > 1000 and sys.getrefcount(None) > 1000
+
+
+def test_changing_a_shapes_type_keeps_its_extent_and_its_colour():
+    from lenslab.gui.properties import convert_type
+    from lenslab.scene.materials import Diffuse, Emissive
+    from lenslab.scene.shapes import Box, Rectangle, Sphere
+
+    assert convert_type(Box(size=(0.2, 0.3, 0.1)), Sphere) == Sphere(radius=0.15)
+    assert convert_type(Sphere(radius=0.25), Box) == Box(size=(0.5, 0.5, 0.5))
+    assert convert_type(Sphere(radius=0.25), Rectangle) == Rectangle(size=(0.5, 0.5))
+    assert convert_type(Diffuse((0.8, 0.1, 0.1)), Emissive).radiance == (0.8, 0.1, 0.1)

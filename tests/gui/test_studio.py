@@ -302,6 +302,10 @@ def test_export_dialog_builds_the_request(window, tmp_path):
     assert window.doc.scene.camera.resolution == (64, 48)  # the document is untouched
     dialog.path_edit.setText(str(tmp_path / "missing" / "a.png"))
     assert "does not exist" in dialog.validate()
+    dialog.accept()  # refused, with the reason under the settings
+    assert "does not exist" in dialog.estimate.text()
+    dialog.path_edit.setText(str(tmp_path / "a.png"))  # fixed: the complaint goes
+    assert dialog.validate() is None and "does not exist" not in dialog.estimate.text()
 
 
 # -- closing -----------------------------------------------------------------------------------------------------------

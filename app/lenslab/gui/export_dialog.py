@@ -174,6 +174,7 @@ class ExportDialog(QDialog):
         png = suffix == ".png"
         self.exposure_spin.setEnabled(png)
         self.tone_combo.setEnabled(png)
+        self._update_estimate()  # a complaint about the previous path no longer applies
 
     def _width_changed(self, w: int) -> None:
         if self.lock_aspect.isChecked():

@@ -38,7 +38,7 @@ from lenslab.scene.lights import LIGHT_TYPES, Light
 from lenslab.scene.materials import MATERIAL_TYPES, Diffuse, Material
 from lenslab.scene.io.meshes import MESH_SUFFIXES
 from lenslab.scene.scene import ENVIRONMENT_TYPES, Environment, Node
-from lenslab.scene.shapes import SHAPE_TYPES, MeshFile, Shape
+from lenslab.scene.shapes import SHAPE_TYPES, Box, Disk, MeshFile, Rectangle, Shape, Sphere
 
 #: Polymorphic slots: the base class picks the registry of concrete types to choose from.
 TAGGED_TYPES: dict[type, dict[str, type]] = {Shape: SHAPE_TYPES, Material: MATERIAL_TYPES,
@@ -96,7 +96,19 @@ def convert_type(old: Any, new_cls: type) -> Any:
         new_colour = next((k for k in new_fields if k in COLOUR_FIELDS and k not in kwargs), None)
         if old_colour is not None and new_colour is not None and typing.get_origin(hints[new_colour]) is tuple:
             kwargs[new_colour] = tuple(old_colour)
+        kwargs.update(_same_extent(old, new_cls))
     return new_cls(**kwargs)
+
+
+def _same_extent(old: Any, new_cls: type) -> dict[str, Any]:
+    """Size fields that keep a shape's extent when its type changes (a 0.3 m box becomes a 0.3 m sphere)."""
+    half = {Sphere: lambda o: o.radius, Disk: lambda o: o.radius, Box: lambda o: max(o.size) / 2,
+            Rectangle: lambda o: max(o.size) / 2}.get(type(old))
+    if half is None:
+        return {}
+    r = float(half(old))
+    return {Sphere: {"radius": r}, Disk: {"radius": r}, Box: {"size": (2 * r,) * 3},
+            Rectangle: {"size": (2 * r, 2 * r)}}.get(new_cls, {})
 
 
 class FieldEditor:
