@@ -387,3 +387,9 @@ def test_modules_expose_documented_names():
     for module in (thinlens, dof, stops):
         for name in module.__all__:
             assert getattr(module, name).__doc__ or not callable(getattr(module, name)), name
+
+
+def test_format_focal_length_reads_as_a_lens_barrel():
+    from lenslab.optics import format_focal_length
+
+    assert [format_focal_length(v) for v in (50, 31.1769, 24.04, 85.0)] == ["50 mm", "31.2 mm", "24 mm", "85 mm"]

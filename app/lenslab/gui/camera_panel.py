@@ -32,6 +32,7 @@ from lenslab.optics import (
     circle_of_confusion_mm,
     depth_of_field,
     format_f_number,
+    format_focal_length,
     load_lens_presets,
     load_sensor_presets,
     parse_f_number,
@@ -446,7 +447,8 @@ class CameraPanel(QWidget):
         self.doc.push(LensCommand(self.doc, lens))
         if lens is not None:
             cam = self.doc.scene.camera
-            self.status_message.emit(f"{lens.name}: {cam.focal_length_mm:g} mm, {format_f_number(cam.f_number)}")
+            self.status_message.emit(
+                f"{lens.name}: {format_focal_length(cam.focal_length_mm)}, {format_f_number(cam.f_number)}")
 
     def set_f_number(self, n: float, merge: bool = False) -> None:
         lens = self.doc.lens

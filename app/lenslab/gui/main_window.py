@@ -43,7 +43,7 @@ from lenslab.gui.export_dialog import ExportDialog
 from lenslab.gui.properties import PropertyEditor
 from lenslab.gui.scene_tree import SceneTreeView, node_context_menu
 from lenslab.gui.viewport import Viewport
-from lenslab.optics import circle_of_confusion_mm, depth_of_field, format_f_number
+from lenslab.optics import circle_of_confusion_mm, depth_of_field, format_f_number, format_focal_length
 from lenslab.render.film import TONE_MAPS
 from lenslab.scene.io.loader import open_scene, resolve_scene_path, shipped_scene_names
 from lenslab.scene.io.meshes import MESH_SUFFIXES, MeshLoadError, load_mesh
@@ -440,7 +440,7 @@ class MainWindow(QMainWindow):
 
     def _update_hud(self) -> None:
         cam = self.doc.scene.camera
-        self.viewport.hud_text = (f"{cam.focal_length_mm:g} mm · {format_f_number(cam.f_number)} · "
+        self.viewport.hud_text = (f"{format_focal_length(cam.focal_length_mm)} · {format_f_number(cam.f_number)} · "
                                   f"focus {format_distance(cam.focus_distance_m)}")
         self.viewport.update()
 

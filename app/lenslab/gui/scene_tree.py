@@ -202,9 +202,10 @@ class SceneTreeModel(QAbstractItemModel):
             users = len(self.doc.material_users(key[1]))
             return f"<b>{key[1]}</b><br>{obj.type_name} · used by {users} node{'s' * (users != 1)}"
         if kind == "camera":
-            from lenslab.optics import format_f_number
+            from lenslab.optics import format_f_number, format_focal_length
 
-            return (f"{obj.focal_length_mm:g} mm · {format_f_number(obj.f_number)} · focus {obj.focus_distance_m:.2f} m"
+            return (f"{format_focal_length(obj.focal_length_mm)} · {format_f_number(obj.f_number)} · "
+                    f"focus {obj.focus_distance_m:.2f} m"
                     f" · {obj.resolution[0]}×{obj.resolution[1]}")
         return None
 

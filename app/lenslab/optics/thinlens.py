@@ -26,6 +26,7 @@ import numpy as np
 
 __all__ = [
     "MM_PER_M",
+    "format_focal_length",
     "field_of_view_x",
     "focal_length_for_fov",
     "lens_radius_m",
@@ -138,3 +139,8 @@ def textbook_blur_diameter_mm(focal_length_mm, f_number, focus_distance_m, depth
     s_mm = s * MM_PER_M
     c = planar * s_mm / (s_mm - f)  # swap magnification f/s for f/(s-f)
     return float(c) if c.ndim == 0 else c
+
+
+def format_focal_length(mm: float) -> str:
+    """Text as a lens barrel reads: ``"50 mm"``, ``"31.2 mm"`` (one decimal at most, trailing zeros dropped)."""
+    return f"{float(mm):.1f}".rstrip("0").rstrip(".") + " mm"
