@@ -51,13 +51,9 @@ def _number(kind, low: float, high: float):
     return parse
 
 
-def _shipped_scenes() -> list[str]:
+def build_parser() -> argparse.ArgumentParser:
     from lenslab.scene.io.loader import shipped_scene_names
 
-    return shipped_scene_names()
-
-
-def build_parser() -> argparse.ArgumentParser:
     p = _Parser(
         prog="lenslab",
         description="LensLab: a photographic studio on a physically based path tracer. Without --headless it "
@@ -66,7 +62,7 @@ def build_parser() -> argparse.ArgumentParser:
         "  lenslab cornell_box --headless -o cornell.png --spp 64\n"
         "  lenslab my_scene.json --headless -o shot.exr --f-stop 1.4 --focus-distance 2.5 --time-limit 60\n"
         "Focal length, f-number and focus distance override the scene's camera for this render only; "
-        "brightness does not change with the f-number. Shipped scenes: " + ", ".join(_shipped_scenes()) + ".\n"
+        "brightness does not change with the f-number. Shipped scenes: " + ", ".join(shipped_scene_names()) + ".\n"
         "Compare with Mitsuba 3: lenslab validate --help.\n",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

@@ -288,8 +288,7 @@ class GpuScene:
         make_current(ctx)
         self.buffers = {name: ctx.buffer(a.tobytes()) for name, a in packed.arrays.items()}
 
-    def bind(self) -> None:
-        make_current(self.ctx)
+    def bind(self) -> None:  # callers (RenderSession.step, cast_rays) have made the context current
         for name, buffer in self.buffers.items():
             buffer.bind_to_storage_buffer(BINDINGS[name])
 
