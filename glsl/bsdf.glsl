@@ -25,7 +25,7 @@ vec3 emitted_radiance(int m, bool front_face) {
 
 // Beer-Lambert absorption coefficient (per metre) inside a dielectric; zero elsewhere.
 vec3 material_absorption(int m) {
-    return material_type(m) == MATERIAL_DIELECTRIC ? material_row(m, 5).xyz : vec3(0.0);
+    return HAS_MATERIAL(MATERIAL_DIELECTRIC) && material_type(m) == MATERIAL_DIELECTRIC ? material_row(m, 5).xyz : vec3(0.0);
 }
 
 // A material's parameters at one surface point, textures resolved.
@@ -42,6 +42,9 @@ struct Bsdf {
     mat3 frame;   // local shading frame: columns tangent, bitangent, normal
 };
 
+// b is of material type `code`: false at compile time for types the scene lacks (features.glsl).
+bool is_type(Bsdf b, int code) { return HAS_MATERIAL(code) && b.type == code; }
+
 Bsdf bsdf_at(SurfaceHit s) {
     Bsdf b;
     int m = s.material;
@@ -55,20 +58,20 @@ Bsdf bsdf_at(SurfaceHit s) {
     b.eta = r2.x;
     b.internal_reflectance = r2.y;
     b.reflectance_table = floatBitsToInt(r2.z);
-    if (r3.w >= 0.0) b.color = texture_rgb(int(r3.w), s.uv);
-    if (r4.w >= 0.0) {  // roughness texture: perceptual roughness in the red channel
+    if (HAS_TEXTURES != 0 && r3.w >= 0.0) b.color = texture_rgb(int(r3.w), s.uv);
+    if (HAS_TEXTURES != 0 && r4.w >= 0.0) {  // roughness texture: perceptual roughness in the red channel
         float r = texture_rgb(int(r4.w), s.uv).x;
         b.alpha = r * r;
     }
-    if (b.type == MATERIAL_DIELECTRIC && !s.front_face) b.eta = 1.0 / b.eta;
+    if (is_type(b, MATERIAL_DIELECTRIC) && !s.front_face) b.eta = 1.0 / b.eta;
     b.alpha = b.alpha > 0.0 ? max(b.alpha, 1e-4) : 0.0;  // keep tiny roughness out of float trouble
     b.frame = frame_around(s.ns);
     return b;
 }
 
 bool bsdf_is_delta(Bsdf b) {
-    return b.type == MATERIAL_THIN_DIELECTRIC ||
-           ((b.type == MATERIAL_CONDUCTOR || b.type == MATERIAL_DIELECTRIC) && b.alpha == 0.0);
+    return is_type(b, MATERIAL_THIN_DIELECTRIC) ||
+           ((is_type(b, MATERIAL_CONDUCTOR) || is_type(b, MATERIAL_DIELECTRIC)) && b.alpha == 0.0);
 }
 
 vec3 to_local(Bsdf b, vec3 w) { return w * b.frame; }  // = transpose(frame) * w
@@ -125,29 +128,29 @@ vec3 rough_dielectric_eval(Bsdf b, vec3 wo, vec3 wi, out float pdf) {
 }
 
 // f(wo, wi) |cos theta_i| and the density with which bsdf_sample would choose wi (solid angle).
-vec3 bsdf_eval(SurfaceHit s, vec3 wi_world, out float pdf) {
+// b is bsdf_at(s), resolved once per hit and shared by evaluation and sampling.
+vec3 bsdf_eval(SurfaceHit s, Bsdf b, vec3 wi_world, out float pdf) {
     pdf = 0.0;
-    Bsdf b = bsdf_at(s);
     if (bsdf_is_delta(b)) return vec3(0.0);
     vec3 wo = to_local(b, s.wo), wi = to_local(b, wi_world);
     if (wo.z <= 0.0) return vec3(0.0);
     bool same_side = dot(wi_world, s.ng) > 0.0;  // the geometric normal decides, so shading normals never leak
-    if (b.type == MATERIAL_DIELECTRIC) {
+    if (is_type(b, MATERIAL_DIELECTRIC)) {
         if (same_side != (wi.z > 0.0)) return vec3(0.0);
         return rough_dielectric_eval(b, wo, wi, pdf);
     }
     if (!same_side || wi.z <= 0.0) return vec3(0.0);
-    if (b.type == MATERIAL_DIFFUSE) {
+    if (is_type(b, MATERIAL_DIFFUSE)) {
         pdf = wi.z * INV_PI;
         return b.color * INV_PI * wi.z;
     }
     vec3 m = normalize(wo + wi);
-    if (b.type == MATERIAL_CONDUCTOR) {
+    if (is_type(b, MATERIAL_CONDUCTOR)) {
         pdf = ggx_visible_normal_pdf(wo, m, b.alpha) / (4.0 * dot(wo, m));
         vec3 f = fresnel_conductor(dot(wo, m), b.eta3, b.k);
         return b.tint * f * (ggx_d(m, b.alpha) * ggx_g(wo, wi, b.alpha) / (4.0 * wo.z));
     }
-    if (b.type == MATERIAL_PLASTIC) {
+    if (is_type(b, MATERIAL_PLASTIC)) {
         float p_spec = plastic_specular_probability(b, wo.z);
         vec3 value = plastic_diffuse(b, wo.z, wi.z);
         pdf = (1.0 - p_spec) * wi.z * INV_PI;
@@ -163,22 +166,21 @@ vec3 bsdf_eval(SurfaceHit s, vec3 wi_world, out float pdf) {
 
 // Sample wi given three uniform numbers; weight = f |cos| / pdf. delta: a Dirac lobe was chosen
 // (no MIS against light sampling is possible for it).
-bool bsdf_sample(SurfaceHit s, vec3 u, out vec3 wi_world, out vec3 weight, out float pdf, out bool delta) {
+bool bsdf_sample(SurfaceHit s, Bsdf b, vec3 u, out vec3 wi_world, out vec3 weight, out float pdf, out bool delta) {
     weight = vec3(0.0);
     pdf = 0.0;
     delta = false;
     wi_world = vec3(0.0);
-    Bsdf b = bsdf_at(s);
     vec3 wo = to_local(b, s.wo);
     if (wo.z <= 0.0 || b.type == MATERIAL_EMISSIVE) return false;
     vec3 wi;
     bool transmit = false;
 
-    if (b.type == MATERIAL_DIFFUSE) {
+    if (is_type(b, MATERIAL_DIFFUSE)) {
         wi = sample_cosine_hemisphere(u.xy);
         pdf = wi.z * INV_PI;
         weight = b.color;
-    } else if (b.type == MATERIAL_CONDUCTOR) {
+    } else if (is_type(b, MATERIAL_CONDUCTOR)) {
         vec3 m = b.alpha == 0.0 ? vec3(0.0, 0.0, 1.0) : ggx_sample_visible_normal(wo, b.alpha, u.xy);
         wi = 2.0 * dot(wo, m) * m - wo;
         if (wi.z <= 0.0) return false;
@@ -191,7 +193,7 @@ bool bsdf_sample(SurfaceHit s, vec3 u, out vec3 wi_world, out vec3 weight, out f
             pdf = ggx_visible_normal_pdf(wo, m, b.alpha) / (4.0 * dot(wo, m));
             weight = f * (ggx_g(wo, wi, b.alpha) / ggx_g1(wo, b.alpha));
         }
-    } else if (b.type == MATERIAL_PLASTIC) {
+    } else if (is_type(b, MATERIAL_PLASTIC)) {
         float p_spec = plastic_specular_probability(b, wo.z);
         if (u.z < p_spec) {
             vec3 m = b.alpha == 0.0 ? vec3(0.0, 0.0, 1.0) : ggx_sample_visible_normal(wo, b.alpha, u.xy);
@@ -208,12 +210,12 @@ bool bsdf_sample(SurfaceHit s, vec3 u, out vec3 wi_world, out vec3 weight, out f
         if (!delta) {  // both lobes can produce this direction: weigh by the full density
             wi_world = to_world(b, wi);
             if (dot(wi_world, s.ng) <= 0.0) return false;
-            vec3 f = bsdf_eval(s, wi_world, pdf);
+            vec3 f = bsdf_eval(s, b, wi_world, pdf);
             if (pdf <= 0.0) return false;
             weight = f / pdf;
             return true;
         }
-    } else if (b.type == MATERIAL_THIN_DIELECTRIC) {
+    } else if (is_type(b, MATERIAL_THIN_DIELECTRIC)) {
         float r = fresnel_dielectric(wo.z, b.eta);
         if (r < 1.0) r += (1.0 - r) * (1.0 - r) * r / (1.0 - r * r);  // inter-reflections inside the pane
         delta = true;
@@ -226,7 +228,7 @@ bool bsdf_sample(SurfaceHit s, vec3 u, out vec3 wi_world, out vec3 weight, out f
             pdf = 1.0 - r;
             transmit = true;
         }
-    } else if (b.type == MATERIAL_DIELECTRIC) {
+    } else if (is_type(b, MATERIAL_DIELECTRIC)) {
         vec3 m = b.alpha == 0.0 ? vec3(0.0, 0.0, 1.0) : ggx_sample_visible_normal(wo, b.alpha, u.xy);
         float f = fresnel_dielectric(dot(wo, m), b.eta);
         if (u.z < f) {
@@ -260,7 +262,7 @@ bool bsdf_sample(SurfaceHit s, vec3 u, out vec3 wi_world, out vec3 weight, out f
 // How much a transmission from wo to wi compresses radiance (eta^2 entering glass, 1/eta^2 leaving); 1 for
 // reflection. Russian roulette divides it out so that paths inside glass are not killed for looking dim.
 float bsdf_eta_scale(SurfaceHit s, vec3 wi) {
-    if (dot(wi, s.ng) >= 0.0 || material_type(s.material) != MATERIAL_DIELECTRIC) return 1.0;
+    if (dot(wi, s.ng) >= 0.0 || !HAS_MATERIAL(MATERIAL_DIELECTRIC) || material_type(s.material) != MATERIAL_DIELECTRIC) return 1.0;
     float eta = material_row(s.material, 2).x;
     return s.front_face ? eta * eta : 1.0 / (eta * eta);
 }

@@ -36,12 +36,12 @@ void main() {
         vec3 wi, weight;
         float pdf;
         bool delta;
-        bool ok = bsdf_sample(s, b.xyz, wi, weight, pdf, delta);
+        bool ok = bsdf_sample(s, bsdf_at(s), b.xyz, wi, weight, pdf, delta);
         probe_out[2 * i] = vec4(ok ? wi : vec3(0.0), ok ? pdf : 0.0);
         probe_out[2 * i + 1] = vec4(ok ? weight : vec3(0.0), ok ? (delta ? 2.0 : 1.0) : 0.0);
     } else {
         float pdf;
-        vec3 f = bsdf_eval(s, normalize(b.xyz), pdf);
+        vec3 f = bsdf_eval(s, bsdf_at(s), normalize(b.xyz), pdf);
         probe_out[2 * i] = vec4(normalize(b.xyz), pdf);
         probe_out[2 * i + 1] = vec4(f, 1.0);
     }

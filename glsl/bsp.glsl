@@ -20,10 +20,11 @@ bool trace_bsp(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
     int sp = 0;
     int node = 0;
     while (true) {
-        if (hit.t < t0) break;  // the nearest hit so far lies before this node: nothing here is nearer
+        // Down to a leaf, in a loop of its own ("while-while", Aila and Laine 2009): lanes in lockstep then
+        // descend together instead of each interior step also paying for the leaf code below.
         uvec2 n = kd_nodes[node];
-        uint axis = n.y & 3u;
-        if (axis != 3u) {
+        while ((n.y & 3u) != 3u) {
+            uint axis = n.y & 3u;
             float split = uintBitsToFloat(n.x);
             float t_plane = (split - ray.o[axis]) * inv_dir[axis];
             // Points exactly on the plane belong to the above child (bsp.py), and so does a ray lying in it.
@@ -43,26 +44,34 @@ bool trace_bsp(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
                 node = first;
                 t1 = t_plane;
             }
-        } else {
-            int count = int(n.y >> 2);
-            int first_ref = int(n.x);
-            for (int i = 0; i < count; i++) {
-                int prim = prim_refs[first_ref + i];
-                vec2 bary;
-                float t = intersect_prim(ray, prim, t_min, hit.t, bary);
-                if (t < hit.t) {
-                    hit.t = t;
-                    hit.prim = prim;
-                    hit.uv = bary;
-                    if (any_hit) return true;
-                }
+            n = kd_nodes[node];
+        }
+        int count = int(n.y >> 2);
+        int first_ref = int(n.x);
+        for (int i = 0; i < count; i++) {
+            int prim = prim_refs[first_ref + i];
+            vec2 bary;
+            float t = intersect_prim(ray, prim, t_min, hit.t, bary);
+            if (t < hit.t) {
+                hit.t = t;
+                hit.prim = prim;
+                hit.uv = bary;
+                if (any_hit) return true;
             }
-            if (sp == 0) break;
+        }
+        // The next far child whose interval starts before the nearest hit so far; the rest hold nothing nearer.
+        bool more = false;
+        while (sp > 0) {
             sp--;
             node = stack_node[sp];
             t0 = stack_span[sp].x;
             t1 = stack_span[sp].y;
+            if (t0 <= hit.t) {
+                more = true;
+                break;
+            }
         }
+        if (!more) break;
     }
     return hit.prim != NO_HIT;
 }

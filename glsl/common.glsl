@@ -1,6 +1,8 @@
 // Shared declarations: constants, the scene's storage buffers and the uniforms every kernel reads.
 // Buffer layouts are written by app/lenslab/render/buffers.py; keep the two in step.
 
+#include "features.glsl"
+
 const float PI = 3.14159265358979323846;
 const float INV_PI = 0.31830988618379067154;
 const float INFINITY = 1.0 / 0.0;
@@ -42,7 +44,7 @@ struct Hit {
 
 int material_of(int prim) { return floatBitsToInt(geometry[3 * prim + 1].w); }
 float light_pmf_of(int prim) { return geometry[3 * prim + 2].w; }
-bool is_sphere(int prim) { return prim >= triangle_count; }
+bool is_sphere(int prim) { return HAS_SPHERES != 0 && prim >= triangle_count; }
 
 float luminance(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
 float max_component(vec3 c) { return max(c.x, max(c.y, c.z)); }

@@ -43,6 +43,7 @@ vec3 path_radiance(Ray ray, inout Sampler sampler) {
         }
         if (segments >= max_depth || !material_scatters(s.material)) break;
 
+        Bsdf bsdf = bsdf_at(s);
         vec4 u_light = sample4(sampler);
         vec4 u_bsdf = sample4(sampler);
 
@@ -50,7 +51,7 @@ vec3 path_radiance(Ray ray, inout Sampler sampler) {
         LightSample ls;
         if (sample_light(s.p, u_light, ls)) {
             float bsdf_pdf;
-            vec3 f = bsdf_eval(s, ls.wi, bsdf_pdf);
+            vec3 f = bsdf_eval(s, bsdf, ls.wi, bsdf_pdf);
             if (max_component(f) > 0.0) {
                 Ray shadow = spawn_ray(s, ls.wi);
                 float t_max = INFINITY;
@@ -75,7 +76,7 @@ vec3 path_radiance(Ray ray, inout Sampler sampler) {
         vec3 wi, weight;
         float pdf;
         bool delta;
-        if (!bsdf_sample(s, u_bsdf.xyz, wi, weight, pdf, delta)) break;
+        if (!bsdf_sample(s, bsdf, u_bsdf.xyz, wi, weight, pdf, delta)) break;
         throughput *= weight;
         eta_scale *= bsdf_eta_scale(s, wi);
         prev_bsdf_pdf = pdf;

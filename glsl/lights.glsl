@@ -84,7 +84,7 @@ vec3 environment_direction(vec2 uv) {
 float env_table(int i) { return uintBitsToFloat(image_data[env_dist_offset + i]); }
 
 vec3 environment_radiance(vec3 dir) {
-    if (env_type == 0) return env_radiance;
+    if (HAS_ENVIRONMENT_MAP == 0 || env_type == 0) return env_radiance;
     vec2 uv = environment_uv(dir);
     float h = float(env_size.y);
     if (env_rows_pole_to_pole != 0) {
@@ -99,7 +99,7 @@ vec3 environment_radiance(vec3 dir) {
 
 float environment_pdf(vec3 dir) {
     if (env_select_pmf <= 0.0) return 0.0;
-    if (env_type == 0) return env_select_pmf * (0.25 * INV_PI);
+    if (HAS_ENVIRONMENT_MAP == 0 || env_type == 0) return env_select_pmf * (0.25 * INV_PI);
     vec2 uv = environment_uv(dir);
     float sin_theta = sin(uv.y * PI);
     if (sin_theta <= 0.0) return 0.0;
@@ -120,7 +120,7 @@ int search_cdf(int first, int count, float u) {
 }
 
 vec3 sample_environment_direction(vec2 u) {
-    if (env_type == 0) return sample_uniform_sphere(u);
+    if (HAS_ENVIRONMENT_MAP == 0 || env_type == 0) return sample_uniform_sphere(u);
     int w = env_table_size.x, h = env_table_size.y;
     int row = search_cdf(0, h, u.y);
     float r0 = env_table(row), r1 = env_table(row + 1);
@@ -135,10 +135,10 @@ vec3 sample_environment_direction(vec2 u) {
 // -- the sun ------------------------------------------------------------------------------------------
 // Radiance of the sun's disk seen along dir, for rays that escape the scene (zero for a delta sun).
 vec3 sun_seen(vec3 dir) {
-    return (sun_one_minus_cos > 0.0 && 1.0 - dot(dir, sun_direction) <= sun_one_minus_cos) ? sun_radiance : vec3(0.0);
+    return (HAS_SUN != 0 && sun_one_minus_cos > 0.0 && 1.0 - dot(dir, sun_direction) <= sun_one_minus_cos) ? sun_radiance : vec3(0.0);
 }
 
-float sun_pdf() { return sun_one_minus_cos > 0.0 ? sun_pmf / (2.0 * PI * sun_one_minus_cos) : 0.0; }
+float sun_pdf() { return HAS_SUN != 0 && sun_one_minus_cos > 0.0 ? sun_pmf / (2.0 * PI * sun_one_minus_cos) : 0.0; }
 
 // -- sampling any light -------------------------------------------------------------------------------
 bool sample_area_light(int prim, vec3 p, vec2 u, out LightSample ls) {
@@ -180,8 +180,8 @@ bool sample_light(vec3 p, vec4 u, out LightSample ls) {
     int i = pick_light(u.x);
     vec4 l0 = lights[3 * i], l1 = lights[3 * i + 1], l2 = lights[3 * i + 2];
     int type = int(l0.x);
-    if (type == LIGHT_AREA) return sample_area_light(floatBitsToInt(l0.y), p, u.yz, ls);
-    if (type == LIGHT_POINT) {
+    if (HAS_AREA_LIGHTS != 0 && type == LIGHT_AREA) return sample_area_light(floatBitsToInt(l0.y), p, u.yz, ls);
+    if (HAS_POINT_LIGHTS != 0 && type == LIGHT_POINT) {
         vec3 to_l = l1.xyz - p;
         float d2 = dot(to_l, to_l);
         ls.dist = sqrt(d2);
@@ -191,7 +191,7 @@ bool sample_light(vec3 p, vec4 u, out LightSample ls) {
         ls.delta = true;
         return d2 > 0.0;
     }
-    if (type == LIGHT_SUN) {
+    if (HAS_SUN != 0 && type == LIGHT_SUN) {
         if (sun_one_minus_cos <= 0.0) {
             ls.wi = sun_direction;
             ls.radiance = sun_radiance;  // a delta sun carries its irradiance
@@ -204,6 +204,7 @@ bool sample_light(vec3 p, vec4 u, out LightSample ls) {
         ls.pdf = sun_pdf();
         return true;
     }
+    if (HAS_ENVIRONMENT_LIGHT == 0) return false;
     ls.wi = sample_environment_direction(u.yz);
     ls.radiance = environment_radiance(ls.wi);
     ls.pdf = environment_pdf(ls.wi);

@@ -22,6 +22,7 @@ import numpy as np
 
 from lenslab.render import gl
 from lenslab.render.buffers import ACCUMULATION_BINDING, GpuScene, pack_scene
+from lenslab.render.features import GENERAL, KernelFeatures, scene_features
 from lenslab.render.sobol import glsl_array_literal
 from lenslab.scene.camera import ThinLensCamera
 from lenslab.scene.scene import RenderSettings, Scene
@@ -64,8 +65,9 @@ class Renderer:
             self._programs[key] = self.ctx.compute_shader(gl.load_shader_source(shader, defines))
         return self._programs[key]
 
-    def trace_program(self, stack_size: int, sampler: str):
-        defines = {"LOCAL_SIZE_X": LOCAL_SIZE_X, "KD_STACK_SIZE": stack_size, "SOBOL_DIRECTIONS": glsl_array_literal()}
+    def trace_program(self, stack_size: int, sampler: str, features: KernelFeatures = GENERAL):
+        defines = {"LOCAL_SIZE_X": LOCAL_SIZE_X, "KD_STACK_SIZE": stack_size, "SOBOL_DIRECTIONS": glsl_array_literal(),
+                   **features.defines()}
         if sampler == "independent":
             defines["SAMPLER_INDEPENDENT"] = 1
         return self.program("trace.comp", **defines)
@@ -119,8 +121,9 @@ class RenderSession:
 
     def __init__(self, renderer: Renderer, scene: Scene, *, width: int | None = None, height: int | None = None,
                  settings: RenderSettings | None = None, dispatch_seconds: float = DEFAULT_DISPATCH_SECONDS,
-                 environment_importance: bool = True):
+                 environment_importance: bool = True, specialise: bool = True):
         self.renderer = renderer
+        self.specialise = specialise  # False: the general kernel, whatever the scene uses (for comparisons)
         self.environment_importance = environment_importance
         self.ctx = renderer.ctx
         self.dispatch_seconds = dispatch_seconds
@@ -147,7 +150,8 @@ class RenderSession:
         self._gpu_scene = gpu_scene
         self.width = int(width or scene.camera.resolution[0])
         self.height = int(height or scene.camera.resolution[1])
-        self.program = self.renderer.trace_program(self.program_stack_size, self.settings.sampler)
+        self.features = scene_features(packed) if self.specialise else GENERAL
+        self.program = self._trace_program(self.settings.sampler)
         self.set_camera(scene.camera)
 
     @in_context
@@ -160,7 +164,7 @@ class RenderSession:
     @in_context
     def set_settings(self, settings: RenderSettings) -> None:
         if settings.sampler != self.settings.sampler:
-            self.program = self.renderer.trace_program(self.program_stack_size, settings.sampler)
+            self.program = self._trace_program(settings.sampler)
         self.settings = settings
         self.reset()
 
@@ -174,6 +178,9 @@ class RenderSession:
         if layer_bytes > min(SPLAT_MEMORY_BYTES, self.renderer.limits.max_storage_block_bytes):
             return 0
         return max(1, min(SPLAT_MAX_LAYERS, SPLAT_LAYERS_BYTES // layer_bytes))
+
+    def _trace_program(self, sampler: str):
+        return self.renderer.trace_program(self.program_stack_size, sampler, self.features)
 
     @property
     def program_stack_size(self) -> int:

@@ -1,0 +1,69 @@
+"""Which parts of the trace kernel a scene needs: the kernel is compiled once per set of features.
+
+On a SIMD device every lane pays for both sides of a branch that any of its lanes takes; Mesa's llvmpipe
+(the CPU renderer) pays for both sides of *every* branch, taken or not. A general kernel therefore costs a
+Cornell box the code for textures, spheres, an environment map and five material models it never uses.
+:func:`scene_features` reads the packed scene and names what it uses; :meth:`KernelFeatures.defines` turns
+that into the #defines glsl/features.glsl declares, so the compiler drops everything else. The general
+kernel (:data:`GENERAL`) keeps it all; tests check that both render the same image.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from lenslab.render.buffers import (LIGHT_AREA, LIGHT_ENVIRONMENT, LIGHT_POINT, LIGHT_SUN, MATERIAL_CODES,
+                                    MATERIAL_ROWS, PackedScene)
+
+ALL_MATERIAL_TYPES = frozenset(MATERIAL_CODES.values())
+
+
+@dataclass(frozen=True)
+class KernelFeatures:
+    """What a kernel can handle. Every field True (and every material type) is the general kernel."""
+
+    spheres: bool = True
+    textures: bool = True  # image or checker textures on materials (an environment map is separate)
+    environment_map: bool = True
+    environment_light: bool = True  # next-event estimation may choose the environment
+    area_lights: bool = True
+    point_lights: bool = True
+    sun: bool = True
+    material_types: frozenset[int] = ALL_MATERIAL_TYPES  # render/buffers.py's MATERIAL_CODES
+
+    def defines(self) -> dict[str, int]:
+        return {
+            "HAS_SPHERES": int(self.spheres),
+            "HAS_TEXTURES": int(self.textures),
+            "HAS_ENVIRONMENT_MAP": int(self.environment_map),
+            "HAS_ENVIRONMENT_LIGHT": int(self.environment_light),
+            "HAS_AREA_LIGHTS": int(self.area_lights),
+            "HAS_POINT_LIGHTS": int(self.point_lights),
+            "HAS_SUN": int(self.sun),
+            "MATERIAL_TYPES": sum(1 << code for code in self.material_types),
+        }
+
+
+GENERAL = KernelFeatures()
+
+
+def scene_features(packed: PackedScene) -> KernelFeatures:
+    """The features the packed scene uses (materials only as far as some primitive uses them)."""
+    uniforms, arrays = packed.uniforms, packed.arrays
+    prim_count, triangle_count = int(uniforms["prim_count"]), int(uniforms["triangle_count"])
+    materials = arrays["materials"][: int(uniforms["texture_base"])].reshape(-1, MATERIAL_ROWS, 4)
+    used = np.unique(arrays["geometry"].reshape(-1, 3, 4)[:prim_count, 1, 3].view(np.int32)) if prim_count else []
+    records = materials[np.asarray(used, dtype=np.int64)]
+    light_kinds = set(arrays["lights"].reshape(-1, 3, 4)[: int(uniforms["light_count"]), 0, 0].astype(int).tolist())
+    return KernelFeatures(
+        spheres=prim_count > triangle_count,
+        textures=bool((records[:, 3, 3] >= 0).any() or (records[:, 4, 3] >= 0).any()),
+        environment_map=int(uniforms["env_type"]) == 1,
+        environment_light=LIGHT_ENVIRONMENT in light_kinds,
+        area_lights=LIGHT_AREA in light_kinds,
+        point_lights=LIGHT_POINT in light_kinds,
+        sun=LIGHT_SUN in light_kinds,
+        material_types=frozenset(int(code) for code in records[:, 0, 3]),
+    )

@@ -1,0 +1,33 @@
+// Which parts of the kernel a scene needs. render/features.py passes each as a #define (0 or 1, or a bit
+// mask of material types) so that a Cornell box is not slowed by code for textures, spheres or an
+// environment map it does not have: on a SIMD device every lane pays for both sides of a branch that any
+// lane takes, and on Mesa's llvmpipe for both sides of every branch. A kernel compiled without these
+// defines is the general kernel, with everything in; the tests compare the two.
+#ifndef HAS_SPHERES
+#define HAS_SPHERES 1
+#endif
+#ifndef HAS_TEXTURES
+#define HAS_TEXTURES 1
+#endif
+#ifndef HAS_ENVIRONMENT_LIGHT
+#define HAS_ENVIRONMENT_LIGHT 1
+#endif
+#ifndef HAS_ENVIRONMENT_MAP
+#define HAS_ENVIRONMENT_MAP 1
+#endif
+#ifndef HAS_AREA_LIGHTS
+#define HAS_AREA_LIGHTS 1
+#endif
+#ifndef HAS_POINT_LIGHTS
+#define HAS_POINT_LIGHTS 1
+#endif
+#ifndef HAS_SUN
+#define HAS_SUN 1
+#endif
+#ifndef MATERIAL_TYPES
+#define MATERIAL_TYPES 0xFFFF
+#endif
+
+// Whether material type `code` (bsdf.glsl's MATERIAL_* codes) can occur: a constant, so the compiler drops
+// the code of every type the scene does not use.
+#define HAS_MATERIAL(code) (((MATERIAL_TYPES) >> (code) & 1) != 0)
