@@ -16,8 +16,8 @@ The flat layout (a contract with ``glsl/bsp.glsl``)
 * leaf: ``nodes[i, 1] = (prim_count << 2) | 3`` and ``nodes[i, 0]`` is the offset of the leaf's first
   entry in ``prim_refs``; the leaf's primitives are ``prim_refs[offset : offset + prim_count]``.
 
-``bounds`` is the root box. The depth of the tree never exceeds ``max_depth_limit``; a front-to-back
-traversal pushes at most one far child per level, so a stack of ``max_depth`` entries is enough.
+``bounds`` is the root box. The depth of the tree never exceeds ``max_depth_limit``. The GPU traversal
+(glsl/bsp.glsl) needs no stack of that depth: it keeps a short one and restarts from the root when it runs dry.
 
 Which side gets a primitive
 ---------------------------

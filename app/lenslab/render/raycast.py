@@ -33,8 +33,7 @@ def cast_rays(renderer, gpu_scene: GpuScene, origins: np.ndarray, directions: np
         return RayHits(np.zeros(0, np.float32), np.zeros(0, np.int32), np.zeros((0, 2), np.float32))
     ctx = renderer.ctx
     make_current(ctx)  # whatever context was made in this thread since (see gl.make_current)
-    stack = max(1, gpu_scene.packed.kdtree.max_depth)
-    program = renderer.program("raycast.comp", LOCAL_SIZE_X=LOCAL_SIZE_X, KD_STACK_SIZE=stack)
+    program = renderer.program("raycast.comp", LOCAL_SIZE_X=LOCAL_SIZE_X)
     packed = np.zeros((n, 2, 4), np.float32)
     packed[:, 0, :3], packed[:, 0, 3] = origins, t_min
     packed[:, 1, :3], packed[:, 1, 3] = directions, np.float32(min(t_max, np.finfo(np.float32).max))

@@ -65,8 +65,8 @@ class Renderer:
             self._programs[key] = self.ctx.compute_shader(gl.load_shader_source(shader, defines))
         return self._programs[key]
 
-    def trace_program(self, stack_size: int, sampler: str, features: KernelFeatures = GENERAL):
-        defines = {"LOCAL_SIZE_X": LOCAL_SIZE_X, "KD_STACK_SIZE": stack_size, "SOBOL_DIRECTIONS": glsl_array_literal(),
+    def trace_program(self, sampler: str, features: KernelFeatures = GENERAL):
+        defines = {"LOCAL_SIZE_X": LOCAL_SIZE_X, "SOBOL_DIRECTIONS": glsl_array_literal(),
                    **features.defines()}
         if sampler == "independent":
             defines["SAMPLER_INDEPENDENT"] = 1
@@ -180,12 +180,7 @@ class RenderSession:
         return max(1, min(SPLAT_MAX_LAYERS, SPLAT_LAYERS_BYTES // layer_bytes))
 
     def _trace_program(self, sampler: str):
-        return self.renderer.trace_program(self.program_stack_size, sampler, self.features)
-
-    @property
-    def program_stack_size(self) -> int:
-        # The traversal stack holds at most one far child per level below the root.
-        return max(1, self._gpu_scene.packed.kdtree.max_depth)
+        return self.renderer.trace_program(sampler, self.features)
 
     @in_context
     def reset(self) -> None:
