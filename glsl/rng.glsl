@@ -22,10 +22,9 @@ float u32_to_unit_float(uint x) { return min(float(x >> 8) * (1.0 / 16777216.0),
 // the others XOR together the direction numbers of the index's set bits, in one pass over the bits.
 uvec4 sobol4_u32(uint index) {
     uvec3 x = uvec3(0u);
-    for (uint bit = 0u, rest = index; rest != 0u; bit++, rest >>= 1) {
-        if ((rest & 1u) != 0u) {
-            x ^= uvec3(sobol_directions[32u + bit], sobol_directions[64u + bit], sobol_directions[96u + bit]);
-        }
+    for (int bit = 0; bit < 32; bit++) {  // a fixed count: unrolled, every table read at a constant place
+        uvec3 take = uvec3(0u - ((index >> uint(bit)) & 1u));
+        x ^= take & uvec3(sobol_directions[32 + bit], sobol_directions[64 + bit], sobol_directions[96 + bit]);
     }
     return uvec4(bitfieldReverse(index), x);
 }
