@@ -53,7 +53,9 @@ def drop_files(window, paths):
 def test_choosing_f28_sets_the_f_number_and_restarts_accumulation(qtbot, window):
     frames = []
     window.controller.frame_ready.connect(lambda f: frames.append((f.generation, f.samples_per_pixel, f.preview)))
-    before = wait_for_frame(qtbot, window, min_spp=12)
+    # Enough samples that the new generation's first frame, a quarter of a second in, cannot have as many
+    # unless accumulation failed to restart.
+    before = wait_for_frame(qtbot, window, min_spp=300)
     assert window.doc.scene.camera.f_number == 1.8
     combo = window.camera_panel.aperture_combo
     with qtbot.waitSignal(window.controller.restarted, timeout=5000) as restart:
