@@ -61,3 +61,13 @@ def test_specialised_and_general_kernels_render_the_same_image(renderer, name):
     close = np.isclose(specialised, general, rtol=1e-3, atol=1e-5).all(axis=-1)
     assert close.mean() > 0.99
     assert specialised.mean() == pytest.approx(general.mean(), rel=0.01)
+
+
+def test_a_scene_without_lights_or_shapes_still_gets_a_kernel():
+    from lenslab.scene.scene import Scene
+
+    scene = Scene()
+    packed = pack_scene(scene.flatten(), scene.environment, lights=scene.lights)
+    features = scene_features(packed)
+    assert not (features.area_lights or features.point_lights or features.sun or features.spheres)
+    assert features.material_types == frozenset()

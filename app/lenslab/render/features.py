@@ -56,7 +56,9 @@ def scene_features(packed: PackedScene) -> KernelFeatures:
     materials = arrays["materials"][: int(uniforms["texture_base"])].reshape(-1, MATERIAL_ROWS, 4)
     used = np.unique(arrays["geometry"].reshape(-1, 3, 4)[:prim_count, 1, 3].view(np.int32)) if prim_count else []
     records = materials[np.asarray(used, dtype=np.int64)]
-    light_kinds = set(arrays["lights"].reshape(-1, 3, 4)[: int(uniforms["light_count"]), 0, 0].astype(int).tolist())
+    # Three rows per light; a scene without lights still has one (GL refuses empty buffers).
+    light_rows = arrays["lights"].reshape(-1, 4)[0::3][: int(uniforms["light_count"])]
+    light_kinds = set(light_rows[:, 0].astype(int).tolist())
     return KernelFeatures(
         spheres=prim_count > triangle_count,
         textures=bool((records[:, 3, 3] >= 0).any() or (records[:, 4, 3] >= 0).any()),

@@ -1,0 +1,153 @@
+"""LensLab against Mitsuba 3 on the same Mitsuba XML scenes, on this machine, in one run.
+
+For each scene (benchmarks/scenes/*.xml) at the same resolution, samples per pixel and pixel filter:
+
+* Mitsuba 3 (``llvm_ad_rgb``) with the independent sampler the files ask for;
+* LensLab with the same independent sampler, and with its default Owen-scrambled Sobol sampler;
+
+each against a converged reference (Mitsuba at ``--reference-spp``, cached under ``--cache``). Printed per
+render: wall seconds (loading, tree build and kernel compile included, as a user waits), samples per second
+of the rendering alone, relative MSE against the reference, and efficiency 1 / (seconds x relMSE) as a
+multiple of Mitsuba's. Ratios are what to compare across machines: these are shared and noisy.
+
+Usage: python benchmarks/vs_mitsuba.py [--res 256] [--spp 64] [--reference-spp 1024] [--scenes a,b]
+       python benchmarks/vs_mitsuba.py --lenslab-only --res 16 --spp 2 --triangles 2000   (no Mitsuba needed)
+The million-triangle scene's mesh (a bumpy torus) is written into the cache as a PLY the first time.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import hashlib
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from lenslab.validate.metrics import relative_mse
+
+HERE = Path(__file__).resolve().parent
+SCENES = ("cornell_dof", "dof_lights", "glass_metal_envmap", "million_triangles")
+MITSUBA_PASS_SPP = 256  # Mitsuba's LLVM wavefront holds every sample of a pass in memory
+
+
+@dataclass
+class Result:
+    image: np.ndarray
+    seconds: float  # wall, loading included
+    render_seconds: float  # sampling alone
+    samples: int
+
+
+def torus_mesh(cache: Path, triangles: int) -> Path:
+    """The million-triangle scene's mesh: benchmarks/bsp_build.py's bumpy torus as a binary PLY."""
+    import trimesh
+
+    from bsp_build import bumpy_torus
+
+    path = cache / f"torus_{triangles}.ply"
+    if not path.exists():
+        soup = bumpy_torus(triangles).reshape(-1, 3)
+        mesh = trimesh.Trimesh(vertices=soup, faces=np.arange(len(soup)).reshape(-1, 3), process=False)
+        mesh.merge_vertices()
+        path.write_bytes(trimesh.exchange.ply.export_ply(mesh, encoding="binary", include_attributes=False))
+    return path
+
+
+def render_lenslab(renderer, path: Path, defines: dict, spp: int, sampler: str, seed: int) -> Result:
+    from lenslab.render.tracer import RenderSession
+    from lenslab.scene.io.loader import open_scene
+
+    start = time.perf_counter()
+    scene = open_scene(path, defines=defines, warn=lambda message: print(f"  lenslab: {message}", file=sys.stderr))
+    scene = dataclasses.replace(scene, render=dataclasses.replace(scene.render, spp=spp, seed=seed, sampler=sampler))
+    session = RenderSession(renderer, scene, dispatch_seconds=0.25)
+    try:
+        while not session.done(spp):
+            session.step(1.0, spp)
+        image = session.image()
+        render_seconds = session.elapsed_seconds
+        samples = session.width * session.height * spp
+    finally:
+        session.release()
+    return Result(image, time.perf_counter() - start, render_seconds, samples)
+
+
+def render_mitsuba(path: Path, defines: dict, spp: int, seed: int) -> Result:
+    from lenslab.validate.mitsuba_env import load_mitsuba
+
+    mi = load_mitsuba()
+    start = time.perf_counter()
+    scene = mi.load_file(str(path), **defines)
+    loaded = time.perf_counter()
+    total, done, index = None, 0, 0
+    while done < spp:
+        n = min(MITSUBA_PASS_SPP, spp - done)
+        image = np.array(mi.render(scene, spp=n, seed=seed + index), dtype=np.float64)[..., :3]
+        total = image * n if total is None else total + image * n
+        done, index = done + n, index + 1
+    end = time.perf_counter()
+    height, width = total.shape[:2]
+    return Result((total / spp).astype(np.float32), end - start, end - loaded, width * height * spp)
+
+
+def reference(path: Path, defines: dict, spp: int, cache: Path) -> np.ndarray:
+    """Mitsuba at ``spp`` (seeds from 1000, apart from the compared renders'), cached by scene file and settings."""
+    key = hashlib.sha256(path.read_bytes() + repr(sorted(defines.items())).encode() + str(spp).encode()).hexdigest()[:16]
+    file = cache / f"reference_{path.stem}_{key}.npy"
+    if not file.exists():
+        print(f"  {path.stem}: Mitsuba reference at {spp} spp (cached in {file})", file=sys.stderr)
+        np.save(file, render_mitsuba(path, defines, spp, 1000).image)
+    return np.load(file)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--res", type=int, default=256)
+    parser.add_argument("--spp", type=int, default=64)
+    parser.add_argument("--reference-spp", type=int, default=1024)
+    parser.add_argument("--scenes", default=",".join(SCENES))
+    parser.add_argument("--triangles", type=int, default=1_000_000, help="of the million-triangle scene's torus")
+    parser.add_argument("--cache", type=Path, default=Path.home() / ".cache" / "lenslab" / "benchmarks")
+    parser.add_argument("--lenslab-only", action="store_true", help="no Mitsuba: times and samples per second only")
+    args = parser.parse_args()
+    args.cache.mkdir(parents=True, exist_ok=True)
+
+    from lenslab.render.tracer import Renderer
+
+    renderer = Renderer()
+    print(f"device: {renderer.describe()['renderer']}; {args.res}x{args.res}, {args.spp} spp, box filter; "
+          f"reference: Mitsuba at {args.reference_spp} spp")
+    header = f"{'scene':<20} {'renderer':<22} {'seconds':>8} {'Msamples/s':>11} {'relMSE':>9} {'efficiency':>11}"
+    print(header)
+    print("-" * len(header))
+    for name in args.scenes.split(","):
+        path = HERE / "scenes" / f"{name}.xml"
+        defines = {"res": str(args.res), "spp": str(args.spp)}
+        if name == "million_triangles":
+            defines["mesh"] = str(torus_mesh(args.cache, args.triangles))
+        runs: list[tuple[str, Result]] = []
+        if not args.lenslab_only:
+            ref = reference(path, defines, args.reference_spp, args.cache)
+            runs.append(("mitsuba independent", render_mitsuba(path, defines, args.spp, 0)))
+        for sampler in ("independent", "sobol"):
+            runs.append((f"lenslab {sampler}", render_lenslab(renderer, path, defines, args.spp, sampler, 0)))
+        baseline = None
+        for label, result in runs:
+            rate = result.samples / result.render_seconds / 1e6
+            if args.lenslab_only:
+                print(f"{name:<20} {label:<22} {result.seconds:>8.2f} {rate:>11.3f} {'-':>9} {'-':>11}")
+                continue
+            error = relative_mse(result.image, ref)
+            efficiency = 1.0 / (result.seconds * error)
+            baseline = baseline or efficiency
+            print(f"{name:<20} {label:<22} {result.seconds:>8.2f} {rate:>11.3f} {error:>9.5f} {efficiency / baseline:>10.2f}x")
+        sys.stdout.flush()
+    renderer.release()
+
+
+if __name__ == "__main__":
+    main()
