@@ -43,15 +43,17 @@ class Result:
 
 
 def torus_mesh(cache: Path, triangles: int) -> Path:
-    """The million-triangle scene's mesh: benchmarks/bsp_build.py's bumpy torus as a binary PLY."""
+    """The million-triangle scene's mesh: benchmarks/bsp_build.py's bumpy torus as a binary PLY, its faces wound
+    to face outwards (Mitsuba's diffuse reflects on the front side only; LensLab's on both)."""
     import trimesh
 
     from bsp_build import bumpy_torus
 
-    path = cache / f"torus_{triangles}.ply"
+    path = cache / f"torus_outward_{triangles}.ply"
     if not path.exists():
         soup = bumpy_torus(triangles).reshape(-1, 3)
-        mesh = trimesh.Trimesh(vertices=soup, faces=np.arange(len(soup)).reshape(-1, 3), process=False)
+        mesh = trimesh.Trimesh(vertices=soup, faces=np.arange(len(soup)).reshape(-1, 3)[:, ::-1],
+                               process=False)
         mesh.merge_vertices()
         path.write_bytes(trimesh.exchange.ply.export_ply(mesh, encoding="binary", include_attributes=False))
     return path

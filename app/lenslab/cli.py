@@ -7,6 +7,7 @@ driver, an unwritable output) ends with a non-zero exit status and one line on s
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import logging
 import os
@@ -211,6 +212,19 @@ def _progress_display(total_spp: int | None, time_limit: float | None):
     )
 
 
+def _terminal_console():
+    """A rich console on stderr when it is a terminal (None otherwise: logs and pipes get no spinners)."""
+    from rich.console import Console
+
+    console = Console(stderr=True)
+    return console if console.is_terminal else None
+
+
+def _loading_status(console, text: str):
+    """A spinner while a scene loads or its tree builds: a million triangles take seconds before any sample."""
+    return console.status(text) if console is not None else contextlib.nullcontext()
+
+
 def render_headless(args) -> int:
     from lenslab.render.film import write_image
     from lenslab.render.tracer import Renderer, RenderSession
@@ -220,13 +234,22 @@ def render_headless(args) -> int:
     output = _check_output(args.output)
     if args.exposure and output.suffix.lower() == ".exr":
         _warn("--exposure applies to PNG only: an EXR keeps the linear radiance")
-    scene = _apply_overrides(open_scene(args.scene, defines=parse_defines(args.defines), warn=_warn), args)
+    console = _terminal_console()
+    loading_start = time.perf_counter()
+    with _loading_status(console, f"loading {args.scene}"):
+        scene = _apply_overrides(open_scene(args.scene, defines=parse_defines(args.defines), warn=_warn), args)
     target_spp = args.spp if args.spp is not None else (None if args.time_limit else scene.render.spp)
     renderer = Renderer(args.device)
     try:
-        session = RenderSession(renderer, scene, dispatch_seconds=HEADLESS_DISPATCH_SECONDS)
+        with _loading_status(console, "building the kd-tree and compiling the kernel"):
+            session = RenderSession(renderer, scene, dispatch_seconds=HEADLESS_DISPATCH_SECONDS)
     except (SceneError, ValueError) as exc:  # found only when the scene is packed for the GPU: name its file
         raise SceneError(f"{scene.source_path or args.scene}: {exc}") from None
+    if console is not None:
+        flat, tree = session.flat_scene, session.kdtree
+        console.print(f"{flat.triangle_count:,} triangles, {flat.sphere_count:,} spheres; kd-tree of {len(tree.nodes):,} "
+                      f"nodes built in {tree.build_seconds:.1f} s; ready to sample after "
+                      f"{time.perf_counter() - loading_start:.1f} s", highlight=False)
     for warning in session.warnings:
         _warn(warning)
     start = time.perf_counter()

@@ -179,6 +179,11 @@ class RenderSession:
             return 0
         return max(1, min(SPLAT_MAX_LAYERS, SPLAT_LAYERS_BYTES // layer_bytes))
 
+    @property
+    def kdtree(self):
+        """The scene's kd-tree as built for the GPU (its size and build time, for progress reports)."""
+        return self._gpu_scene.packed.kdtree
+
     def _trace_program(self, sampler: str):
         return self.renderer.trace_program(sampler, self.features)
 

@@ -1,0 +1,37 @@
+"""The benchmark scripts run end to end on a tiny size (their figures are for people, never asserted)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+BENCHMARKS = Path(__file__).resolve().parents[1] / "benchmarks"
+
+
+def run(script, *args, tmp_path):
+    result = subprocess.run([sys.executable, str(BENCHMARKS / script), *map(str, args)], capture_output=True,
+                            text=True, timeout=600, cwd=tmp_path)
+    assert result.returncode == 0, result.stderr[-2000:]
+    return result.stdout
+
+
+@pytest.mark.gl
+def test_vs_mitsuba_renders_every_scene_with_both_samplers(renderer, tmp_path):
+    out = run("vs_mitsuba.py", "--lenslab-only", "--res", 12, "--spp", 2, "--triangles", 2000,
+              "--cache", tmp_path / "cache", tmp_path=tmp_path)
+    rows = [line.split() for line in out.splitlines() if line.split()[:1] and line.split()[0] in
+            ("cornell_dof", "dof_lights", "glass_metal_envmap", "million_triangles")]
+    assert {(row[0], row[2]) for row in rows} == {(scene, sampler) for scene in
+                                                   ("cornell_dof", "dof_lights", "glass_metal_envmap", "million_triangles")
+                                                   for sampler in ("independent", "sobol")}
+    assert all(float(row[3]) > 0 and float(row[4]) > 0 for row in rows)  # seconds and samples per second
+    assert list((tmp_path / "cache").glob("torus_outward_2000.ply"))
+
+
+@pytest.mark.gl
+def test_render_throughput_prints_a_figure_per_scene_and_depth(renderer, tmp_path):
+    out = run("render_throughput.py", "--seconds", 0.05, "--size", 16, tmp_path=tmp_path)
+    assert out.count("cornell_box") == 5 and out.count("dof_chart") == 5
