@@ -141,12 +141,12 @@ def main() -> None:
         for label, result in runs:
             rate = result.samples / result.render_seconds / 1e6
             if args.lenslab_only:
-                print(f"{name:<20} {label:<22} {result.seconds:>8.2f} {rate:>11.3f} {'-':>9} {'-':>11}")
+                print(f"{name:<20} {label:<22} {result.seconds:>8.2f} {rate:>11.3g} {'-':>9} {'-':>11}")
                 continue
             error = relative_mse(result.image, ref)
             efficiency = 1.0 / (result.seconds * error)
             baseline = baseline or efficiency
-            print(f"{name:<20} {label:<22} {result.seconds:>8.2f} {rate:>11.3f} {error:>9.5f} {efficiency / baseline:>10.2f}x")
+            print(f"{name:<20} {label:<22} {result.seconds:>8.2f} {rate:>11.3g} {error:>9.5f} {efficiency / baseline:>10.2f}x")
         sys.stdout.flush()
     renderer.release()
 

@@ -7,19 +7,21 @@ const float PI = 3.14159265358979323846;
 const float INV_PI = 0.31830988618379067154;
 const float INFINITY = 1.0 / 0.0;
 const int NO_HIT = -1;
+const float ONE_MINUS_EPSILON = 0.99999994;  // the largest float below 1
 
 // kd-tree nodes (see bsp.py): interior x = split (float bits), y = (above child << 2) | axis;
 // leaf x = first reference, y = (count << 2) | 3. The below child of node i is node i + 1.
 layout(std430, binding = 0) readonly buffer KdNodes { uvec2 kd_nodes[]; };
 layout(std430, binding = 1) readonly buffer PrimRefs { int prim_refs[]; };
-// Three vec4 per primitive. Triangle: (v0, -), (e1, material), (e2, light pmf).
-// Sphere: (centre, radius), (-, material), (-, light pmf). Material is an int stored as float bits.
+// Three vec4 per primitive. Triangle: (v0, -), (e1, material), (e2, light).
+// Sphere: (centre, radius), (-, material), (-, light). Material and light (the primitive's row in the light
+// table, -1 if it emits nothing) are ints stored as float bits.
 layout(std430, binding = 2) readonly buffer Geometry { vec4 geometry[]; };
 // Four vec4 per triangle (spheres have none): (n0, u0), (n1, v0), (n2, u1), (v1, u2, v2, -).
 layout(std430, binding = 3) readonly buffer Shading { vec4 shading[]; };
 // Eight vec4 per material (see bsdf.glsl), then four per texture from row texture_base (textures.glsl).
 layout(std430, binding = 4) readonly buffer Materials { vec4 materials[]; };
-// Three vec4 per light, chosen by power (see lights.glsl).
+// Three vec4 per light (see lights.glsl).
 layout(std430, binding = 5) readonly buffer Lights { vec4 lights[]; };
 
 uniform int triangle_count;
@@ -28,7 +30,6 @@ uniform vec3 scene_min;
 uniform vec3 scene_max;
 
 uniform int light_count;      // entries in the light table
-uniform float env_select_pmf; // probability that next-event estimation picks the environment
 uniform vec3 env_radiance;    // constant environment
 
 struct Ray {
@@ -43,7 +44,7 @@ struct Hit {
 };
 
 int material_of(int prim) { return floatBitsToInt(geometry[3 * prim + 1].w); }
-float light_pmf_of(int prim) { return geometry[3 * prim + 2].w; }
+int light_of(int prim) { return floatBitsToInt(geometry[3 * prim + 2].w); }
 bool is_sphere(int prim) { return HAS_SPHERES != 0 && prim >= triangle_count; }
 
 float luminance(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }

@@ -24,6 +24,12 @@
 #ifndef HAS_SUN
 #define HAS_SUN 1
 #endif
+#ifndef HAS_LIGHTS_AT_POINT
+#define HAS_LIGHTS_AT_POINT 1
+#endif
+#ifndef HAS_LIGHTS_BY_POWER
+#define HAS_LIGHTS_BY_POWER 1
+#endif
 #ifndef MATERIAL_TYPES
 #define MATERIAL_TYPES 0xFFFF
 #endif

@@ -11,6 +11,7 @@ vec3 path_radiance(Ray ray, inout Sampler sampler) {
     float prev_bsdf_pdf = 0.0;
     bool prev_delta = true;  // the camera ray: nothing to weigh emission against
     vec3 prev_p = ray.o;
+    float prev_light_weights = 1.0;  // LightChoice.weights at prev_p: MIS needs the light choice made there
     float eta_scale = 1.0;  // radiance compression by refraction so far (see bsdf_eta_scale)
 
     for (int segments = 1; ; segments++) {
@@ -18,11 +19,13 @@ vec3 path_radiance(Ray ray, inout Sampler sampler) {
         if (!trace_bsp(ray, 0.0, INFINITY, false, hit)) {
             // The ray leaves the scene: the sky, and the sun's disk if it looks straight at it.
             vec3 le = environment_radiance(ray.d);
-            float w = prev_delta ? 1.0 : power_heuristic(prev_bsdf_pdf, environment_pdf(ray.d));
+            float w = prev_delta ? 1.0 : power_heuristic(prev_bsdf_pdf, environment_pdf(ray.d,
+                                                          light_choice_pmf(env_light, prev_p, prev_light_weights)));
             radiance += throughput * le * w;
             vec3 sun = sun_seen(ray.d);
             if (max_component(sun) > 0.0) {
-                radiance += throughput * sun * (prev_delta ? 1.0 : power_heuristic(prev_bsdf_pdf, sun_pdf()));
+                float pmf = light_choice_pmf(sun_light, prev_p, prev_light_weights);
+                radiance += throughput * sun * (prev_delta ? 1.0 : power_heuristic(prev_bsdf_pdf, sun_pdf(pmf)));
             }
             break;
         }
@@ -37,7 +40,8 @@ vec3 path_radiance(Ray ray, inout Sampler sampler) {
             float w = 1.0;
             if (!prev_delta) {
                 // ng was turned towards the ray; the light pdf only needs |cos|, so its sign does not matter.
-                w = power_heuristic(prev_bsdf_pdf, area_light_pdf(s.prim, prev_p, s.p, s.ng));
+                float pmf = light_choice_pmf(light_of(s.prim), prev_p, prev_light_weights);
+                w = power_heuristic(prev_bsdf_pdf, area_light_pdf(s.prim, prev_p, s.p, s.ng, pmf));
             }
             radiance += throughput * le * w;
         }
@@ -47,9 +51,10 @@ vec3 path_radiance(Ray ray, inout Sampler sampler) {
         vec4 u_light = sample4(sampler);
         vec4 u_bsdf = sample4(sampler);
 
-        // Next-event estimation: one shadow ray towards a light chosen by power.
+        // Next-event estimation: one shadow ray towards a light chosen for this point (lights.glsl).
+        LightChoice choice = choose_light(s.p, u_light.x);
         LightSample ls;
-        if (sample_light(s.p, u_light, ls)) {
+        if (sample_light(s.p, choice, u_light.yz, ls)) {
             float bsdf_pdf;
             vec3 f = bsdf_eval(s, bsdf, ls.wi, bsdf_pdf);
             if (max_component(f) > 0.0) {
@@ -82,6 +87,7 @@ vec3 path_radiance(Ray ray, inout Sampler sampler) {
         prev_bsdf_pdf = pdf;
         prev_delta = delta;
         prev_p = s.p;
+        prev_light_weights = choice.weights;
         ray = spawn_ray(s, wi);
 
         if (segments >= rr_depth) {

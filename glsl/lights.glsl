@@ -1,9 +1,10 @@
-// Next-event estimation: choose a light in proportion to its power, then a point or direction on it.
-// Every pdf here is with respect to solid angle at the shading point and includes the selection
-// probability, so that MIS against BSDF sampling compares like with like.
+// Next-event estimation: choose a light (see "Choosing a light" below), then a point or direction on it.
+// Every pdf here is with respect to solid angle at the shading point and includes the probability of
+// choosing the light, so that MIS against BSDF sampling compares like with like.
 //
 // The light table (render/buffers.py) holds three vec4 per light:
-//   (type, primitive index as float bits, cumulative pmf, pmf), (position | direction, cos theta_max), (rgb, -).
+//   (type, primitive index as float bits, cumulative power share, power share), (position | direction, -),
+//   (rgb, -).
 
 const int LIGHT_AREA = 0;
 const int LIGHT_POINT = 1;
@@ -21,7 +22,9 @@ uniform int env_rows_pole_to_pole; // 1: image row i lies at polar angle pi i / 
 uniform vec3 sun_direction;     // towards the sun
 uniform float sun_one_minus_cos; // 1 - cos of the disk's angular radius (host-computed: precise); 0: delta
 uniform vec3 sun_radiance;
-uniform float sun_pmf;
+uniform int env_light;          // the environment's row in the light table; -1: it lights nothing directly
+uniform int sun_light;          // the sun's row, or -1
+uniform int lights_at_point;    // 1: choose lights by what they bring to the shading point (the general kernel asks)
 
 struct LightSample {
     vec3 wi;
@@ -31,7 +34,46 @@ struct LightSample {
     bool delta;  // a point or a sun of zero size: no BSDF sample can hit it, no MIS
 };
 
-// The light whose cumulative pmf first exceeds u (binary search over the table).
+// -- Choosing a light ----------------------------------------------------------------------------------
+// By power alone (a binary search of the cumulative table) is cheap and blind to where the shading point
+// is: a lamp beside the subject and a sky whose power is measured over the whole scene compete by their
+// totals, and in a large scene the sky takes most shadow rays while the lamp that lights the subject stays
+// noisy. With few lights (buffers.py's LIGHTS_AT_POINT_LIMIT) the choice is instead proportional to a rough
+// estimate of the irradiance each light brings to the shading point: its power over the squared distance
+// to it (never less than its own extent), or a constant for light from infinity; no occlusion and no
+// cosines, as in the importance of pbrt-v4's light BVH. Each point then has a distribution of its own, so
+// MIS must recompute the probability at the point a BSDF sample left from (light_choice_pmf). Every light
+// that could reach the point keeps a nonzero probability: both choices are unbiased.
+
+bool choosing_at_point() {
+    return HAS_LIGHTS_AT_POINT != 0 && (HAS_LIGHTS_BY_POWER == 0 || lights_at_point != 0);
+}
+
+// What the choice reads, in a uniform block (render/buffers.py's light_choice array): every lane reads the
+// same light at the same time, which uniform blocks serve best.
+const int LIGHT_PLACES = 32;  // buffers.py's
+layout(std140, binding = 0) uniform LightPlaces {
+    vec4 light_place[LIGHT_PLACES];     // (centre, reach^2); reach^2 < 0: at infinity
+    vec4 light_scale[LIGHT_PLACES / 4]; // power share x falloff, four lights to a vec4
+};
+
+// Light i's weight at p: roughly the irradiance it brings there (render/buffers.py's _LightEntry).
+float light_weight_at(int i, vec3 p) {
+    vec4 where = light_place[i];
+    float scale = light_scale[i >> 2][i & 3];
+    vec3 d = where.xyz - p;
+    return scale / (where.w < 0.0 ? 1.0 : max(dot(d, d), where.w));
+}
+
+// The probability that next-event estimation at p chooses light i (-1: no light, probability 0), where
+// `weights` is the sum of all lights' weights there (LightChoice.weights).
+float light_choice_pmf(int i, vec3 p, float weights) {
+    if (i < 0) return 0.0;
+    if (choosing_at_point()) return weights > 0.0 ? light_weight_at(i, p) / weights : 0.0;
+    return lights[3 * i].w;
+}
+
+// The light whose cumulative power share first exceeds u (binary search over the table).
 int pick_light(float u) {
     int lo = 0, hi = light_count - 1;
     while (lo < hi) {
@@ -39,6 +81,47 @@ int pick_light(float u) {
         if (lights[3 * mid].z <= u) lo = mid + 1; else hi = mid;
     }
     return lo;
+}
+
+// Next-event estimation's choice at a shading point: the light (-1: none), the probability of choosing
+// it, and the sum of all lights' weights there, which MIS needs later (light_choice_pmf).
+struct LightChoice {
+    int light;
+    float pmf;
+    float weights;
+};
+
+LightChoice choose_light(vec3 p, float u) {
+    LightChoice c;
+    c.light = -1;
+    c.pmf = 0.0;
+    c.weights = 1.0;
+    if (light_count == 0) return c;
+    if (choosing_at_point()) {
+        // One pass, as a weighted reservoir of one: light i takes the place of the choice so far with
+        // probability w_i / (w_0 + ... + w_i), which leaves each light chosen with probability w_i / total.
+        // The one random number serves every step, rescaled to [0, 1) after each (as pbrt-v4's
+        // SampleDiscrete remaps it). The loop runs alike in all lanes, so the table reads are uniform.
+        float total = 0.0, chosen_weight = 0.0;
+        for (int i = 0; i < light_count; i++) {
+            float w = light_weight_at(i, p);
+            total += w;
+            float q = total > 0.0 ? w / total : 0.0;
+            if (u < q) {
+                c.light = i;
+                chosen_weight = w;
+                u = min(u / q, ONE_MINUS_EPSILON);
+            } else {
+                u = min((u - q) / (1.0 - q), ONE_MINUS_EPSILON);
+            }
+        }
+        c.weights = total;
+        c.pmf = total > 0.0 ? chosen_weight / total : 0.0;
+    } else {
+        c.light = pick_light(u);
+        c.pmf = lights[3 * c.light].w;
+    }
+    return c;
 }
 
 // 1 - cos(theta_max) of the cone a sphere subtends from distance d > r, precise for tiny cones.
@@ -51,9 +134,9 @@ float triangle_area(int prim) {
     return 0.5 * length(cross(geometry[3 * prim + 1].xyz, geometry[3 * prim + 2].xyz));
 }
 
-// Density (solid angle, selection included) of reaching point q with normal nq on emissive prim from p.
-float area_light_pdf(int prim, vec3 p, vec3 q, vec3 nq) {
-    float pmf = light_pmf_of(prim);
+// Density (solid angle) of reaching point q with normal nq on emissive prim from p, where `pmf` is the
+// probability of having chosen the prim's light.
+float area_light_pdf(int prim, vec3 p, vec3 q, vec3 nq, float pmf) {
     if (pmf <= 0.0) return 0.0;
     vec3 to_q = q - p;
     float dist2 = dot(to_q, to_q);
@@ -97,16 +180,17 @@ vec3 environment_radiance(vec3 dir) {
     return env_strength * texture_rgb(env_texture, vec2(uv.x, 1.0 - uv.y));  // row 0 is the top
 }
 
-float environment_pdf(vec3 dir) {
-    if (env_select_pmf <= 0.0) return 0.0;
-    if (HAS_ENVIRONMENT_MAP == 0 || env_type == 0) return env_select_pmf * (0.25 * INV_PI);
+// Density (solid angle) of sampling dir from the environment, chosen with probability `pmf`.
+float environment_pdf(vec3 dir, float pmf) {
+    if (pmf <= 0.0) return 0.0;
+    if (HAS_ENVIRONMENT_MAP == 0 || env_type == 0) return pmf * (0.25 * INV_PI);
     vec2 uv = environment_uv(dir);
     float sin_theta = sin(uv.y * PI);
     if (sin_theta <= 0.0) return 0.0;
     int w = env_table_size.x, h = env_table_size.y;
     int row = min(int(uv.y * float(h)), h - 1), col = min(int(uv.x * float(w)), w - 1);
     float pdf_uv = env_table((h + 1) + h * (w + 1) + row * w + col);
-    return env_select_pmf * pdf_uv / (2.0 * PI * PI * sin_theta);
+    return pmf * pdf_uv / (2.0 * PI * PI * sin_theta);
 }
 
 // First index i in [first, first + count) with table[i + 1] > u, for a cumulative table starting at 0.
@@ -138,10 +222,11 @@ vec3 sun_seen(vec3 dir) {
     return (HAS_SUN != 0 && sun_one_minus_cos > 0.0 && 1.0 - dot(dir, sun_direction) <= sun_one_minus_cos) ? sun_radiance : vec3(0.0);
 }
 
-float sun_pdf() { return HAS_SUN != 0 && sun_one_minus_cos > 0.0 ? sun_pmf / (2.0 * PI * sun_one_minus_cos) : 0.0; }
+// Density (solid angle) of sampling a direction in the sun's disk, the sun chosen with probability `pmf`.
+float sun_pdf(float pmf) { return HAS_SUN != 0 && sun_one_minus_cos > 0.0 ? pmf / (2.0 * PI * sun_one_minus_cos) : 0.0; }
 
 // -- sampling any light -------------------------------------------------------------------------------
-bool sample_area_light(int prim, vec3 p, vec2 u, out LightSample ls) {
+bool sample_area_light(int prim, vec3 p, vec2 u, float pmf, out LightSample ls) {
     ls.delta = false;  // `out` starts undefined: every field must be written
     vec3 q, nq;
     if (is_sphere(prim)) {
@@ -169,25 +254,27 @@ bool sample_area_light(int prim, vec3 p, vec2 u, out LightSample ls) {
     if (ls.dist <= 0.0) return false;
     ls.wi = to_q / ls.dist;
     ls.radiance = emitted_radiance(material_of(prim), dot(nq, -ls.wi) > 0.0);
-    ls.pdf = area_light_pdf(prim, p, q, nq);
+    ls.pdf = area_light_pdf(prim, p, q, nq, pmf);
     return ls.pdf > 0.0 && max_component(ls.radiance) > 0.0;
 }
 
-bool sample_light(vec3 p, vec4 u, out LightSample ls) {
+// A sample of the chosen light for the shading point p.
+bool sample_light(vec3 p, LightChoice choice, vec2 u, out LightSample ls) {
     ls.delta = false;
     ls.dist = INFINITY;
-    if (light_count == 0) return false;
-    int i = pick_light(u.x);
+    float pmf = choice.pmf;
+    if (pmf <= 0.0) return false;
+    int i = choice.light;
     vec4 l0 = lights[3 * i], l1 = lights[3 * i + 1], l2 = lights[3 * i + 2];
     int type = int(l0.x);
-    if (HAS_AREA_LIGHTS != 0 && type == LIGHT_AREA) return sample_area_light(floatBitsToInt(l0.y), p, u.yz, ls);
+    if (HAS_AREA_LIGHTS != 0 && type == LIGHT_AREA) return sample_area_light(floatBitsToInt(l0.y), p, u, pmf, ls);
     if (HAS_POINT_LIGHTS != 0 && type == LIGHT_POINT) {
         vec3 to_l = l1.xyz - p;
         float d2 = dot(to_l, to_l);
         ls.dist = sqrt(d2);
         ls.wi = to_l / ls.dist;
         ls.radiance = l2.xyz / d2;  // intensity falls off with the square of the distance
-        ls.pdf = l0.w;
+        ls.pdf = pmf;
         ls.delta = true;
         return d2 > 0.0;
     }
@@ -195,18 +282,18 @@ bool sample_light(vec3 p, vec4 u, out LightSample ls) {
         if (sun_one_minus_cos <= 0.0) {
             ls.wi = sun_direction;
             ls.radiance = sun_radiance;  // a delta sun carries its irradiance
-            ls.pdf = l0.w;
+            ls.pdf = pmf;
             ls.delta = true;
             return true;
         }
-        ls.wi = frame_around(sun_direction) * sample_uniform_cone(u.yz, sun_one_minus_cos);
+        ls.wi = frame_around(sun_direction) * sample_uniform_cone(u, sun_one_minus_cos);
         ls.radiance = sun_radiance;
-        ls.pdf = sun_pdf();
+        ls.pdf = sun_pdf(pmf);
         return true;
     }
     if (HAS_ENVIRONMENT_LIGHT == 0) return false;
-    ls.wi = sample_environment_direction(u.yz);
+    ls.wi = sample_environment_direction(u);
     ls.radiance = environment_radiance(ls.wi);
-    ls.pdf = environment_pdf(ls.wi);
+    ls.pdf = environment_pdf(ls.wi, pmf);
     return ls.pdf > 0.0 && max_component(ls.radiance) > 0.0;
 }

@@ -274,3 +274,37 @@ def test_a_large_panorama_is_sampled_through_coarser_tables_without_bias(rendere
                         environment_importance=False)
     assert importance.mean() == pytest.approx(reference.mean(), rel=0.02)
     assert np.mean((importance - reference) ** 2) < 0.3 * np.mean((uniform - reference) ** 2)
+
+
+def test_lights_chosen_by_what_reaches_the_point_agree_with_lights_chosen_by_power_and_are_less_noisy(
+        renderer, monkeypatch):
+    """Every kind of light at once over a wide floor: a small lamp close above it, a sphere lamp and a point
+    light far off, a sun and a dim sky. Choosing lights by power hands the sky (whose power is measured over
+    the whole 100 m floor) most shadow rays; choosing by the irradiance each light brings to the shading
+    point gives the lamp beside the subject its due. Both are unbiased: their converged images agree."""
+    from lenslab.render import buffers
+    from lenslab.scene.materials import Emissive
+
+    scene = looking_down_at_floor(
+        camera=ThinLensCamera(position=(0, 1.5, 1.5), look_at=(0, 0, 0), focal_length_mm=35, f_number=16,
+                              focus_distance_m=2, resolution=(24, 24)),
+        render=RenderSettings(max_depth=3),
+        environment=ConstantEnvironment((0.05, 0.05, 0.07)),
+        materials={"floor": Diffuse((ALBEDO,) * 3), "lamp": Emissive((20.0,) * 3), "far lamp": Emissive((500.0,) * 3)},
+        nodes=[Node("floor", Transform(rotate_deg=(-90, 0, 0)), Rectangle((100, 100)), "floor"),
+               Node("lamp", Transform(translate=(0.3, 0.8, 0), rotate_deg=(90, 0, 0)), Rectangle((0.3, 0.3)), "lamp"),
+               Node("far lamp", Transform(translate=(-20, 3, -30)), Sphere(0.2), "far lamp")],
+        lights=[PointLight("bulb", position=(15, 4, -25), intensity=(30.0,) * 3),
+                SunLight("sun", direction=(0.3, 0.2, 0.9), irradiance=(0.3,) * 3, angular_diameter_deg=0.53)],
+    )
+    at_point_reference, _ = render(renderer, scene, 1024)
+    at_point, _ = render(renderer, dataclasses.replace(scene, render=RenderSettings(max_depth=3, seed=9)), 16)
+    monkeypatch.setattr(buffers, "LIGHTS_AT_POINT_LIMIT", 0)
+    by_power_reference, _ = render(renderer, scene, 1024)
+    by_power, _ = render(renderer, dataclasses.replace(scene, render=RenderSettings(max_depth=3, seed=9)), 16)
+
+    assert by_power_reference.mean() == pytest.approx(at_point_reference.mean(), rel=0.01)
+    quadrants = lambda image: image.reshape(2, 12, 2, 12, 3).mean(axis=(1, 3))  # noqa: E731
+    assert np.allclose(quadrants(by_power_reference), quadrants(at_point_reference), rtol=0.02)
+    error = lambda image: np.mean((image - at_point_reference) ** 2)  # noqa: E731
+    assert error(at_point) < 0.1 * error(by_power)

@@ -31,6 +31,7 @@ MATERIAL_ROWS = 8
 
 # Binding points, as declared in glsl/common.glsl, glsl/textures.glsl and glsl/trace.comp.
 BINDINGS = {"kd_nodes": 0, "prim_refs": 1, "geometry": 2, "shading": 3, "materials": 4, "lights": 5, "image_data": 7}
+UNIFORM_BINDINGS = {"light_choice": 0}  # uniform blocks (glsl/lights.glsl's LightPlaces)
 ACCUMULATION_BINDING = 6
 MISSING_SKY = (0.2, 0.0, 0.2)  # what a scene whose environment map cannot be read is lit by
 
@@ -118,13 +119,43 @@ def _emitted_power(flat: FlatScene) -> np.ndarray:
 LIGHT_AREA, LIGHT_POINT, LIGHT_SUN, LIGHT_ENVIRONMENT = 0, 1, 2, 3  # glsl/lights.glsl
 
 
+# Next-event estimation chooses among at most this many lights by what each brings to the shading point
+# (glsl/lights.glsl, "Choosing a light"), which costs a pass over the table per choice; more lights (an
+# emissive mesh) are chosen by power alone.
+LIGHT_PLACES = 32  # the lights glsl/lights.glsl's LightPlaces block holds
+LIGHTS_AT_POINT_LIMIT = LIGHT_PLACES
+
+
 @dataclass
 class _LightEntry:
+    """A row of the light table. ``falloff`` and ``reach2`` give the irradiance a light of power P brings to
+    a point at distance d, roughly: P falloff / max(d^2, reach2) about ``vector``, or P falloff for a light
+    at infinity (``reach2`` < 0)."""
+
     kind: int
     power: float
     prim: int = 0
     vector: tuple = (0.0, 0.0, 0.0)
     rgb: tuple = (0.0, 0.0, 0.0)
+    falloff: float = 1.0 / (4.0 * math.pi)  # a point light: intensity P / 4 pi over d^2
+    reach2: float = 1e-12
+
+
+def _area_light_entries(flat: FlatScene, power: np.ndarray) -> list[_LightEntry]:
+    """One entry per emissive primitive: its power, and its centre and extent for the irradiance estimate."""
+    prims = np.flatnonzero(power > 0)
+    tri, sph = prims[prims < flat.triangle_count], prims[prims >= flat.triangle_count] - flat.triangle_count
+    t = flat.triangles[tri].astype(np.float64)
+    centres = np.concatenate([t.mean(axis=1), flat.spheres[sph, :3].astype(np.float64)])
+    reach2 = np.concatenate([((t - t.mean(axis=1, keepdims=True)) ** 2).sum(-1).max(-1),
+                             flat.spheres[sph, 3].astype(np.float64) ** 2])
+    # On its axis, a one-sided Lambertian emitter of power P gives irradiance P / (pi d^2); a two-sided one
+    # spends half its power on the far side; a sphere spreads it over all directions, P / (4 pi d^2).
+    two_sided = np.array([flat.materials[m].two_sided for m in flat.triangle_material[tri]], bool)
+    falloff = np.concatenate([np.where(two_sided, 0.5, 1.0) / math.pi, np.full(len(sph), 0.25 / math.pi)])
+    return [_LightEntry(LIGHT_AREA, float(power[prim]), prim=int(prim), vector=tuple(centre), falloff=float(f),
+                        reach2=float(r2))
+            for prim, centre, f, r2 in zip(np.concatenate([tri, sph + flat.triangle_count]), centres, falloff, reach2)]
 
 
 def _environment_uniforms(environment: Environment, textures: TextureTable, scene_radius: float,
@@ -190,8 +221,10 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
     scene_radius = max(0.5 * float(np.linalg.norm(bounds[1] - bounds[0])), 1e-3)
 
     # Every light, with its power: next-event estimation chooses among them in proportion to it.
-    power = _emitted_power(flat)
-    entries = [_LightEntry(LIGHT_AREA, float(power[i]), prim=int(i)) for i in np.flatnonzero(power > 0)]
+    entries = _area_light_entries(flat, _emitted_power(flat))
+    # Light from infinity comes from every direction at every point: its irradiance is its power over the
+    # disk of the scene's radius that the power was measured through (environment.infinite_light_power).
+    at_infinity = {"falloff": 1.0 / (math.pi * scene_radius**2), "reach2": -1.0}
     sun_uniforms = {"sun_direction": (0.0, 1.0, 0.0), "sun_one_minus_cos": 0.0, "sun_radiance": (0.0, 0.0, 0.0)}
     suns = [light.name for light in lights if isinstance(light, SunLight)]
     if len(suns) > 1:
@@ -206,23 +239,30 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
                             "sun_radiance": tuple(float(v) for v in light.radiance())}
             # pbrt-v4's DistantLight::Phi: the irradiance falling on a disk of the scene's radius.
             entries.append(_LightEntry(LIGHT_SUN, math.pi * scene_radius**2 * _luminance(light.irradiance),
-                                       vector=light.unit_direction(), rgb=light.radiance()))
+                                       vector=light.unit_direction(), rgb=light.radiance(), **at_infinity))
     env_uniforms, env_power = _environment_uniforms(environment, textures, scene_radius, environment_importance)
     if env_power > 0:
-        entries.append(_LightEntry(LIGHT_ENVIRONMENT, env_power))
+        entries.append(_LightEntry(LIGHT_ENVIRONMENT, env_power, **at_infinity))
     total = sum(e.power for e in entries)
     pmfs = np.array([e.power / total for e in entries]) if total > 0 else np.zeros(len(entries))
-    prim_pmf = np.zeros(n_prim)
+    light_of_prim = np.full(n_prim, -1, np.int32)  # each primitive's row in the light table, or -1
     lights_table = np.zeros((len(entries), 3, 4), np.float32)
     for row, (entry, pmf, cdf) in enumerate(zip(entries, pmfs, np.cumsum(pmfs))):
         lights_table[row, 0] = (entry.kind, np.int32(entry.prim).view(np.float32), cdf, pmf)
         lights_table[row, 1, :3], lights_table[row, 2, :3] = entry.vector, entry.rgb
         if entry.kind == LIGHT_AREA:
-            prim_pmf[entry.prim] = pmf
+            light_of_prim[entry.prim] = row
     if len(entries):
         lights_table[-1, 0, 2] = 1.0  # the last cumulative value is exactly 1, whatever the rounding
-    env_pmf = next((float(p) for e, p in zip(entries, pmfs) if e.kind == LIGHT_ENVIRONMENT), 0.0)
-    sun_pmf = next((float(p) for e, p in zip(entries, pmfs) if e.kind == LIGHT_SUN), 0.0)
+    # glsl/lights.glsl's LightPlaces block: (centre, reach^2) per light, then power share x falloff, four
+    # lights to a row. Left empty when there are too many lights to choose among at each point.
+    light_choice = np.zeros((LIGHT_PLACES + LIGHT_PLACES // 4, 4), np.float32)
+    if len(entries) <= LIGHTS_AT_POINT_LIMIT:
+        for row, (entry, pmf) in enumerate(zip(entries, pmfs)):
+            light_choice[row] = (*entry.vector, entry.reach2)
+            light_choice[LIGHT_PLACES + row // 4, row % 4] = pmf * entry.falloff
+    env_row = next((row for row, e in enumerate(entries) if e.kind == LIGHT_ENVIRONMENT), -1)
+    sun_row = next((row for row, e in enumerate(entries) if e.kind == LIGHT_SUN), -1)
 
     geometry = np.zeros((n_prim, 3, 4), np.float32)
     tris = flat.triangles
@@ -231,7 +271,7 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
     geometry[:n_tri, 2, :3] = tris[:, 2] - tris[:, 0]
     geometry[n_tri:, 0] = flat.spheres
     geometry[:, 1, 3] = material_ids.view(np.float32)
-    geometry[:, 2, 3] = prim_pmf
+    geometry[:, 2, 3] = light_of_prim.view(np.float32)
 
     shading = np.zeros((n_tri, 4, 4), np.float32)
     shading[:, :3, :3] = flat.triangle_normals
@@ -252,6 +292,7 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
         "shading": shading,
         "materials": np.concatenate([material_rows, textures.records()]).astype(np.float32),
         "lights": lights_table.reshape(-1, 4),
+        "light_choice": light_choice,
         "image_data": textures.texels(),
     }
     arrays = {name: at_least_one(np.ascontiguousarray(a)) for name, a in arrays.items()}
@@ -261,8 +302,9 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
         "scene_min": tuple(float(v) for v in kdtree.bounds[0]),
         "scene_max": tuple(float(v) for v in kdtree.bounds[1]),
         "light_count": len(entries),
-        "env_select_pmf": env_pmf,
-        "sun_pmf": sun_pmf,
+        "env_light": env_row,
+        "sun_light": sun_row,
+        "lights_at_point": int(len(entries) <= LIGHTS_AT_POINT_LIMIT),
         "texture_base": len(material_rows),
         **env_uniforms,
         **sun_uniforms,
@@ -290,7 +332,10 @@ class GpuScene:
 
     def bind(self) -> None:  # callers (RenderSession.step, cast_rays) have made the context current
         for name, buffer in self.buffers.items():
-            buffer.bind_to_storage_buffer(BINDINGS[name])
+            if name in UNIFORM_BINDINGS:
+                buffer.bind_to_uniform_block(UNIFORM_BINDINGS[name])
+            else:
+                buffer.bind_to_storage_buffer(BINDINGS[name])
 
     def release(self) -> None:
         if self.buffers:

@@ -31,6 +31,10 @@ class KernelFeatures:
     area_lights: bool = True
     point_lights: bool = True
     sun: bool = True
+    # How next-event estimation chooses a light (glsl/lights.glsl): by what each brings to the shading point
+    # (a few lights), or by power (many). The general kernel has both and asks the uniform lights_at_point.
+    lights_at_point: bool = True
+    lights_by_power: bool = True
     material_types: frozenset[int] = ALL_MATERIAL_TYPES  # render/buffers.py's MATERIAL_CODES
 
     def defines(self) -> dict[str, int]:
@@ -42,6 +46,8 @@ class KernelFeatures:
             "HAS_AREA_LIGHTS": int(self.area_lights),
             "HAS_POINT_LIGHTS": int(self.point_lights),
             "HAS_SUN": int(self.sun),
+            "HAS_LIGHTS_AT_POINT": int(self.lights_at_point),
+            "HAS_LIGHTS_BY_POWER": int(self.lights_by_power),
             "MATERIAL_TYPES": sum(1 << code for code in self.material_types),
         }
 
@@ -67,5 +73,7 @@ def scene_features(packed: PackedScene) -> KernelFeatures:
         area_lights=LIGHT_AREA in light_kinds,
         point_lights=LIGHT_POINT in light_kinds,
         sun=LIGHT_SUN in light_kinds,
+        lights_at_point=bool(uniforms["lights_at_point"]),
+        lights_by_power=not uniforms["lights_at_point"],
         material_types=frozenset(int(code) for code in records[:, 0, 3]),
     )
