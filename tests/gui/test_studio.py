@@ -425,3 +425,17 @@ def test_point_lights_and_suns_are_in_the_outliner_editable_and_undoable(qtbot, 
     assert doc.selection == [("light", 1)] and window.properties.title.text() == "point light"
     doc.undo_stack.undo()
     assert len(doc.scene.lights) == 1
+
+
+# -- a million triangles -----------------------------------------------------------------------------------------
+def test_the_million_triangle_scene_opens_in_the_studio_and_renders(qtbot, make_window):
+    import dataclasses
+
+    from lenslab.scene.io.loader import open_scene
+
+    scene = open_scene("marbles_on_sand")
+    scene.camera = dataclasses.replace(scene.camera, resolution=(64, 48))
+    window = make_window(scene)
+    assert window.doc.scene.nodes[0].shape.type_name == "relief"
+    frame = wait_for_frame(qtbot, window, min_spp=1, timeout=180000)
+    assert frame.samples_per_pixel >= 1

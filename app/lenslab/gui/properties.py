@@ -38,7 +38,7 @@ from lenslab.scene.lights import LIGHT_TYPES, Light
 from lenslab.scene.materials import MATERIAL_TYPES, Diffuse, Material
 from lenslab.scene.io.meshes import MESH_SUFFIXES
 from lenslab.scene.scene import ENVIRONMENT_TYPES, Environment, Node
-from lenslab.scene.shapes import SHAPE_TYPES, Box, Disk, MeshFile, Rectangle, Shape, Sphere
+from lenslab.scene.shapes import SHAPE_TYPES, Box, Disk, MeshFile, Rectangle, Relief, Shape, Sphere
 
 #: Polymorphic slots: the base class picks the registry of concrete types to choose from.
 TAGGED_TYPES: dict[type, dict[str, type]] = {Shape: SHAPE_TYPES, Material: MATERIAL_TYPES,
@@ -103,12 +103,14 @@ def convert_type(old: Any, new_cls: type) -> Any:
 def _same_extent(old: Any, new_cls: type) -> dict[str, Any]:
     """Size fields that keep a shape's extent when its type changes (a 0.3 m box becomes a 0.3 m sphere)."""
     half = {Sphere: lambda o: o.radius, Disk: lambda o: o.radius, Box: lambda o: max(o.size) / 2,
-            Rectangle: lambda o: max(o.size) / 2}.get(type(old))
+            Rectangle: lambda o: max(o.size) / 2, Relief: lambda o: max(o.size) / 2}.get(type(old))
     if half is None:
         return {}
     r = float(half(old))
+    if isinstance(old, (Rectangle, Relief)) and new_cls in (Rectangle, Relief):
+        return {"size": tuple(old.size)}  # a floor becomes a relief of the same extent, and back
     return {Sphere: {"radius": r}, Disk: {"radius": r}, Box: {"size": (2 * r,) * 3},
-            Rectangle: {"size": (2 * r, 2 * r)}}.get(new_cls, {})
+            Rectangle: {"size": (2 * r, 2 * r)}, Relief: {"size": (2 * r, 2 * r)}}.get(new_cls, {})
 
 
 class FieldEditor:

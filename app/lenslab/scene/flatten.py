@@ -6,14 +6,16 @@ Primitives are numbered triangles first, then spheres; ``prim_node`` maps each b
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
 from lenslab.scene.materials import Material
 from lenslab.scene.scene import DEFAULT_MATERIAL, Node, Scene, SceneError
-from lenslab.scene.shapes import Box, Disk, MeshFile, Rectangle, Sphere, TriangleMesh
+from lenslab.scene.shapes import Box, Disk, MeshFile, Rectangle, Relief, Sphere, TriangleMesh
 from lenslab.scene.io.meshes import LoadedMesh, MeshLoadError, MeshPart
 from lenslab.scene.transform import transform_normals, transform_points
 
@@ -66,6 +68,9 @@ def _flat_normals(corners: np.ndarray) -> np.ndarray:
 
 def _mesh_parts(scene: Scene, node: Node, loader) -> LoadedMesh:
     shape = node.shape
+    if isinstance(shape, Relief):
+        fields = (tuple(v) if isinstance(v, list) else v for v in dataclasses.astuple(shape))  # hashable
+        return LoadedMesh((MeshPart(_relief_mesh(*fields)),))
     if isinstance(shape, (Rectangle, Disk, Box)):
         return LoadedMesh((MeshPart(shape.mesh()),))
     assert isinstance(shape, MeshFile)
@@ -77,6 +82,13 @@ def _mesh_parts(scene: Scene, node: Node, loader) -> LoadedMesh:
     except MeshLoadError as exc:
         where = scene.source_path or "scene"
         raise SceneError(f"{where}: node '{node.name}': {exc}") from None
+
+
+@lru_cache(maxsize=4)
+def _relief_mesh(*fields) -> TriangleMesh:
+    """A relief's mesh, kept for the next flatten: millions of triangles take a second to make, and the
+    studio flattens the scene again after every edit, most of which leave the relief as it was."""
+    return Relief(*fields).mesh()
 
 
 def flatten_scene(scene: Scene, mesh_loader=None) -> FlatScene:

@@ -1,6 +1,6 @@
 """Shapes: what a node draws. Triangle meshes (from files or built in) and analytic spheres.
 
-Built-in shapes (rectangle, box) are meshes made in code so that a scene like the Cornell box needs no
+Built-in shapes (rectangle, disk, box, relief) are meshes made in code so that a scene like the Cornell box needs no
 mesh files. Mesh files are read through trimesh (``lenslab.scene.io.meshes``) when the scene is flattened,
 and cached by path and modification time.
 """
@@ -92,6 +92,85 @@ class Box(Shape):
 
 
 @dataclass
+class Relief(Shape):
+    """A rectangle in the local XY plane raised towards +Z by fractal noise: ground, rock, sand, hammered metal.
+
+    A mesh made in code, a grid of ``resolution`` vertices (2 (nx - 1)(ny - 1) triangles, smooth normals), so
+    a scene can hold millions of triangles without a mesh file. The relief is fractal Brownian motion of
+    gradient noise (Perlin 1985; Musgrave's fBm): ``octaves`` layers, each of half the feature size and half
+    the height of the one before, the first with features of ``feature_size``. ``seed`` picks the landscape.
+    """
+
+    type_name: ClassVar[str] = "relief"
+    size: tuple[float, float] = field(default=(1.0, 1.0), metadata={"range": (1e-9, 1e9), "doc": "width, height in metres"})
+    height: float = field(default=0.02, metadata={"range": (0.0, 1e9), "doc": "metres from the lowest to the highest point, about"})
+    feature_size: float = field(default=0.1, metadata={"range": (1e-9, 1e9), "doc": "metres across the largest bumps"})
+    octaves: int = field(default=5, metadata={"range": (1, 16), "doc": "layers of ever finer detail"})
+    resolution: tuple[int, int] = field(default=(256, 256), metadata={"range": (2, 8192), "doc": "vertices along X and Y"})
+    seed: int = field(default=0, metadata={"range": (0, 2**31 - 1), "doc": "which landscape"})
+
+    def mesh(self) -> TriangleMesh:
+        nx, ny = (int(n) for n in self.resolution)
+        x = np.linspace(-self.size[0] / 2, self.size[0] / 2, nx)
+        y = np.linspace(-self.size[1] / 2, self.size[1] / 2, ny)
+        gx, gy = np.meshgrid(x, y)  # (ny, nx)
+        z = self.height * relief_height(gx / self.feature_size, gy / self.feature_size, self.octaves, self.seed)
+        # Smooth normals from the height field's slopes: n ~ (-dz/dx, -dz/dy, 1).
+        dz_dy, dz_dx = np.gradient(z, y, x) if nx > 1 and ny > 1 else (np.zeros_like(z), np.zeros_like(z))
+        normals = np.stack([-dz_dx, -dz_dy, np.ones_like(z)], axis=-1)
+        normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
+        vertices = np.stack([gx, gy, z], axis=-1).reshape(-1, 3)
+        index = np.arange(nx * ny).reshape(ny, nx)
+        a, b, c, d = index[:-1, :-1], index[:-1, 1:], index[1:, 1:], index[1:, :-1]  # a cell, counter-clockwise
+        faces = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
+        u, v = np.meshgrid(np.linspace(0.0, 1.0, nx), np.linspace(0.0, 1.0, ny))
+        return TriangleMesh(vertices, faces, normals.reshape(-1, 3), np.stack([u, v], -1).reshape(-1, 2))
+
+
+def relief_height(x: np.ndarray, y: np.ndarray, octaves: int, seed: int) -> np.ndarray:
+    """fBm of 2D gradient noise at (x, y) in units of the largest feature, scaled to span about [-1/2, 1/2]."""
+    total, amplitude, frequency, norm = np.zeros(np.shape(x)), 1.0, 1.0, 0.0
+    for octave in range(int(octaves)):
+        total += amplitude * _gradient_noise(x * frequency, y * frequency, seed * 131 + octave)
+        norm += amplitude
+        amplitude, frequency = amplitude * 0.5, frequency * 2.0
+    return total / norm  # gradient noise lies within about [-0.5, 0.5] (at most sqrt(2)/2 at worst)
+
+
+def _gradient_noise(x: np.ndarray, y: np.ndarray, seed: int) -> np.ndarray:
+    """Perlin's gradient noise: a random unit gradient at every integer lattice point, blended with his
+    quintic fade so that the surface has continuous slope and curvature."""
+    x0, y0 = np.floor(x), np.floor(y)
+    fx, fy = x - x0, y - y0
+    ix, iy = x0.astype(np.int64), y0.astype(np.int64)
+
+    def corner(dx: int, dy: int) -> np.ndarray:
+        angle = 2.0 * np.pi * _lattice_hash(ix + dx, iy + dy, seed)
+        return np.cos(angle) * (fx - dx) + np.sin(angle) * (fy - dy)
+
+    def fade(t: np.ndarray) -> np.ndarray:
+        return t * t * t * (t * (t * 6.0 - 15.0) + 10.0)
+
+    sx, sy = fade(fx), fade(fy)
+    bottom = corner(0, 0) + sx * (corner(1, 0) - corner(0, 0))
+    top = corner(0, 1) + sx * (corner(1, 1) - corner(0, 1))
+    return bottom + sy * (top - bottom)
+
+
+def _lattice_hash(ix: np.ndarray, iy: np.ndarray, seed: int) -> np.ndarray:
+    """A uniform number in [0, 1) per lattice point (a 64-bit integer mix, SplitMix64's finaliser)."""
+    with np.errstate(over="ignore"):
+        h = (ix.astype(np.uint64) * np.uint64(0x9E3779B97F4A7C15)) ^ (iy.astype(np.uint64) * np.uint64(0xC2B2AE3D27D4EB4F))
+        h ^= np.uint64(seed & 0xFFFFFFFF) * np.uint64(0x165667B19E3779F9)
+        h ^= h >> np.uint64(30)
+        h *= np.uint64(0xBF58476D1CE4E5B9)
+        h ^= h >> np.uint64(27)
+        h *= np.uint64(0x94D049BB133111EB)
+        h ^= h >> np.uint64(31)
+    return (h >> np.uint64(11)).astype(np.float64) / float(1 << 53)
+
+
+@dataclass
 class MeshFile(Shape):
     """A triangle mesh read from a file (OBJ, PLY, glTF/GLB, STL) through trimesh; path relative to the scene."""
 
@@ -100,4 +179,4 @@ class MeshFile(Shape):
     smooth: bool = field(default=True, metadata={"doc": "interpolate vertex normals (false: flat facets)"})
 
 
-SHAPE_TYPES: dict[str, type[Shape]] = {cls.type_name: cls for cls in (Sphere, Rectangle, Disk, Box, MeshFile)}
+SHAPE_TYPES: dict[str, type[Shape]] = {cls.type_name: cls for cls in (Sphere, Rectangle, Disk, Box, Relief, MeshFile)}
