@@ -130,14 +130,18 @@ LIGHTS_AT_POINT_LIMIT = LIGHT_PLACES
 class _LightEntry:
     """A row of the light table. ``falloff`` and ``reach2`` give the irradiance a light of power P brings to
     a point at distance d, roughly: P falloff / max(d^2, reach2) about ``vector``, or P falloff for a light
-    at infinity (``reach2`` < 0)."""
+    at infinity (``reach2`` < 0). Roughly means averaged over the ways a surface at the point may face, as
+    infinite_light_power (render/environment.py) measures the sky: a quarter of the irradiance on a surface
+    facing a small light squarely. Measured alike, a lamp and the sky compete fairly; measured on a surface
+    facing the lamp, lamps took shadow rays the sky needed (glass_metal_envmap in benchmarks/: 27% more
+    noise than choosing by power)."""
 
     kind: int
     power: float
     prim: int = 0
     vector: tuple = (0.0, 0.0, 0.0)
     rgb: tuple = (0.0, 0.0, 0.0)
-    falloff: float = 1.0 / (4.0 * math.pi)  # a point light: intensity P / 4 pi over d^2
+    falloff: float = 1.0 / (16.0 * math.pi)  # a point light: intensity P / 4 pi over d^2, facing it
     reach2: float = 1e-12
 
 
@@ -149,10 +153,11 @@ def _area_light_entries(flat: FlatScene, power: np.ndarray) -> list[_LightEntry]
     centres = np.concatenate([t.mean(axis=1), flat.spheres[sph, :3].astype(np.float64)])
     reach2 = np.concatenate([((t - t.mean(axis=1, keepdims=True)) ** 2).sum(-1).max(-1),
                              flat.spheres[sph, 3].astype(np.float64) ** 2])
-    # On its axis, a one-sided Lambertian emitter of power P gives irradiance P / (pi d^2); a two-sided one
-    # spends half its power on the far side; a sphere spreads it over all directions, P / (4 pi d^2).
+    # On its axis, a one-sided Lambertian emitter of power P gives a surface facing it irradiance
+    # P / (pi d^2); a two-sided one spends half its power on the far side; a sphere spreads it over all
+    # directions, P / (4 pi d^2). A quarter of each: the average over the ways the surface may face.
     two_sided = np.array([flat.materials[m].two_sided for m in flat.triangle_material[tri]], bool)
-    falloff = np.concatenate([np.where(two_sided, 0.5, 1.0) / math.pi, np.full(len(sph), 0.25 / math.pi)])
+    falloff = 0.25 * np.concatenate([np.where(two_sided, 0.5, 1.0) / math.pi, np.full(len(sph), 0.25 / math.pi)])
     return [_LightEntry(LIGHT_AREA, float(power[prim]), prim=int(prim), vector=tuple(centre), falloff=float(f),
                         reach2=float(r2))
             for prim, centre, f, r2 in zip(np.concatenate([tri, sph + flat.triangle_count]), centres, falloff, reach2)]
