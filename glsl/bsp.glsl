@@ -8,6 +8,12 @@
 // on Mesa's llvmpipe it made a whole Cornell box render 15% slower than this. A push onto a full stack
 // drops its deepest entry, the farthest interval; when the stack runs dry before the ray's interval is
 // covered, traversal restarts at the root for what is left (kd-restart, Foley and Sugerman 2005).
+//
+// A plane crossed exactly at an end of the current interval sends the ray to both children (one of them
+// for an interval of zero length), as in pbrt. In float arithmetic two distinct planes can give the same t:
+// a floor rotated into place lies at y = 1e-16 and y = 7e-17, and a ray reaching the second plane "at t0"
+// may still be on the first child's side there. Choosing one child at an exact tie lost such floors
+// (validation scene environment_depths, 10% too dark).
 
 #ifndef SHORT_STACK
 #define SHORT_STACK 4
@@ -30,6 +36,10 @@ bool trace_bsp(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
     vec2 stack_span[SHORT_STACK];
     int depth = 0;  // entries on the stack
     int node = 0;
+    float restarted_at = -1.0;
+    // After a restart that made no progress (the zero-length intervals of ties at t0 filled the stack and
+    // pushed out what lies beyond), ties at t0 go to the far side only: the near sides were just visited.
+    bool past_ties = false;
     while (true) {
         // Down to a leaf, in a loop of its own ("while-while", Aila and Laine 2009): lanes in lockstep then
         // descend together instead of each interior step also paying for the leaf code below.
@@ -44,9 +54,9 @@ bool trace_bsp(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
             int above = int(n.y >> 2);
             int first = below_first ? below : above;
             int second = below_first ? above : below;
-            if (t_plane >= t1 || t_plane <= 0.0) {
+            if (t_plane > t1 || t_plane <= 0.0) {
                 node = first;
-            } else if (t_plane <= t0) {
+            } else if (t_plane < t0 || (past_ties && t_plane == t0)) {
                 node = second;
             } else {
                 for (int k = SHORT_STACK - 1; k > 0; k--) {
@@ -61,6 +71,7 @@ bool trace_bsp(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
             }
             n = kd_nodes[node];
         }
+        past_ties = false;
         int count = int(n.y >> 2);
         int first_ref = int(n.x);
         for (int i = 0; i < count; i++) {
@@ -87,6 +98,8 @@ bool trace_bsp(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
             depth--;
         } else {
             node = 0;  // the stack dropped what lies beyond: restart from the root there
+            past_ties = t1 == restarted_at;
+            restarted_at = t1;
             t0 = t1;
             t1 = t_end;
         }

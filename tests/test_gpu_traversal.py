@@ -90,3 +90,34 @@ def test_scene_too_big_for_the_device_is_refused_with_a_clear_message(renderer):
     packed = pack_scene(flat, ConstantEnvironment())
     with pytest.raises(SceneTooLarge, match=r"needs 125 KiB of shading in one storage buffer, more than this GL device allows \(64 KiB\).*2,000 triangles"):
         GpuScene(renderer.ctx, packed, max_block_bytes=64 * 1024)
+
+
+def test_a_floor_rotated_into_place_is_found_by_rays_that_reach_it(renderer):
+    """A disk turned -90 degrees about x lies at y = 1e-16-ish, not 0: the tree splits it at planes a rounding
+    error apart, which a ray reaches at the same float t. Traversal must visit both sides of such a tie
+    (validation scene environment_depths rendered 10% too dark when it did not)."""
+    from lenslab.scene.scene import Node, Scene
+    from lenslab.scene.shapes import Disk, Sphere
+    from lenslab.scene.transform import Transform
+
+    scene = Scene(nodes=[
+        Node("ground", Transform(rotate_deg=(-90, 0, 0), scale=(30, 30, 30)), Disk(radius=1.0), "grey"),
+        Node("ball", Transform(translate=(0.5, 0.6, -5)), Sphere(radius=0.6), "grey"),
+    ], materials={"grey": Diffuse()})
+    flat = scene.flatten()
+    assert 0 < np.abs(flat.triangles[..., 1]).max() < 1e-5  # the premise: almost, not exactly, flat
+    rng = np.random.default_rng(4)
+    n = 4000
+    directions = rng.normal(size=(n, 3))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    from_eye = np.tile([0.0, 1.0, 0.0], (n, 1))
+    from_floor = np.stack([rng.uniform(-8, 8, n), np.full(n, 1e-4), rng.uniform(-14, 2, n)], axis=1)
+    gpu = GpuScene(renderer.ctx, pack_scene(flat, ConstantEnvironment()), renderer.limits.max_storage_block_bytes)
+    try:
+        for origins in (from_eye, from_floor):
+            hits = cast_rays(renderer, gpu, origins, directions)
+            expected_t, _ = brute_force(flat, origins, directions)
+            assert np.isfinite(expected_t).sum() > n // 3
+            assert np.array_equal(np.isfinite(hits.t), np.isfinite(expected_t))
+    finally:
+        gpu.release()
