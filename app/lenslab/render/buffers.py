@@ -227,9 +227,12 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
 
     # Every light, with its power: next-event estimation chooses among them in proportion to it.
     entries = _area_light_entries(flat, _emitted_power(flat))
-    # Light from infinity comes from every direction at every point: its irradiance is its power over the
-    # disk of the scene's radius that the power was measured through (environment.infinite_light_power).
+    # Light from infinity reaches every point alike: its irradiance is its power over the disk of the
+    # scene's radius that the power was measured through. The sky's power (environment.infinite_light_power)
+    # is already the average over the ways a surface may face; the sun's is pbrt's, for a surface facing it,
+    # so it takes the quarter that averaging gives every small light (_LightEntry).
     at_infinity = {"falloff": 1.0 / (math.pi * scene_radius**2), "reach2": -1.0}
+    sun_at_infinity = {**at_infinity, "falloff": 0.25 / (math.pi * scene_radius**2)}
     sun_uniforms = {"sun_direction": (0.0, 1.0, 0.0), "sun_one_minus_cos": 0.0, "sun_radiance": (0.0, 0.0, 0.0)}
     suns = [light.name for light in lights if isinstance(light, SunLight)]
     if len(suns) > 1:
@@ -244,7 +247,7 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
                             "sun_radiance": tuple(float(v) for v in light.radiance())}
             # pbrt-v4's DistantLight::Phi: the irradiance falling on a disk of the scene's radius.
             entries.append(_LightEntry(LIGHT_SUN, math.pi * scene_radius**2 * _luminance(light.irradiance),
-                                       vector=light.unit_direction(), rgb=light.radiance(), **at_infinity))
+                                       vector=light.unit_direction(), rgb=light.radiance(), **sun_at_infinity))
     env_uniforms, env_power = _environment_uniforms(environment, textures, scene_radius, environment_importance)
     if env_power > 0:
         entries.append(_LightEntry(LIGHT_ENVIRONMENT, env_power, **at_infinity))
