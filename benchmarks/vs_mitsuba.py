@@ -31,7 +31,6 @@ from lenslab.validate.metrics import relative_mse
 
 HERE = Path(__file__).resolve().parent
 SCENES = ("cornell_dof", "dof_lights", "glass_metal_envmap", "million_triangles")
-MITSUBA_PASS_SPP = 256  # Mitsuba's LLVM wavefront holds every sample of a pass in memory
 
 
 @dataclass
@@ -80,20 +79,16 @@ def render_lenslab(renderer, path: Path, defines: dict, spp: int, sampler: str, 
 
 def render_mitsuba(path: Path, defines: dict, spp: int, seed: int) -> Result:
     from lenslab.validate.mitsuba_env import load_mitsuba
+    from lenslab.validate.runner import mitsuba_image
 
     mi = load_mitsuba()
     start = time.perf_counter()
     scene = mi.load_file(str(path), **defines)
     loaded = time.perf_counter()
-    total, done, index = None, 0, 0
-    while done < spp:
-        n = min(MITSUBA_PASS_SPP, spp - done)
-        image = np.array(mi.render(scene, spp=n, seed=seed + index), dtype=np.float64)[..., :3]
-        total = image * n if total is None else total + image * n
-        done, index = done + n, index + 1
+    image = mitsuba_image(mi, scene, spp, seed)
     end = time.perf_counter()
-    height, width = total.shape[:2]
-    return Result((total / spp).astype(np.float32), end - start, end - loaded, width * height * spp)
+    height, width = image.shape[:2]
+    return Result(image, end - start, end - loaded, width * height * spp)
 
 
 def reference(path: Path, defines: dict, spp: int, cache: Path) -> np.ndarray:

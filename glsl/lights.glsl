@@ -119,7 +119,7 @@ LightChoice choose_light(vec3 p, float u) {
         c.pmf = total > 0.0 ? chosen_weight / total : 0.0;
     } else {
         c.light = pick_light(u);
-        c.pmf = lights[3 * c.light].w;
+        c.pmf = light_choice_pmf(c.light, p, c.weights);
     }
     return c;
 }

@@ -150,8 +150,9 @@ def _area_light_entries(flat: FlatScene, power: np.ndarray) -> list[_LightEntry]
     prims = np.flatnonzero(power > 0)
     tri, sph = prims[prims < flat.triangle_count], prims[prims >= flat.triangle_count] - flat.triangle_count
     t = flat.triangles[tri].astype(np.float64)
-    centres = np.concatenate([t.mean(axis=1), flat.spheres[sph, :3].astype(np.float64)])
-    reach2 = np.concatenate([((t - t.mean(axis=1, keepdims=True)) ** 2).sum(-1).max(-1),
+    centroids = t.mean(axis=1)
+    centres = np.concatenate([centroids, flat.spheres[sph, :3].astype(np.float64)])
+    reach2 = np.concatenate([((t - centroids[:, None]) ** 2).sum(-1).max(-1),
                              flat.spheres[sph, 3].astype(np.float64) ** 2])
     # On its axis, a one-sided Lambertian emitter of power P gives a surface facing it irradiance
     # P / (pi d^2); a two-sided one spends half its power on the far side; a sphere spreads it over all

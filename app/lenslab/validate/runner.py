@@ -91,6 +91,12 @@ def render_mitsuba(path: Path, spp: int, seed: int, res: int) -> Render:
     mi = load_mitsuba()
     start = time.perf_counter()
     scene = mi.load_file(str(path), res=str(res), spp=str(spp))
+    return Render(mitsuba_image(mi, scene, spp, seed), spp, time.perf_counter() - start)
+
+
+def mitsuba_image(mi, scene, spp: int, seed: int) -> np.ndarray:
+    """A loaded Mitsuba scene at ``spp``, rendered in passes of at most MITSUBA_PASS_SPP (seeds seed, seed + 1,
+    ...) and averaged: linear RGB, float32."""
     total = None
     done, pass_index = 0, 0
     while done < spp:
@@ -99,7 +105,7 @@ def render_mitsuba(path: Path, spp: int, seed: int, res: int) -> Render:
         total = image * n if total is None else total + image * n
         done += n
         pass_index += 1
-    return Render((total / spp).astype(np.float32), spp, time.perf_counter() - start)
+    return (total / spp).astype(np.float32)
 
 
 def validate_scene(name: str, *, spp: int, reference_spp: int, bias_spp: int, res: int, renderer,
