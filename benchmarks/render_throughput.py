@@ -31,7 +31,8 @@ def main() -> None:
     parser.add_argument("--size", type=int, default=192)
     args = parser.parse_args()
     renderer = Renderer()
-    print(f"device: {renderer.describe()['renderer']}, image {args.size}x{args.size}, {args.seconds:g} s per figure")
+    device = renderer.describe()
+    print(f"device: {device['renderer']}, {device['version']}, image {args.size}x{args.size}, {args.seconds:g} s per figure")
     print(f"{'scene':<12} {'max_depth':>9} {'sobol Msamples/s':>17} {'independent':>12} {'sobol/indep':>12}")
     for name in ("cornell_box", "dof_chart"):
         scene = open_scene(name)

@@ -10,6 +10,10 @@ render: wall seconds (loading, tree build and kernel compile included, as a user
 of the rendering alone, relative MSE against the reference, and efficiency 1 / (seconds x relMSE) as a
 multiple of Mitsuba's. Ratios are what to compare across machines: these are shared and noisy.
 
+Mitsuba renders in a child process of its own: Dr.Jit's LLVM and thread pool in the same process as Mesa's
+llvmpipe slowed LensLab's sampling by up to four times (Mesa 25, glass_metal_envmap), which would have
+measured the neighbourhood rather than the renderer.
+
 Usage: python benchmarks/vs_mitsuba.py [--res 256] [--spp 64] [--reference-spp 1024] [--scenes a,b]
        python benchmarks/vs_mitsuba.py --lenslab-only --res 16 --spp 2 --triangles 2000   (no Mitsuba needed)
 The million-triangle scene's mesh (a bumpy torus) is written into the cache as a PLY the first time.
@@ -18,7 +22,9 @@ The million-triangle scene's mesh (a bumpy torus) is written into the cache as a
 from __future__ import annotations
 
 import argparse
+import concurrent.futures
 import dataclasses
+import multiprocessing
 import hashlib
 import sys
 import time
@@ -78,6 +84,13 @@ def render_lenslab(renderer, path: Path, defines: dict, spp: int, sampler: str, 
 
 
 def render_mitsuba(path: Path, defines: dict, spp: int, seed: int) -> Result:
+    """Mitsuba's render, in a child process (see the module's note)."""
+    context = multiprocessing.get_context("spawn")
+    with concurrent.futures.ProcessPoolExecutor(max_workers=1, mp_context=context) as child:
+        return child.submit(_render_mitsuba_here, path, defines, spp, seed).result()
+
+
+def _render_mitsuba_here(path: Path, defines: dict, spp: int, seed: int) -> Result:
     from lenslab.validate.mitsuba_env import load_mitsuba
     from lenslab.validate.runner import mitsuba_image
 
@@ -116,7 +129,8 @@ def main() -> None:
     from lenslab.render.tracer import Renderer
 
     renderer = Renderer()
-    print(f"device: {renderer.describe()['renderer']}; {args.res}x{args.res}, {args.spp} spp, box filter; "
+    device = renderer.describe()
+    print(f"device: {device['renderer']}, {device['version']}; {args.res}x{args.res}, {args.spp} spp, box filter; "
           f"reference: Mitsuba at {args.reference_spp} spp")
     header = f"{'scene':<20} {'renderer':<22} {'seconds':>8} {'Msamples/s':>11} {'relMSE':>9} {'efficiency':>11}"
     print(header)

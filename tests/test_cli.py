@@ -173,6 +173,21 @@ def test_info_prints_the_gl_renderer_and_limits(renderer, capsys):
     assert "max storage block" in out and "MiB" in out
 
 
+@pytest.mark.parametrize("renderer_name, version, advised", [
+    ("llvmpipe (LLVM 15.0.6, 256 bits)", "4.5 (Core Profile) Mesa 22.3.6", True),
+    ("llvmpipe (LLVM 15.0.6, 256 bits)", "4.5 (Core Profile) Mesa 25.0.7-2~bpo12+1", False),
+    ("NVIDIA H100 80GB HBM3/PCIe/SSE2", "4.6.0 NVIDIA 550.54.15", False),
+    ("AMD Radeon RX 7900 XTX (radeonsi, navi31, LLVM 15.0.6)", "4.6 (Core Profile) Mesa 22.3.6", False),
+])
+def test_info_advises_a_newer_mesa_only_for_an_old_llvmpipe(renderer_name, version, advised):
+    from lenslab.render.gl import slow_driver_note
+
+    note = slow_driver_note(renderer_name, version)
+    assert (note is not None) == advised
+    if advised:
+        assert "Mesa 22" in note and "bookworm-backports" in note
+
+
 def test_help_speaks_photography(capsys):
     with pytest.raises(SystemExit) as info:
         main(["--help"])

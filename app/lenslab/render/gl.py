@@ -75,10 +75,25 @@ def device_limits(ctx) -> DeviceLimits:
     )
 
 
+# llvmpipe from Mesa before 24 runs the trace kernels 1.3 to 2 times slower (docs/performance.md).
+FAST_LLVMPIPE_MESA = 24
+_MESA_VERSION = re.compile(r"Mesa (\d+)\.")
+
+
+def slow_driver_note(renderer: str, version: str) -> str | None:
+    """Advice for a CPU renderer that a newer Mesa would make faster; None when there is nothing to say."""
+    match = _MESA_VERSION.search(version)
+    if "llvmpipe" not in renderer or match is None or int(match.group(1)) >= FAST_LLVMPIPE_MESA:
+        return None
+    return (f"Mesa {match.group(1)}'s llvmpipe renders 1.3 to 2 times slower than Mesa {FAST_LLVMPIPE_MESA} or later "
+            "(on Debian 12: apt-get install -t bookworm-backports libgl1-mesa-dri libegl-mesa0)")
+
+
 def describe_device(ctx) -> dict[str, str]:
     """What `lenslab --info` prints: renderer, version and the limits the tracer works within."""
     info = ctx.info
     limits = device_limits(ctx)
+    note = slow_driver_note(info["GL_RENDERER"], info["GL_VERSION"])
     return {
         "renderer": info["GL_RENDERER"],
         "vendor": info["GL_VENDOR"],
@@ -87,6 +102,7 @@ def describe_device(ctx) -> dict[str, str]:
         "storage blocks per compute shader": str(limits.max_compute_storage_blocks),
         "max work-group invocations": str(limits.max_work_group_invocations),
         "max work-group count": " x ".join(str(v) for v in limits.max_work_group_count),
+        **({"note": note} if note else {}),
     }
 
 
