@@ -1,8 +1,9 @@
 // Which parts of the kernel a scene needs. render/features.py passes each as a #define (0 or 1, or a bit
 // mask of material types) so that a Cornell box is not slowed by code for textures, spheres or an
 // environment map it does not have: on a SIMD device every lane pays for both sides of a branch that any
-// lane takes, and on Mesa's llvmpipe for both sides of every branch. A kernel compiled without these
-// defines is the general kernel, with everything in; the tests compare the two.
+// lane takes (Mesa 22's llvmpipe pays for both sides of every branch, taken or not), and every loop runs
+// its body at least once on llvmpipe. A kernel compiled without these defines is the general kernel, with
+// everything in; the tests compare the two.
 #ifndef HAS_SPHERES
 #define HAS_SPHERES 1
 #endif

@@ -1,8 +1,10 @@
 """Which parts of the trace kernel a scene needs: the kernel is compiled once per set of features.
 
-On a SIMD device every lane pays for both sides of a branch that any of its lanes takes; Mesa's llvmpipe
-(the CPU renderer) pays for both sides of *every* branch, taken or not. A general kernel therefore costs a
-Cornell box the code for textures, spheres, an environment map and five material models it never uses.
+On a SIMD device every lane pays for both sides of a branch that any of its lanes takes; Mesa 22's llvmpipe
+(the CPU renderer) pays for both sides of *every* branch, taken or not, and llvmpipe runs the body of every
+loop at least once, needed or not. A general kernel therefore costs a Cornell box the code for textures,
+spheres, an environment map and five material models it never uses (12-16% of its speed on Mesa 25's
+llvmpipe, up to 64% on Mesa 22's: docs/performance.md).
 :func:`scene_features` reads the packed scene and names what it uses; :meth:`KernelFeatures.defines` turns
 that into the #defines glsl/features.glsl declares, so the compiler drops everything else. The general
 kernel (:data:`GENERAL`) keeps it all; tests check that both render the same image.
