@@ -10,9 +10,7 @@ render: wall seconds (loading, tree build and kernel compile included, as a user
 of the rendering alone, relative MSE against the reference, and efficiency 1 / (seconds x relMSE) as a
 multiple of Mitsuba's. Ratios are what to compare across machines: these are shared and noisy.
 
-Mitsuba renders in a child process of its own: Dr.Jit's LLVM and thread pool in the same process as Mesa's
-llvmpipe slowed LensLab's sampling by up to four times (Mesa 25, glass_metal_envmap), which would have
-measured the neighbourhood rather than the renderer.
+Mitsuba renders in a child process of its own (lenslab.validate.runner.render_mitsuba_file says why).
 
 Usage: python benchmarks/vs_mitsuba.py [--res 256] [--spp 64] [--reference-spp 1024] [--scenes a,b]
        python benchmarks/vs_mitsuba.py --lenslab-only --res 16 --spp 2 --triangles 2000   (no Mitsuba needed)
@@ -22,9 +20,7 @@ The million-triangle scene's mesh (a bumpy torus) is written into the cache as a
 from __future__ import annotations
 
 import argparse
-import concurrent.futures
 import dataclasses
-import multiprocessing
 import hashlib
 import sys
 import time
@@ -84,24 +80,11 @@ def render_lenslab(renderer, path: Path, defines: dict, spp: int, sampler: str, 
 
 
 def render_mitsuba(path: Path, defines: dict, spp: int, seed: int) -> Result:
-    """Mitsuba's render, in a child process (see the module's note)."""
-    context = multiprocessing.get_context("spawn")
-    with concurrent.futures.ProcessPoolExecutor(max_workers=1, mp_context=context) as child:
-        return child.submit(_render_mitsuba_here, path, defines, spp, seed).result()
+    from lenslab.validate.runner import render_mitsuba_file
 
-
-def _render_mitsuba_here(path: Path, defines: dict, spp: int, seed: int) -> Result:
-    from lenslab.validate.mitsuba_env import load_mitsuba
-    from lenslab.validate.runner import mitsuba_image
-
-    mi = load_mitsuba()
-    start = time.perf_counter()
-    scene = mi.load_file(str(path), **defines)
-    loaded = time.perf_counter()
-    image = mitsuba_image(mi, scene, spp, seed)
-    end = time.perf_counter()
+    image, seconds, render_seconds = render_mitsuba_file(path, defines, spp, seed)
     height, width = image.shape[:2]
-    return Result(image, end - start, end - loaded, width * height * spp)
+    return Result(image, seconds, render_seconds, width * height * spp)
 
 
 def reference(path: Path, defines: dict, spp: int, cache: Path) -> np.ndarray:

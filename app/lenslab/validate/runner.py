@@ -12,12 +12,14 @@ Per scene (all images at the scene's film size, ``res`` x ``res``):
 
 LensLab renders exactly as ``lenslab scene.xml --headless`` does: ``open_scene`` then a ``RenderSession``
 stepped until the samples are in. Mitsuba loads the same file with ``mi.load_file`` and renders with
-``mi.render``.
+``mi.render``, in a child process of its own (:func:`render_mitsuba_file`).
 """
 
 from __future__ import annotations
 
+import concurrent.futures
 import dataclasses
+import multiprocessing
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -88,10 +90,30 @@ def render_lenslab(path: Path, spp: int, seed: int, res: int, renderer, warn: Ca
 
 
 def render_mitsuba(path: Path, spp: int, seed: int, res: int) -> Render:
+    image, seconds, _ = render_mitsuba_file(path, {"res": str(res), "spp": str(spp)}, spp, seed)
+    return Render(image, spp, seconds)
+
+
+def render_mitsuba_file(path: Path, defines: dict[str, str], spp: int, seed: int) -> tuple[np.ndarray, float, float]:
+    """Mitsuba's image of a scene file at ``spp`` (see :func:`mitsuba_image`), the wall seconds from loading
+    the file and the seconds of the rendering alone.
+
+    It runs in a child process: Dr.Jit's LLVM JIT and thread pool in the process where Mesa's llvmpipe then
+    renders LensLab slowed LensLab's sampling by up to four times (docs/performance.md), so that the timings
+    measured the neighbourhood, not the renderer.
+    """
+    with concurrent.futures.ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("spawn")) as child:
+        return child.submit(_render_mitsuba_here, path, defines, spp, seed).result()
+
+
+def _render_mitsuba_here(path: Path, defines: dict[str, str], spp: int, seed: int) -> tuple[np.ndarray, float, float]:
     mi = load_mitsuba()
     start = time.perf_counter()
-    scene = mi.load_file(str(path), res=str(res), spp=str(spp))
-    return Render(mitsuba_image(mi, scene, spp, seed), spp, time.perf_counter() - start)
+    scene = mi.load_file(str(path), **defines)
+    loaded = time.perf_counter()
+    image = mitsuba_image(mi, scene, spp, seed)
+    end = time.perf_counter()
+    return image, end - start, end - loaded
 
 
 def mitsuba_image(mi, scene, spp: int, seed: int) -> np.ndarray:
