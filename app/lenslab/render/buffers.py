@@ -265,8 +265,9 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
         lights_table[-1, 0, 2] = 1.0  # the last cumulative value is exactly 1, whatever the rounding
     # glsl/lights.glsl's LightPlaces block: (centre, reach^2) per light, then power share x falloff, four
     # lights to a row. Left empty when there are too many lights to choose among at each point.
+    choose_at_point = len(entries) <= LIGHTS_AT_POINT_LIMIT
     light_choice = np.zeros((LIGHT_PLACES + LIGHT_PLACES // 4, 4), np.float32)
-    if len(entries) <= LIGHTS_AT_POINT_LIMIT:
+    if choose_at_point:
         for row, (entry, pmf) in enumerate(zip(entries, pmfs)):
             light_choice[row] = (*entry.vector, entry.reach2)
             light_choice[LIGHT_PLACES + row // 4, row % 4] = pmf * entry.falloff
@@ -313,7 +314,7 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
         "light_count": len(entries),
         "env_light": env_row,
         "sun_light": sun_row,
-        "lights_at_point": int(len(entries) <= LIGHTS_AT_POINT_LIMIT),
+        "lights_at_point": int(choose_at_point),
         "texture_base": len(material_rows),
         **env_uniforms,
         **sun_uniforms,

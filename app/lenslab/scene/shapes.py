@@ -152,8 +152,9 @@ def _gradient_noise(x: np.ndarray, y: np.ndarray, seed: int) -> np.ndarray:
         return t * t * t * (t * (t * 6.0 - 15.0) + 10.0)
 
     sx, sy = fade(fx), fade(fy)
-    bottom = corner(0, 0) + sx * (corner(1, 0) - corner(0, 0))
-    top = corner(0, 1) + sx * (corner(1, 1) - corner(0, 1))
+    c00, c10, c01, c11 = corner(0, 0), corner(1, 0), corner(0, 1), corner(1, 1)
+    bottom = c00 + sx * (c10 - c00)
+    top = c01 + sx * (c11 - c01)
     return bottom + sy * (top - bottom)
 
 
