@@ -254,8 +254,9 @@ def test_primary_rays_through_the_image_match_mitsubas_convention(tmp_path):
     mitsuba_391 = {(0, 0): (-0.743494, 0.129489, -0.656086), (1, 0): (0.268095, -0.04219, -0.962468),
                    (0, 1): (-0.767544, -0.523853, -0.369397), (1, 1): (0.244045, -0.695532, -0.675779),
                    (0.25, 0.8): (-0.607871, -0.51996, -0.600113)}
+    frame = cam.frame()
     for (sx, sy), measured in mitsuba_391.items():
-        ours = cam.primary_ray_direction(2 * sx - 1, 1 - 2 * sy)
+        ours = frame.pinhole_directions([(sx * 300, sy * 200)])[0]
         assert np.allclose(ours, mitsuba_direction(to_world, sx, sy, fov_x, 1.5), atol=1e-12)
         assert np.allclose(ours, measured, atol=2e-6)
     assert np.allclose(cam.position, (1, 2, 3))
@@ -283,7 +284,7 @@ def test_no_sensor_gives_a_camera_that_sees_the_scene(tmp_path):
     scene, warnings = load(tmp_path, '<shape type="sphere"><point name="center" x="1" y="2" z="3"/></shape>')
     cam = scene.camera
     assert np.allclose(cam.position[:2], (1, 2)) and cam.position[2] < 2
-    assert np.allclose(cam.primary_ray_direction(0, 0), (0, 0, 1))
+    assert np.allclose(cam.frame().pinhole_directions([(cam.resolution[0] / 2, cam.resolution[1] / 2)]), (0, 0, 1))
     assert only(warnings, "no sensor").startswith(f"{tmp_path / 'scene.xml'}:2: <scene>")
 
 

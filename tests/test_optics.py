@@ -354,7 +354,7 @@ def test_parse_f_number_rejects_garbage_naming_it(text):
     assert repr(text) in str(info.value)
 
 
-@pytest.mark.parametrize("text", ["f/0", "0.5", "f/200", "128.5"])
+@pytest.mark.parametrize("text", ["f/0", "0.49", "f/200", "128.5"])
 def test_parse_f_number_rejects_out_of_range(text):
     with pytest.raises(ValueError, match="out of range") as info:
         parse_f_number(text)
@@ -362,10 +362,15 @@ def test_parse_f_number_rejects_out_of_range(text):
 
 
 def test_f_number_range_bounds():
+    # One range for every part of LensLab: what a scene file accepts, the stop scale accepts too.
+    from lenslab.scene.camera import ThinLensCamera
+
+    assert ThinLensCamera.accepted_range("f_number") == (0.5, 128)
     assert parse_f_number("f/128") == 128
-    assert parse_f_number("0.51") == 0.51
+    assert parse_f_number("0.5") == 0.5
+    assert format_f_number(0.5) == "f/0.5"
     with pytest.raises(ValueError):
-        format_f_number(0.5)
+        format_f_number(0.49)
 
 
 # --- layering -------------------------------------------------------------------------------

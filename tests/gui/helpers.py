@@ -33,7 +33,13 @@ def cpu_depth(scene, u: float, v: float) -> tuple[float, int]:
 
     flat = scene.flatten()
     cam = scene.camera
-    d = cam.primary_ray_direction(2 * u - 1, 1 - 2 * v)
+    # The pinhole ray written out here, not asked of the camera under test: tan(fov_x / 2) = w / 2f, the
+    # image's height a cut of the sensor's width.
+    right, up, back = cam.basis()
+    tan_x = cam.sensor_mm[0] / (2 * cam.focal_length_mm)
+    tan_y = tan_x * cam.resolution[1] / cam.resolution[0]
+    d = (2 * u - 1) * tan_x * right + (1 - 2 * v) * tan_y * up - back
+    d /= np.linalg.norm(d)
     o = np.asarray(cam.position, float)
     best_t, best_prim = np.inf, -1
     tri = flat.triangles.astype(float)

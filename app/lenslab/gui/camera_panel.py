@@ -38,6 +38,7 @@ from lenslab.optics import (
     parse_f_number,
     step_stop,
 )
+from lenslab.scene.camera import ThinLensCamera
 
 FULL_STOPS = (1.4, 2, 2.8, 4, 5.6, 8, 11, 16, 22)
 COMMON_FOCAL_LENGTHS = (14, 24, 35, 50, 85, 135, 200)
@@ -323,11 +324,11 @@ class CameraPanel(QWidget):
         # Iris.
         grid = QGridLayout()
         grid.setHorizontalSpacing(6)
-        self.blades = IntEdit(0, 32)
+        self.blades = IntEdit(*ThinLensCamera.accepted_range("aperture_blades"))
         self.blades.setSpecialValueText("round")
         self.blades.setToolTip("Number of aperture blades: round (0) or 3 to 32. Shapes the bokeh.")
         self.blades.edited.connect(self._blades_edited)
-        self.rotation = NumberEdit(-360, 360, decimals=1, step=1.0, suffix=" °")
+        self.rotation = NumberEdit(*ThinLensCamera.accepted_range("blade_rotation_deg"), decimals=1, step=1.0, suffix=" °")
         self.rotation.setToolTip("Rotation of the blade polygon")
         self.rotation.edited.connect(lambda v, merge: self.doc.set_camera("Blade rotation", merge, blade_rotation_deg=v))
         grid.addWidget(QLabel("Blades"), 0, 0)
@@ -340,7 +341,7 @@ class CameraPanel(QWidget):
     def _focal_section(self) -> Section:
         section = Section("Focal length")
         row = QHBoxLayout()
-        self.focal = NumberEdit(1, 2000, decimals=1, step=1.0, suffix=" mm")
+        self.focal = NumberEdit(*ThinLensCamera.accepted_range("focal_length_mm"), decimals=1, step=1.0, suffix=" mm")
         self.focal.setObjectName("focalLength")
         self.focal.edited.connect(lambda v, merge: self.set_focal_length(v, merge))
         self.focal_slider = QSlider(Qt.Horizontal)
@@ -373,7 +374,7 @@ class CameraPanel(QWidget):
         self.focus_slider.setRange(0, 1000)
         self.focus_slider.setFocusPolicy(Qt.StrongFocus)
         self.focus_slider.valueChanged.connect(self._focus_slid)
-        self.focus = NumberEdit(0.01, 1e6, decimals=3, step=0.01, suffix=" m")
+        self.focus = NumberEdit(*ThinLensCamera.accepted_range("focus_distance_m"), decimals=3, step=0.01, suffix=" m")
         self.focus.setObjectName("focusDistance")
         self.focus.setFixedWidth(86)
         self.focus.edited.connect(lambda v, merge: self.doc.set_camera("Focus distance", merge, focus_distance_m=v))
@@ -422,8 +423,8 @@ class CameraPanel(QWidget):
         self.sensor_combo.currentIndexChanged.connect(self._sensor_chosen)
         section.add(self.sensor_combo)
         row = QHBoxLayout()
-        self.sensor_w = NumberEdit(1, 500, decimals=2, step=0.1, suffix=" mm")
-        self.sensor_h = NumberEdit(1, 500, decimals=2, step=0.1, suffix=" mm")
+        self.sensor_w = NumberEdit(*ThinLensCamera.accepted_range("sensor_mm"), decimals=2, step=0.1, suffix=" mm")
+        self.sensor_h = NumberEdit(*ThinLensCamera.accepted_range("sensor_mm"), decimals=2, step=0.1, suffix=" mm")
         self.sensor_w.edited.connect(lambda v, merge: self._sensor_edited(merge))
         self.sensor_h.edited.connect(lambda v, merge: self._sensor_edited(merge))
         row.addWidget(QLabel("W"))
@@ -585,10 +586,8 @@ class CameraPanel(QWidget):
                 widget.setEnabled(not prime)
             for b, mm in zip(self.focal_buttons, COMMON_FOCAL_LENGTHS):
                 b.setEnabled(not prime and (lens is None or lens.min_focal_length_mm <= mm <= lens.max_focal_length_mm))
-            fov_x = math.degrees(cam.fov_x)
-            w, h = cam.resolution
-            tan_y = math.tan(cam.fov_x / 2) * h / w
-            self.fov_info.setText(f"Field of view {fov_x:.1f}° × {math.degrees(2 * math.atan(tan_y)):.1f}°"
+            fov_y = math.degrees(cam.frame().fov_y)
+            self.fov_info.setText(f"Field of view {math.degrees(cam.fov_x):.1f}° × {fov_y:.1f}°"
                                   + (" · fixed by the prime" if prime else ""))
             # Focus.
             self.focus.set_quietly(cam.focus_distance_m)

@@ -702,13 +702,11 @@ class MainWindow(QMainWindow):
 
     # -- adding, importing, deleting --------------------------------------------------------------------------------
     def focus_point(self) -> np.ndarray:
-        cam = self.doc.scene.camera
-        forward = -cam.basis()[2]
-        return np.asarray(cam.position, float) + forward * cam.focus_distance_m
+        return self.doc.scene.camera.frame().focus_point()
 
     def view_width_at_focus(self) -> float:
         cam = self.doc.scene.camera
-        return 2 * cam.focus_distance_m * math.tan(cam.fov_x / 2)
+        return cam.frame().view_size_at(cam.focus_distance_m)[0]
 
     def _insertion_parent(self) -> tuple:
         paths = self.doc.selected_node_paths()
@@ -897,9 +895,8 @@ class MainWindow(QMainWindow):
         if depth is None:  # not in view: the depth of its origin
             from lenslab.gui.scene_tree import world_matrix
 
-            cam = self.doc.scene.camera
             origin = world_matrix(self.doc, paths[0])[:3, 3]
-            depth = float(np.dot(origin - np.asarray(cam.position), -cam.basis()[2]))
+            depth = self.doc.scene.camera.frame().depth_of(origin)
         if depth <= 0.01:
             self.statusBar().showMessage("The selection is behind the camera", 4000)
             return

@@ -17,7 +17,6 @@ newest and signals once until the GUI has taken it, so a busy GUI never builds u
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import queue
 import threading
@@ -98,20 +97,6 @@ def upscale_nearest(image: np.ndarray, width: int, height: int) -> np.ndarray:
     rows = np.minimum((np.arange(height) * h) // height, h - 1)
     cols = np.minimum((np.arange(width) * w) // width, w - 1)
     return image[rows][:, cols]
-
-
-def pixel_rays(camera, width: int, height: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Origins, unit directions (both (H*W, 3)) of the pinhole rays through the pixel centres, and the view axis."""
-    right, up, back = camera.basis()
-    tan_x = math.tan(camera.fov_x / 2)
-    tan_y = tan_x * height / width
-    xs = ((np.arange(width) + 0.5) / width * 2 - 1) * tan_x
-    ys = (1 - (np.arange(height) + 0.5) / height * 2) * tan_y
-    d = xs[None, :, None] * right + ys[:, None, None] * up - back
-    d = d.reshape(-1, 3)
-    d /= np.linalg.norm(d, axis=1, keepdims=True)
-    o = np.broadcast_to(np.asarray(camera.position, float), d.shape)
-    return o, d, -back
 
 
 class RenderWorker(QThread):
@@ -412,12 +397,12 @@ class RenderWorker(QThread):
         if gpu_scene is None:
             return
         w, h = self._size
-        camera = dataclasses.replace(session.camera, resolution=(w, h))
-        origins, directions, forward = pixel_rays(camera, w, h)
+        frame = session.camera.frame(w, h)
+        origins, directions = frame.rays(frame.pixel_centres())
         hits = cast_rays(self._renderer, gpu_scene, origins, directions)
         prim_node = session.flat_scene.prim_node
         node_index = np.where(hits.prim >= 0, prim_node[np.maximum(hits.prim, 0)], -1).astype(np.int32)
-        depth = np.where(hits.prim >= 0, hits.t * (directions @ forward), np.inf).astype(np.float32)
+        depth = np.where(hits.prim >= 0, hits.t * (directions @ frame.forward), np.inf).astype(np.float32)
         self._gbuffer_size = (w, h)
         self.gbuffer_ready.emit(GBuffer(node_index.reshape(h, w), depth.reshape(h, w), self._generation))
 

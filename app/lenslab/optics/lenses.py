@@ -14,6 +14,7 @@ from typing import Iterable, Sequence
 
 from .presetfiles import FieldError, PresetError, build_preset, merge_by_name, preset_dirs, read_json
 from .stops import EXTENDED_THIRD_STOPS, MAX_F_NUMBER, MIN_F_NUMBER, is_valid_f_number
+from .thinlens import FOCAL_LENGTH_RANGE_MM
 
 __all__ = ["LensPreset", "LENSES_DIR", "MAX_APERTURE_BLADES", "load_lens_presets"]
 
@@ -23,8 +24,6 @@ LENSES_DIR = "lenses"
 #: More blades than this is indistinguishable from a circle; use 0 instead.
 MAX_APERTURE_BLADES = 32
 
-# Longest focal length we accept (mm); beyond is a typo rather than a lens.
-_MAX_FOCAL_LENGTH_MM = 5000.0
 
 
 @dataclass(frozen=True)
@@ -66,7 +65,7 @@ class LensPreset:
             value = getattr(self, key)
             if not is_valid_f_number(value):
                 raise FieldError(
-                    key, f"f-number must lie in ({MIN_F_NUMBER:g}, {MAX_F_NUMBER:g}], got {value!r}"
+                    key, f"f-number must lie in [{MIN_F_NUMBER:g}, {MAX_F_NUMBER:g}], got {value!r}"
                 )
             object.__setattr__(self, key, float(value))
         if self.narrowest_f_number < self.widest_f_number:
@@ -95,8 +94,9 @@ class LensPreset:
 
     def _check_focal(self):
         def check_mm(key, value):
-            if not (0.0 < value <= _MAX_FOCAL_LENGTH_MM):
-                raise FieldError(key, f"must lie in (0, {_MAX_FOCAL_LENGTH_MM:g}] mm, got {value!r}")
+            low, high = FOCAL_LENGTH_RANGE_MM
+            if not (low <= value <= high):
+                raise FieldError(key, f"must lie in [{low:g}, {high:g}] mm, got {value!r}")
             return float(value)
 
         prime, zoom = self.focal_length_mm, self.focal_range_mm

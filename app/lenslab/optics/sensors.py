@@ -18,6 +18,8 @@ from .presetfiles import FieldError, PresetError, build_preset, merge_by_name, p
 __all__ = [
     "SensorPreset",
     "FULL_FRAME",
+    "SENSOR_SIDE_RANGE_MM",
+    "crop_factor",
     "DEFAULT_SENSOR_NAME",
     "SENSORS_FILE",
     "load_sensor_presets",
@@ -29,9 +31,15 @@ SENSORS_FILE = "sensors.json"
 #: Diagonal of the 36 x 24 mm format, the reference for crop factors.
 _FULL_FRAME_DIAGONAL_MM = math.hypot(36.0, 24.0)
 
-# Largest sensor side we accept: 8x10 inch sheet film is 254 mm; anything
-# much beyond is a typo (metres entered as millimetres, say).
-_MAX_SIDE_MM = 500.0
+#: The sensor sides LensLab accepts, mm, in scene files, presets and the studio: from a 1 mm phone sensor
+#: side to beyond 8x10 inch sheet film (254 mm); much more is a typo (metres entered as millimetres, say).
+SENSOR_SIDE_RANGE_MM = (1.0, 500.0)
+
+
+def crop_factor(width_mm: float, height_mm: float) -> float:
+    """Full-frame diagonal over this sensor's diagonal (1.53 for APS-C 23.5 x 15.6): what a focal length is
+    multiplied by to give its 35 mm equivalent."""
+    return _FULL_FRAME_DIAGONAL_MM / math.hypot(width_mm, height_mm)
 
 
 @dataclass(frozen=True)
@@ -48,8 +56,9 @@ class SensorPreset:
             raise FieldError("name", "must be a non-empty string")
         for key in ("width_mm", "height_mm"):
             value = float(getattr(self, key))
-            if not (0.0 < value <= _MAX_SIDE_MM):
-                raise FieldError(key, f"must lie in (0, {_MAX_SIDE_MM:g}] mm, got {value:g}")
+            low, high = SENSOR_SIDE_RANGE_MM
+            if not (low <= value <= high):
+                raise FieldError(key, f"must lie in [{low:g}, {high:g}] mm, got {value:g}")
             object.__setattr__(self, key, value)  # store ints from JSON as floats
 
     @property
@@ -64,7 +73,7 @@ class SensorPreset:
     @property
     def crop_factor(self) -> float:
         """Full-frame diagonal over this diagonal (1.53 for APS-C 23.5 x 15.6)."""
-        return _FULL_FRAME_DIAGONAL_MM / self.diagonal_mm
+        return crop_factor(self.width_mm, self.height_mm)
 
     @property
     def coc_mm(self) -> float:

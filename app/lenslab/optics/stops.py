@@ -19,6 +19,7 @@ __all__ = [
     "EXTENDED_THIRD_STOPS",
     "MIN_F_NUMBER",
     "MAX_F_NUMBER",
+    "F_NUMBER_RANGE",
     "is_valid_f_number",
     "stops_between",
     "nearest_stop",
@@ -43,11 +44,14 @@ EXTENDED_THIRD_STOPS: tuple[float, ...] = (
     + (25, 29, 32, 36, 40, 45, 51, 57, 64, 72, 81, 90, 102, 114, 128)
 )
 
-#: Valid f-numbers lie in the half-open interval (MIN_F_NUMBER, MAX_F_NUMBER].
-#: 0.5 is the theoretical limit of an aplanatic lens in air (N = 1 / (2 NA),
-#: NA < 1); f/128 is about the smallest aperture ever marked on a lens.
+#: Valid f-numbers lie in [MIN_F_NUMBER, MAX_F_NUMBER], the one range every
+#: part of LensLab accepts (scene files, the command line, the studio, lens
+#: presets, importers).  0.5 is the theoretical limit of an aplanatic lens in
+#: air (N = 1 / (2 NA), NA < 1); f/128 is about the smallest aperture ever
+#: marked on a lens.
 MIN_F_NUMBER = 0.5
 MAX_F_NUMBER = 128.0
+F_NUMBER_RANGE = (MIN_F_NUMBER, MAX_F_NUMBER)
 
 # Two values closer than this (relative) are the same marked stop.  Adjacent
 # third stops differ by about 12 %, so this only absorbs float noise and
@@ -56,17 +60,17 @@ _SAME_STOP_REL_TOL = 1e-3
 
 
 def is_valid_f_number(n: float) -> bool:
-    """True when ``n`` is a finite number in (0.5, 128]."""
+    """True when ``n`` is a finite number in [0.5, 128]."""
     try:
         n = float(n)
     except (TypeError, ValueError):
         return False
-    return MIN_F_NUMBER < n <= MAX_F_NUMBER
+    return MIN_F_NUMBER <= n <= MAX_F_NUMBER
 
 
 def _checked(n: float) -> float:
     if not is_valid_f_number(n):
-        raise ValueError(f"f-number must lie in ({MIN_F_NUMBER:g}, {MAX_F_NUMBER:g}], got {n!r}")
+        raise ValueError(f"f-number must lie in [{MIN_F_NUMBER:g}, {MAX_F_NUMBER:g}], got {n!r}")
     return float(n)
 
 
@@ -147,7 +151,7 @@ def parse_f_number(text: str) -> float:
     """Parse ``"f/2.8"``, ``"2.8"``, ``"F2.8"``, ``"1:2.8"`` (and ``"2,8"``) to ``2.8``.
 
     Raises ValueError naming the text when it is not an f-number or is
-    outside (0.5, 128].
+    outside [0.5, 128].
     """
     match = _F_NUMBER_RE.match(text) if isinstance(text, str) else None
     if match is None:
@@ -155,6 +159,6 @@ def parse_f_number(text: str) -> float:
     n = float(match.group(1).replace(",", "."))
     if not is_valid_f_number(n):
         raise ValueError(
-            f"f-number out of range ({MIN_F_NUMBER:g}, {MAX_F_NUMBER:g}]: {text!r}"
+            f"f-number out of range [{MIN_F_NUMBER:g}, {MAX_F_NUMBER:g}]: {text!r}"
         )
     return n

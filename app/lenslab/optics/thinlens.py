@@ -26,6 +26,9 @@ import numpy as np
 
 __all__ = [
     "MM_PER_M",
+    "FOCAL_LENGTH_RANGE_MM",
+    "FOCUS_DISTANCE_RANGE_M",
+    "f_number_for_lens_radius",
     "format_focal_length",
     "field_of_view_x",
     "focal_length_for_fov",
@@ -36,6 +39,12 @@ __all__ = [
 
 #: Millimetres in a metre; named so that every unit conversion is greppable.
 MM_PER_M = 1000.0
+
+#: The focal lengths LensLab accepts, mm: a 1 mm fisheye-free wide angle to a 2000 mm mirror lens. Scene
+#: files, the command line, the studio's fields, lens presets and importers all read this one range.
+FOCAL_LENGTH_RANGE_MM = (1.0, 2000.0)
+#: The focus distances LensLab accepts, metres: 1 cm (macro) to 1000 km (infinity for any lens).
+FOCUS_DISTANCE_RANGE_M = (0.01, 1e6)
 
 
 def require_positive(name: str, value: float) -> float:
@@ -81,6 +90,19 @@ def lens_radius_m(focal_length_mm: float, f_number: float) -> float:
     f = require_positive("focal_length_mm", focal_length_mm)
     n = require_positive("f_number", f_number)
     return f / (2.0 * n) / MM_PER_M
+
+
+def f_number_for_lens_radius(focal_length_mm: float, lens_radius: float) -> float:
+    """The f-number whose lens disk has radius ``lens_radius`` metres: ``N = f / (2 r)``.
+
+    Inverse of :func:`lens_radius_m`, for importers whose cameras give an aperture radius (Mitsuba's
+    ``aperture_radius``). A zero radius is a pinhole: infinity.
+    """
+    f = require_positive("focal_length_mm", focal_length_mm)
+    r = float(lens_radius)
+    if not (r >= 0.0 and math.isfinite(r)):
+        raise ValueError(f"lens_radius must be a non-negative finite number, got {lens_radius!r}")
+    return math.inf if r == 0.0 else f / MM_PER_M / (2.0 * r)
 
 
 def blur_diameter_mm(focal_length_mm, f_number, focus_distance_m, depth_m):

@@ -13,7 +13,6 @@ renders can be merged by adding, and the same seed gives the same image however 
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 import time
 from dataclasses import dataclass
@@ -87,16 +86,17 @@ class Renderer:
 
 
 def camera_uniforms(camera: ThinLensCamera, width: int, height: int) -> dict[str, object]:
-    tan_x = float(np.tan(camera.fov_x / 2))
+    """glsl/camera.glsl's uniforms: the camera's frame for a width x height image, as the host computes it."""
+    frame = camera.frame(width, height)
     return {
-        "cam_position": tuple(float(v) for v in camera.position),
-        "cam_to_world": tuple(float(v) for v in camera.basis().reshape(-1)),  # rows of basis = columns
-        "cam_tan_half_fov": (tan_x, tan_x * height / width),
-        "cam_lens_radius": float(camera.lens_radius),
-        "cam_focus_distance": float(camera.focus_distance_m),
-        "cam_blades": int(camera.aperture_blades),
-        "cam_blade_rotation": float(np.radians(camera.blade_rotation_deg)),
-        "image_size": (width, height),
+        "cam_position": tuple(float(v) for v in frame.position),
+        "cam_to_world": tuple(float(v) for v in frame.to_world.T.reshape(-1)),  # column-major: right, up, back
+        "cam_tan_half_fov": tuple(float(t) for t in frame.tan_half_fov),
+        "cam_lens_radius": float(frame.lens_radius),
+        "cam_focus_distance": float(frame.focus_distance),
+        "cam_blades": int(frame.blades),
+        "cam_blade_rotation": float(frame.blade_rotation),
+        "image_size": (frame.width, frame.height),
     }
 
 
@@ -324,19 +324,15 @@ class RenderSession:
         """The surface seen through the lens centre at image position (x, y) in pixels, (0, 0) top left."""
         from lenslab.render.raycast import cast_rays
 
-        ndc_x = 2.0 * x / self.width - 1.0
-        ndc_y = 1.0 - 2.0 * y / self.height
-        camera = dataclasses.replace(self.camera, resolution=(self.width, self.height))
-        direction = camera.primary_ray_direction(ndc_x, ndc_y)
-        origin = np.asarray(camera.position, float)
-        hits = cast_rays(self.renderer, self._gpu_scene, origin[None], direction[None])
+        frame = self.camera.frame(self.width, self.height)
+        origins, directions = frame.rays([(x, y)])
+        hits = cast_rays(self.renderer, self._gpu_scene, origins, directions)
         prim = int(hits.prim[0])
         if prim < 0:
             return None
-        point = origin + float(hits.t[0]) * direction
-        forward = -camera.basis()[2]
+        point = origins[0] + float(hits.t[0]) * directions[0]
         node = self.flat_scene.nodes[int(self.flat_scene.prim_node[prim])]
-        return Pick(point=point, depth=float(np.dot(point - origin, forward)), prim=prim, node=node)
+        return Pick(point=point, depth=frame.depth_of(point), prim=prim, node=node)
 
     # -- reading the image --------------------------------------------------------------------------------
     @in_context

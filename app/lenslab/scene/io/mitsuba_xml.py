@@ -38,7 +38,9 @@ from xml.parsers import expat
 
 import numpy as np
 
-from lenslab.optics.thinlens import MM_PER_M, focal_length_for_fov
+from lenslab.optics.stops import MAX_F_NUMBER, MIN_F_NUMBER
+from lenslab.optics.thinlens import (FOCAL_LENGTH_RANGE_MM, FOCUS_DISTANCE_RANGE_M, f_number_for_lens_radius,
+                                     focal_length_for_fov)
 from lenslab.scene.camera import ThinLensCamera
 from lenslab.scene.materials import Diffuse, Emissive, Material
 from lenslab.scene.lights import Light, PointLight, SunLight
@@ -971,22 +973,25 @@ class _Importer:
 
         fov_x = math.radians(cam.fov_x_deg)
         focal_mm = focal_length_for_fov(fov_x, SENSOR_WIDTH_MM)
-        if not 1.0 <= focal_mm <= 2000.0:
+        low, high = FOCAL_LENGTH_RANGE_MM
+        if not low <= focal_mm <= high:
             self.warn(where, f"a field of view of {cam.fov_x_deg:.4g} degrees needs a {focal_mm:.4g} mm lens, "
-                      "outside LensLab's 1-2000 mm: clamped")
-            focal_mm = min(max(focal_mm, 1.0), 2000.0)
+                      f"outside LensLab's {low:g}-{high:g} mm: clamped")
+            focal_mm = min(max(focal_mm, low), high)
         focus = cam.focus_distance
         pinhole = cam.aperture_radius is None
-        f_number = 128.0  # a pinhole ignores it; the nearest a lens gets to one, should it be turned off
+        f_number = MAX_F_NUMBER  # a pinhole ignores it; the nearest a lens gets to one, should it be turned off
         if not pinhole:
             r = cam.aperture_radius
-            f_number = focal_mm / MM_PER_M / (2.0 * r) if r > 0 else math.inf
-            if not 0.5 <= f_number <= 128.0:
-                self.warn(where, f"aperture_radius {r:g} gives f/{f_number:.4g}, outside LensLab's f/0.5-f/128: clamped")
-                f_number = min(max(f_number, 0.5), 128.0)
-        if not 0.01 <= focus <= 1e6 and not pinhole:
-            self.warn(where, f"focus_distance {focus:g} is outside 0.01-1e6: clamped")
-        focus = min(max(focus, 0.01), 1e6)
+            f_number = f_number_for_lens_radius(focal_mm, r) if r > 0 else math.inf
+            if not MIN_F_NUMBER <= f_number <= MAX_F_NUMBER:
+                self.warn(where, f"aperture_radius {r:g} gives f/{f_number:.4g}, outside LensLab's "
+                          f"f/{MIN_F_NUMBER:g}-f/{MAX_F_NUMBER:g}: clamped")
+                f_number = min(max(f_number, MIN_F_NUMBER), MAX_F_NUMBER)
+        low, high = FOCUS_DISTANCE_RANGE_M
+        if not low <= focus <= high and not pinhole:
+            self.warn(where, f"focus_distance {focus:g} is outside {low:g}-{high:g}: clamped")
+        focus = min(max(focus, low), high)
         return ThinLensCamera(
             position=tuple(float(v) for v in position),
             look_at=tuple(float(v) for v in position + forward),

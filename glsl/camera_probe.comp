@@ -1,0 +1,26 @@
+#version 430
+// Calls camera_ray() directly, for tests: for each item, the ray through a pixel sample and a lens sample.
+// tests/test_camera_rays.py compares these rays with the Python camera's (lenslab.scene.camera.CameraFrame),
+// so the shader and the host can never disagree on where a pixel looks. Not used while rendering.
+
+layout(local_size_x = 64) in;
+
+#include "common.glsl"
+#include "sampling.glsl"
+#include "camera.glsl"
+
+// In, one vec4 per item: (pixel x, pixel y, lens u, lens v), pixels as in camera_ray().
+layout(std430, binding = 6) readonly buffer ProbeIn { vec4 probe_in[]; };
+// Out, two vec4 per item: (origin, 0), (direction, 0).
+layout(std430, binding = 8) writeonly buffer ProbeOut { vec4 probe_out[]; };
+
+uniform int item_count;
+
+void main() {
+    int i = int(gl_GlobalInvocationID.x);
+    if (i >= item_count) return;
+    vec4 item = probe_in[i];
+    Ray ray = camera_ray(item.xy, item.zw);
+    probe_out[2 * i] = vec4(ray.o, 0.0);
+    probe_out[2 * i + 1] = vec4(ray.d, 0.0);
+}
