@@ -20,7 +20,6 @@ The million-triangle scene's mesh (a bumpy torus) is written into the cache as a
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import hashlib
 import sys
 import time
@@ -61,21 +60,19 @@ def torus_mesh(cache: Path, triangles: int) -> Path:
 
 
 def render_lenslab(renderer, path: Path, defines: dict, spp: int, sampler: str, seed: int) -> Result:
-    from lenslab.render.tracer import RenderSession
-    from lenslab.scene.io.loader import open_scene
+    from lenslab.render.job import RenderJob
+    from lenslab.scene.overrides import SceneOverrides
 
     start = time.perf_counter()
-    scene = open_scene(path, defines=defines, warn=lambda message: print(f"  lenslab: {message}", file=sys.stderr))
-    scene = dataclasses.replace(scene, render=dataclasses.replace(scene.render, spp=spp, seed=seed, sampler=sampler))
-    session = RenderSession(renderer, scene, dispatch_seconds=0.25)
+    overrides = SceneOverrides(spp=spp, seed=seed, sampler=sampler, defines=defines)
+    scene = overrides.open(path, warn=lambda message: print(f"  lenslab: {message}", file=sys.stderr))
+    job = RenderJob(renderer, scene, spp=spp, dispatch_seconds=0.25)
     try:
-        while not session.done(spp):
-            session.step(1.0, spp)
-        image = session.image()
-        render_seconds = session.elapsed_seconds
-        samples = session.width * session.height * spp
+        image = job.run()
+        render_seconds = job.session.elapsed_seconds
+        samples = job.session.width * job.session.height * spp
     finally:
-        session.release()
+        job.release()
     return Result(image, time.perf_counter() - start, render_seconds, samples)
 
 

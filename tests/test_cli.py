@@ -41,12 +41,20 @@ def test_headless_exr_is_linear_float_with_camera_metadata(renderer, tmp_path, c
     assert "wrote" in err and "\n" == err[-1]
 
 
-def test_headless_png_is_display_referred(renderer, tmp_path, capsys):
-    out = tmp_path / "shot.png"
-    status, _, err = run_cli(capsys, "dof_chart", "--headless", "-o", out, *SMALL)
-    assert status == 0, err
-    pixels, _ = read_image(out)
-    assert pixels.shape == (24, 32, 3) and 0.0 <= pixels.min() and pixels.max() <= 1.0
+def test_headless_png_is_the_exr_tone_mapped_for_display(renderer, tmp_path, capsys):
+    from lenslab.render.film import tone_map
+
+    for suffix in (".exr", ".png"):
+        status, _, err = run_cli(capsys, "dof_chart", "--headless", "-o", tmp_path / f"shot{suffix}", *SMALL,
+                                 "--tone-map", "filmic", "--exposure", "1")
+        assert status == 0, err
+    linear, _ = read_image(tmp_path / "shot.exr")
+    display, _ = read_image(tmp_path / "shot.png")
+    assert display.shape == (24, 32, 3)
+    # The same seed gives the same samples: the PNG is the EXR brightened a stop, filmic, sRGB-encoded, 8 bits.
+    expected = tone_map(linear, exposure_stops=1.0, operator="filmic")
+    assert np.abs(display - expected).max() <= 0.5 / 255 + 1e-6
+    assert np.abs(display - tone_map(linear)).max() > 0.05  # and not merely clamped: the options took effect
 
 
 def test_time_limit_alone_renders_what_fits(renderer, tmp_path, capsys):
@@ -56,6 +64,20 @@ def test_time_limit_alone_renders_what_fits(renderer, tmp_path, capsys):
     assert status == 0, err
     _, meta = read_image(out)
     assert meta["lenslab:SamplesPerPixel"] >= 1
+
+
+def test_a_time_limit_shorter_than_one_pass_still_samples_every_pixel(renderer, tmp_path, capsys):
+    # 65,536 pixels: more than the first dispatch takes, so the pass cannot end inside the limit.
+    out = tmp_path / "short.exr"
+    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", out, "--width", "256", "--time-limit", "0.001")
+    assert status == 0, err
+    pixels, meta = read_image(out)
+    assert pixels.shape == (256, 256, 3)
+    assert meta["lenslab:SamplesPerPixel"] == 1
+    # At 1 spp some paths find no light (a few percent of the ceiling's); a band of rows without a sample finds none.
+    lit_per_band = (pixels.sum(axis=2) > 0).reshape(32, 8 * 256).mean(axis=1)
+    assert lit_per_band.min() > 0.01, f"rows {8 * lit_per_band.argmin()}+ are black"
+    assert "the time limit ended before every pixel had a sample" in err and "1 spp" in err
 
 
 @pytest.mark.parametrize(

@@ -364,8 +364,9 @@ def test_parse_f_number_rejects_out_of_range(text):
 def test_f_number_range_bounds():
     # One range for every part of LensLab: what a scene file accepts, the stop scale accepts too.
     from lenslab.scene.camera import ThinLensCamera
+    from lenslab.scene.fields import declared_range
 
-    assert ThinLensCamera.accepted_range("f_number") == (0.5, 128)
+    assert declared_range(ThinLensCamera, "f_number") == (0.5, 128)
     assert parse_f_number("f/128") == 128
     assert parse_f_number("0.5") == 0.5
     assert format_f_number(0.5) == "f/0.5"

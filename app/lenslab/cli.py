@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import dataclasses
 import logging
 import os
 import sys
@@ -16,6 +15,7 @@ import time
 from pathlib import Path
 
 from lenslab import __version__
+from lenslab.scene.fields import declared_choices, declared_range
 
 EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 HEADLESS_DISPATCH_SECONDS = 0.25
@@ -52,8 +52,15 @@ def _number(kind, low: float, high: float):
     return parse
 
 
+def _declared(kind, cls, field_name: str):
+    """An argument checked against the range the scene class declares for the field it sets."""
+    return _number(kind, *declared_range(cls, field_name))
+
+
 def build_parser() -> argparse.ArgumentParser:
+    from lenslab.scene.camera import MAX_IMAGE_SIDE, ThinLensCamera
     from lenslab.scene.io.loader import shipped_scene_names
+    from lenslab.scene.scene import RenderSettings
 
     p = _Parser(
         prog="lenslab",
@@ -70,24 +77,25 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("scene", nargs="?", help="a scene file (.json), a folder holding scene.json, or a shipped scene name")
     p.add_argument("--headless", action="store_true", help="render to a file without opening a window")
     p.add_argument("-o", "--output", metavar="FILE", help="where to write the image: .exr (linear, float) or .png (sRGB)")
-    p.add_argument("--spp", type=_number(int, 1, 1 << 24), metavar="N",
+    p.add_argument("--spp", type=_declared(int, RenderSettings, "spp"), metavar="N",
                    help="samples per pixel (default: the scene's; with --time-limit alone, as many as fit)")
     p.add_argument("--time-limit", type=_number(float, 0.001, 1e7), metavar="SECONDS",
-                   help="stop after this long, keeping what has been rendered")
-    p.add_argument("--width", type=_number(int, 1, 16384), metavar="W", help="image width in pixels")
-    p.add_argument("--height", type=_number(int, 1, 16384), metavar="H", help="image height in pixels")
-    p.add_argument("--f-stop", type=_number(float, 0.5, 128), metavar="N",
+                   help="stop after this long, keeping what has been rendered (at least one sample in every pixel)")
+    p.add_argument("--width", type=_number(int, 1, MAX_IMAGE_SIDE), metavar="W", help="image width in pixels")
+    p.add_argument("--height", type=_number(int, 1, MAX_IMAGE_SIDE), metavar="H", help="image height in pixels")
+    p.add_argument("--f-stop", type=_declared(float, ThinLensCamera, "f_number"), metavar="N",
                    help="aperture as an f-number (1.4 is wide open and blurry, 16 is deep focus)")
-    p.add_argument("--focal-length", type=_number(float, 1, 2000), metavar="MM",
+    p.add_argument("--focal-length", type=_declared(float, ThinLensCamera, "focal_length_mm"), metavar="MM",
                    help="lens focal length in millimetres (sets the field of view with the sensor width)")
-    p.add_argument("--focus-distance", type=_number(float, 0.01, 1e6), metavar="M",
+    p.add_argument("--focus-distance", type=_declared(float, ThinLensCamera, "focus_distance_m"), metavar="M",
                    help="distance to the plane of focus, in metres")
-    p.add_argument("--seed", type=_number(int, 0, 2**31 - 1), metavar="S",
+    p.add_argument("--seed", type=_declared(int, RenderSettings, "seed"), metavar="S",
                    help="random seed: the same seed gives the same image")
-    p.add_argument("--max-depth", type=_number(int, 1, 1024), metavar="D",
+    p.add_argument("--max-depth", type=_declared(int, RenderSettings, "max_depth"), metavar="D",
                    help="longest light path in segments (2 = direct light only)")
-    p.add_argument("--sampler", choices=("sobol", "independent"), help="sample pattern (default: the scene's)")
-    p.add_argument("--clamp", type=_number(float, 0, 1e9), metavar="L",
+    p.add_argument("--sampler", choices=declared_choices(RenderSettings, "sampler"),
+                   help="sample pattern (default: the scene's)")
+    p.add_argument("--clamp", type=_declared(float, RenderSettings, "clamp"), metavar="L",
                    help="tame fireflies: cap the radiance one sample may add (biased; 0 = off, the default)")
     p.add_argument("--exposure", type=_number(float, -30, 30), default=0.0, metavar="STOPS",
                    help="PNG only: brighten (+) or darken (-) by this many stops")
@@ -148,59 +156,17 @@ def _warn(message: str) -> None:
     print(f"lenslab: warning: {message}", file=sys.stderr)
 
 
-def _apply_overrides(scene, args):
-    camera_changes = {}
-    if args.f_stop is not None:
-        camera_changes["f_number"] = args.f_stop
-    if args.focal_length is not None:
-        camera_changes["focal_length_mm"] = args.focal_length
-    if args.focus_distance is not None:
-        camera_changes["focus_distance_m"] = args.focus_distance
-    if args.width is not None or args.height is not None:
-        width, height = scene.camera.resolution
-        if args.width and not args.height:  # keep the scene's aspect ratio
-            height = max(1, round(args.width * height / width))
-        elif args.height and not args.width:
-            width = max(1, round(args.height * width / height))
-        camera_changes["resolution"] = (args.width or width, args.height or height)
-    render_changes = {k: v for k, v in (("seed", args.seed), ("max_depth", args.max_depth),
-                                        ("sampler", args.sampler), ("spp", args.spp), ("clamp", args.clamp))
-                      if v is not None}
-    return dataclasses.replace(scene, camera=dataclasses.replace(scene.camera, **camera_changes),
-                               render=dataclasses.replace(scene.render, **render_changes))
+def scene_overrides(args):
+    """The command line's settings for this render, on top of the scene's own (headless and studio alike)."""
+    from lenslab.scene.overrides import SceneOverrides
+
+    return SceneOverrides(f_number=args.f_stop, focal_length_mm=args.focal_length,
+                          focus_distance_m=args.focus_distance, width=args.width, height=args.height, spp=args.spp,
+                          seed=args.seed, max_depth=args.max_depth, sampler=args.sampler, clamp=args.clamp,
+                          defines=parse_defines(args.defines))
 
 
-def image_metadata(scene, spp: int) -> dict[str, object]:
-    """Camera settings under Exif's names where it has one, LensLab's own otherwise."""
-    cam = scene.camera
-    sensor_w, sensor_h = cam.sensor_mm
-    width, height = cam.resolution
-    crop_factor = (36.0**2 + 24.0**2) ** 0.5 / (sensor_w**2 + sensor_h**2) ** 0.5
-    return {
-        "Software": f"LensLab {__version__}",
-        "Exif:FNumber": float(cam.f_number),
-        "Exif:FocalLength": float(cam.focal_length_mm),
-        "Exif:FocalLengthIn35mmFilm": int(round(cam.focal_length_mm * crop_factor)),
-        "Exif:SubjectDistance": float(cam.focus_distance_m),
-        # Sensor size in Exif's terms: pixels per centimetre of focal plane.
-        "Exif:FocalPlaneXResolution": float(width / (sensor_w / 10.0)),
-        "Exif:FocalPlaneYResolution": float(width / (sensor_w / 10.0)),
-        "Exif:FocalPlaneResolutionUnit": 3,
-        "lenslab:SensorWidthMM": float(sensor_w),
-        "lenslab:SensorHeightMM": float(sensor_h),
-        # The picture spans the sensor's width; its height follows the image's shape (square pixels).
-        "lenslab:ImageHeightMM": float(sensor_w * height / width),
-        "lenslab:FocusDistanceM": float(cam.focus_distance_m),
-        "lenslab:ApertureBlades": int(cam.aperture_blades),
-        "lenslab:SamplesPerPixel": int(spp),
-        "lenslab:Seed": int(scene.render.seed),
-        "lenslab:MaxDepth": int(scene.render.max_depth),
-        "lenslab:Sampler": scene.render.sampler,
-        "lenslab:Clamp": float(scene.render.clamp),
-    }
-
-
-def _progress_display(total_spp: int | None, time_limit: float | None):
+def _progress_display():
     """A rich progress bar on a terminal; nothing when stderr is a file or pipe."""
     from rich.console import Console
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
@@ -226,25 +192,26 @@ def _loading_status(console, text: str):
 
 
 def render_headless(args) -> int:
-    from lenslab.render.film import write_image
-    from lenslab.render.tracer import Renderer, RenderSession
-    from lenslab.scene.io.loader import open_scene
+    from lenslab.render.job import RenderJob
+    from lenslab.render.tracer import Renderer
     from lenslab.scene.scene import SceneError
 
     output = _check_output(args.output)
     if args.exposure and output.suffix.lower() == ".exr":
         _warn("--exposure applies to PNG only: an EXR keeps the linear radiance")
+    overrides = scene_overrides(args)
     console = _terminal_console()
     loading_start = time.perf_counter()
     with _loading_status(console, f"loading {args.scene}"):
-        scene = _apply_overrides(open_scene(args.scene, defines=parse_defines(args.defines), warn=_warn), args)
-    target_spp = args.spp if args.spp is not None else (None if args.time_limit else scene.render.spp)
+        scene = overrides.open(args.scene, warn=_warn)
     renderer = Renderer(args.device)
     try:
         with _loading_status(console, "building the kd-tree and compiling the kernel"):
-            session = RenderSession(renderer, scene, dispatch_seconds=HEADLESS_DISPATCH_SECONDS)
+            job = RenderJob(renderer, scene, spp=args.spp, time_limit=args.time_limit,
+                            dispatch_seconds=HEADLESS_DISPATCH_SECONDS)
     except (SceneError, ValueError) as exc:  # found only when the scene is packed for the GPU: name its file
         raise SceneError(f"{scene.source_path or args.scene}: {exc}") from None
+    session = job.session
     if console is not None:
         flat, tree = session.flat_scene, session.kdtree
         console.print(f"{flat.triangle_count:,} triangles, {flat.sphere_count:,} spheres; kd-tree of {len(tree.nodes):,} "
@@ -252,27 +219,22 @@ def render_headless(args) -> int:
                       f"{time.perf_counter() - loading_start:.1f} s", highlight=False)
     for warning in session.warnings:
         _warn(warning)
-    start = time.perf_counter()
-    deadline = start + args.time_limit if args.time_limit else None
-    with _progress_display(target_spp, args.time_limit) as bar:
-        task = bar.add_task("render", total=target_spp or args.time_limit, status="")
-        while True:
-            remaining = deadline - time.perf_counter() if deadline else 0.5
-            if remaining <= 0 or (target_spp and session.done(target_spp)):
-                break
-            progress = session.step(min(0.5, remaining), target_spp)
-            done = progress.samples_per_pixel if target_spp else time.perf_counter() - start
-            bar.update(task, completed=done,
-                       status=f"{progress.samples_per_pixel} spp, {progress.samples_per_second / 1e6:.2f} M samples/s")
-    spp = session.samples_per_pixel
-    if spp == 0:  # a time limit shorter than one pass: keep what every pixel has
-        session.step(0.0, 1)
-        spp = session.samples_per_pixel
-    image = session.image()
-    write_image(output, image, image_metadata(scene, spp), exposure_stops=args.exposure, tone_map_operator=args.tone_map)
-    seconds = time.perf_counter() - start
-    print(f"wrote {output} ({session.width}x{session.height}, {spp} spp, {seconds:.1f} s)", file=sys.stderr)
-    session.release()
+    with _progress_display() as bar:
+        task = bar.add_task("render", total=job.target_spp or job.time_limit, status="")
+
+        def show(progress) -> None:
+            done = progress.samples_per_pixel if job.target_spp else min(progress.elapsed_seconds, job.time_limit)
+            bar.update(task, completed=done, status=f"{progress.samples_per_pixel} spp, "
+                                                    f"{progress.samples_per_second / 1e6:.2f} M samples/s")
+
+        job.run(on_progress=show)
+    if job.overran_time_limit > 0:
+        _warn(f"the time limit ended before every pixel had a sample: the first pass was finished "
+              f"{job.overran_time_limit:.1f} s later")
+    job.write(output, exposure_stops=args.exposure, tone_map=args.tone_map)
+    print(f"wrote {output} ({session.width}x{session.height}, {job.samples_per_pixel} spp, "
+          f"{job.elapsed_seconds:.1f} s)", file=sys.stderr)
+    job.release()
     renderer.release()
     return EXIT_OK
 
@@ -287,7 +249,7 @@ def run(argv: list[str] | None = None) -> int:
         return render_headless(args)
     from lenslab.gui.app import run_studio  # only the studio imports Qt
 
-    return run_studio(args)
+    return run_studio(args.scene, scene_overrides(args), device_index=args.device)
 
 
 class _WarningLine(logging.Handler):

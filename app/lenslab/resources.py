@@ -21,6 +21,12 @@ def resource_dir(name: str) -> Path:
     raise FileNotFoundError(f"LensLab's '{name}' folder is missing from {_PACKAGE_DIR} (broken install?)")
 
 
+def checkout_dir() -> Path | None:
+    """The top of the source checkout LensLab runs from (where docs/ and benchmarks/ are), or None when it
+    runs from an installed wheel, which ships no such folders."""
+    return _CHECKOUT_DIR if (_CHECKOUT_DIR / "pyproject.toml").is_file() else None
+
+
 def glsl_dir() -> Path:
     return resource_dir("glsl")
 

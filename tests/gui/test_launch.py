@@ -5,7 +5,6 @@ from __future__ import annotations
 import subprocess
 import sys
 import textwrap
-from types import SimpleNamespace
 
 import pytest
 
@@ -34,6 +33,7 @@ def test_run_studio_opens_the_window_on_a_scene(qtbot, monkeypatch, tmp_path, gl
     from PySide6.QtGui import QGuiApplication
     from PySide6.QtWidgets import QApplication
 
+    from lenslab import cli
     from lenslab.gui import app as studio
     from lenslab.gui import main_window
 
@@ -45,15 +45,16 @@ def test_run_studio_opens_the_window_on_a_scene(qtbot, monkeypatch, tmp_path, gl
         seen["title"] = window.windowTitle()
         seen["f"] = window.doc.scene.camera.f_number
         seen["resolution"] = window.doc.scene.camera.resolution
+        seen["render"] = window.doc.scene.render
         window.close()
 
     monkeypatch.setattr(QApplication, "exec", lambda self: (QTimer.singleShot(0, look_and_close), 0)[1] or
                         (QApplication.processEvents(), 0)[1])
     QTimer.singleShot(0, look_and_close)
-    args = SimpleNamespace(scene="cornell_box", device=None, f_stop=8.0, focal_length=None, focus_distance=None,
-                           width=48, height=None, seed=None, max_depth=None, sampler=None, spp=None)
-    assert studio.run_studio(args) == 0
+    # Through the command line, as a user starts it: the studio applies every override a headless render does.
+    assert cli.run(["cornell_box", "--f-stop", "8", "--width", "48", "--clamp", "5", "--seed", "3"]) == 0
     qtbot.waitUntil(lambda: "title" in seen, timeout=10000)
     assert seen["title"].startswith("cornell_box")
     assert seen["f"] == 8.0 and seen["resolution"] == (48, 48)
+    assert seen["render"].clamp == 5.0 and seen["render"].seed == 3
     assert QGuiApplication.desktopFileName() == studio.DESKTOP_ID

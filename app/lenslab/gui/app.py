@@ -1,15 +1,17 @@
 """Starting the studio: ``lenslab`` opens the window, ``lenslab SCENE`` opens it on a scene.
 
-``run_studio`` is called by ``lenslab.cli`` with its parsed arguments (the scene, ``--device`` and the camera
-overrides such as ``--f-stop``), builds the QApplication with LensLab's look and desktop identity, and returns the
+``run_studio`` is called by ``lenslab.cli`` with the scene, the command line's overrides (``--f-stop``,
+``--spp``, ``--clamp``, ``-D`` ...: the same :class:`~lenslab.scene.overrides.SceneOverrides` a headless render
+applies) and ``--device``, builds the QApplication with LensLab's look and desktop identity, and returns the
 exit status of the event loop.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import sys
 from pathlib import Path
+
+from lenslab.scene.overrides import SceneOverrides
 
 DESKTOP_ID = "io.github.lenslab.LensLab"
 
@@ -38,52 +40,28 @@ def create_application(argv: list[str] | None = None):
     return app
 
 
-def _camera_overrides(scene, args):
-    """Apply the command line's camera settings (--f-stop, --focal-length, --focus-distance, --width, --height)."""
-    changes = {}
-    for attr, field in (("f_stop", "f_number"), ("focal_length", "focal_length_mm"),
-                        ("focus_distance", "focus_distance_m")):
-        value = getattr(args, attr, None)
-        if value is not None:
-            changes[field] = value
-    width, height = getattr(args, "width", None), getattr(args, "height", None)
-    if width or height:
-        w, h = scene.camera.resolution
-        if width and not height:
-            height = max(1, round(width * h / w))
-        elif height and not width:
-            width = max(1, round(height * w / h))
-        changes["resolution"] = (width, height)
-    if changes:
-        scene.camera = dataclasses.replace(scene.camera, **changes)
-    render = {k: getattr(args, k, None) for k in ("seed", "max_depth", "sampler", "spp")}
-    render = {k: v for k, v in render.items() if v is not None}
-    if render:
-        scene.render = dataclasses.replace(scene.render, **render)
-    return scene
-
-
-def run_studio(args) -> int:
-    """Open the studio window; returns the process exit status."""
+def run_studio(scene_ref: str | None = None, overrides: SceneOverrides | None = None,
+               device_index: int | None = None) -> int:
+    """Open the studio window, on ``scene_ref`` with the command line's ``overrides`` if given (the same
+    :class:`SceneOverrides` a headless render applies); returns the process exit status."""
     from PySide6.QtWidgets import QMessageBox
 
     from lenslab.gui.document import Document  # noqa: F401  (imports Qt: fail here, before any window)
     from lenslab.gui.main_window import MainWindow
-    from lenslab.scene.io.loader import open_scene, resolve_scene_path
+    from lenslab.scene.io.loader import resolve_scene_path
     from lenslab.scene.scene import SceneError
 
     app = create_application()
     scene = path = None
     problem = None
-    scene_arg = getattr(args, "scene", None)
-    if scene_arg:
+    if scene_ref:
         try:
-            path = resolve_scene_path(scene_arg)
-            scene = _camera_overrides(open_scene(scene_arg), args)
-        except (SceneError, OSError) as exc:
+            path = resolve_scene_path(scene_ref)
+            scene = (overrides or SceneOverrides()).open(scene_ref)
+        except (SceneError, OSError, ValueError) as exc:
             problem = str(exc)
             scene = path = None
-    window = MainWindow(scene, Path(path) if path else None, device_index=getattr(args, "device", None))
+    window = MainWindow(scene, Path(path) if path else None, device_index=device_index)
     window.show()
     if problem:
         QMessageBox.critical(window, "Cannot open scene", problem)

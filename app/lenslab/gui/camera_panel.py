@@ -39,6 +39,7 @@ from lenslab.optics import (
     step_stop,
 )
 from lenslab.scene.camera import ThinLensCamera
+from lenslab.scene.fields import declared_range
 
 FULL_STOPS = (1.4, 2, 2.8, 4, 5.6, 8, 11, 16, 22)
 COMMON_FOCAL_LENGTHS = (14, 24, 35, 50, 85, 135, 200)
@@ -324,11 +325,12 @@ class CameraPanel(QWidget):
         # Iris.
         grid = QGridLayout()
         grid.setHorizontalSpacing(6)
-        self.blades = IntEdit(*ThinLensCamera.accepted_range("aperture_blades"))
+        self.blades = IntEdit(*declared_range(ThinLensCamera, "aperture_blades"))
         self.blades.setSpecialValueText("round")
         self.blades.setToolTip("Number of aperture blades: round (0) or 3 to 32. Shapes the bokeh.")
         self.blades.edited.connect(self._blades_edited)
-        self.rotation = NumberEdit(*ThinLensCamera.accepted_range("blade_rotation_deg"), decimals=1, step=1.0, suffix=" °")
+        self.rotation = NumberEdit(*declared_range(ThinLensCamera, "blade_rotation_deg"), decimals=1, step=1.0,
+                                   suffix=" °")
         self.rotation.setToolTip("Rotation of the blade polygon")
         self.rotation.edited.connect(lambda v, merge: self.doc.set_camera("Blade rotation", merge, blade_rotation_deg=v))
         grid.addWidget(QLabel("Blades"), 0, 0)
@@ -341,7 +343,7 @@ class CameraPanel(QWidget):
     def _focal_section(self) -> Section:
         section = Section("Focal length")
         row = QHBoxLayout()
-        self.focal = NumberEdit(*ThinLensCamera.accepted_range("focal_length_mm"), decimals=1, step=1.0, suffix=" mm")
+        self.focal = NumberEdit(*declared_range(ThinLensCamera, "focal_length_mm"), decimals=1, step=1.0, suffix=" mm")
         self.focal.setObjectName("focalLength")
         self.focal.edited.connect(lambda v, merge: self.set_focal_length(v, merge))
         self.focal_slider = QSlider(Qt.Horizontal)
@@ -374,7 +376,7 @@ class CameraPanel(QWidget):
         self.focus_slider.setRange(0, 1000)
         self.focus_slider.setFocusPolicy(Qt.StrongFocus)
         self.focus_slider.valueChanged.connect(self._focus_slid)
-        self.focus = NumberEdit(*ThinLensCamera.accepted_range("focus_distance_m"), decimals=3, step=0.01, suffix=" m")
+        self.focus = NumberEdit(*declared_range(ThinLensCamera, "focus_distance_m"), decimals=3, step=0.01, suffix=" m")
         self.focus.setObjectName("focusDistance")
         self.focus.setFixedWidth(86)
         self.focus.edited.connect(lambda v, merge: self.doc.set_camera("Focus distance", merge, focus_distance_m=v))
@@ -423,8 +425,8 @@ class CameraPanel(QWidget):
         self.sensor_combo.currentIndexChanged.connect(self._sensor_chosen)
         section.add(self.sensor_combo)
         row = QHBoxLayout()
-        self.sensor_w = NumberEdit(*ThinLensCamera.accepted_range("sensor_mm"), decimals=2, step=0.1, suffix=" mm")
-        self.sensor_h = NumberEdit(*ThinLensCamera.accepted_range("sensor_mm"), decimals=2, step=0.1, suffix=" mm")
+        self.sensor_w = NumberEdit(*declared_range(ThinLensCamera, "sensor_mm"), decimals=2, step=0.1, suffix=" mm")
+        self.sensor_h = NumberEdit(*declared_range(ThinLensCamera, "sensor_mm"), decimals=2, step=0.1, suffix=" mm")
         self.sensor_w.edited.connect(lambda v, merge: self._sensor_edited(merge))
         self.sensor_h.edited.connect(lambda v, merge: self._sensor_edited(merge))
         row.addWidget(QLabel("W"))

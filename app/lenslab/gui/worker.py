@@ -17,6 +17,7 @@ newest and signals once until the GUI has taken it, so a busy GUI never builds u
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import queue
 import threading
@@ -88,6 +89,61 @@ class ExportProgress:
     samples_per_second: float
 
 
+# -- messages from the GUI thread to the worker (through its queue) ---------------------------------------
+@dataclass(frozen=True)
+class SceneEdit:
+    scene: object  # a Scene copy
+    size: tuple[int, int]  # the viewport image, pixels
+    generation: int
+
+
+@dataclass(frozen=True)
+class CameraEdit:
+    camera: object  # a ThinLensCamera copy
+    size: tuple[int, int]
+    generation: int
+    view_changed: bool  # what the camera sees moved (not only its aperture or focus): refresh the g-buffer
+
+
+@dataclass(frozen=True)
+class SettingsEdit:
+    settings: object  # RenderSettings
+    generation: int
+
+
+@dataclass(frozen=True)
+class Pause:
+    paused: bool
+
+
+@dataclass(frozen=True)
+class TargetSpp:
+    spp: int | None  # None: render on until paused
+
+
+@dataclass(frozen=True)
+class PickRequest:
+    u: float  # [0, 1] image coordinates, (0, 0) top left
+    v: float
+    request_id: int
+
+
+@dataclass(frozen=True)
+class ExportStart:
+    request_id: int
+    request: ExportRequest
+
+
+@dataclass(frozen=True)
+class ExportCancel:
+    request_id: int
+
+
+@dataclass(frozen=True)
+class Stop:
+    pass
+
+
 def preview_size(width: int, height: int) -> tuple[int, int]:
     return max(1, math.ceil(width / PREVIEW_DIVISOR)), max(1, math.ceil(height / PREVIEW_DIVISOR))
 
@@ -143,34 +199,34 @@ class RenderWorker(QThread):
 
     # -- the GUI thread's side ---------------------------------------------------------------------------------
     def set_scene(self, scene, width: int, height: int, generation: int) -> None:
-        self._queue.put(("scene", scene, (int(width), int(height)), generation))
+        self._queue.put(SceneEdit(scene, (int(width), int(height)), generation))
 
     def set_camera(self, camera, width: int, height: int, generation: int, view_changed: bool = True) -> None:
-        self._queue.put(("camera", camera, (int(width), int(height)), generation, view_changed))
+        self._queue.put(CameraEdit(camera, (int(width), int(height)), generation, view_changed))
 
     def set_settings(self, settings, generation: int) -> None:
-        self._queue.put(("settings", settings, generation))
+        self._queue.put(SettingsEdit(settings, generation))
 
     def set_paused(self, paused: bool) -> None:
-        self._queue.put(("pause", bool(paused)))
+        self._queue.put(Pause(bool(paused)))
 
     def set_target_spp(self, spp: int | None) -> None:
-        self._queue.put(("target", spp))
+        self._queue.put(TargetSpp(spp))
 
     def request_pick(self, u: float, v: float, request_id: int) -> None:
         """Ask for the surface at (u, v) in [0, 1] image coordinates (0, 0 top left); answered by pick_ready."""
-        self._queue.put(("pick", float(u), float(v), request_id))
+        self._queue.put(PickRequest(float(u), float(v), request_id))
 
     def start_export(self, request_id: int, request: ExportRequest) -> None:
-        self._queue.put(("export", request_id, request))
+        self._queue.put(ExportStart(request_id, request))
 
     def cancel_export(self, request_id: int) -> None:
-        self._queue.put(("cancel_export", request_id))
+        self._queue.put(ExportCancel(request_id))
 
     def stop(self) -> None:
         """Ask the worker to finish; it does within one dispatch. Follow with wait()."""
         self._stop.set()
-        self._queue.put(("stop",))
+        self._queue.put(Stop())
 
     def take_frame(self) -> Frame | None:
         with self._frame_lock:
@@ -210,7 +266,7 @@ class RenderWorker(QThread):
 
     def _release(self) -> None:
         if self._export is not None:
-            self._export["session"].release()
+            self._export.job.release()
             self._export = None
         if self._session is not None:
             self._session.release()
@@ -227,46 +283,49 @@ class RenderWorker(QThread):
                 messages.append(self._queue.get_nowait())
         except queue.Empty:
             pass
-        scene_msg = camera_msg = settings_msg = None
-        for msg in messages:
-            kind = msg[0]
-            if kind == "stop":
+        # Only the latest scene, camera and settings matter: a new scene supersedes the edits before it.
+        scene_edit: SceneEdit | None = None
+        camera_edit: CameraEdit | None = None
+        settings_edit: SettingsEdit | None = None
+        for message in messages:
+            if isinstance(message, Stop):
                 self._stop.set()
                 return
-            if kind == "scene":
-                scene_msg, camera_msg, settings_msg = msg, None, None
-            elif kind == "camera":
+            if isinstance(message, SceneEdit):
+                scene_edit, camera_edit, settings_edit = message, None, None
+            elif isinstance(message, CameraEdit):
                 # Keep "the view moved" if any of the coalesced camera edits moved it.
-                moved = msg[4] or (camera_msg is not None and camera_msg[4])
-                camera_msg = msg[:4] + (moved,)
-            elif kind == "settings":
-                settings_msg = msg
-            elif kind == "pause":
-                self._paused = msg[1]
+                moved = message.view_changed or (camera_edit is not None and camera_edit.view_changed)
+                camera_edit = dataclasses.replace(message, view_changed=moved)
+            elif isinstance(message, SettingsEdit):
+                settings_edit = message
+            elif isinstance(message, Pause):
+                self._paused = message.paused
                 if not self._paused and self._phase == "done":
                     self._phase = "full"  # the target may have been raised meanwhile
-            elif kind == "target":
-                self._target_spp = msg[1]
+            elif isinstance(message, TargetSpp):
+                self._target_spp = message.spp
                 if self._phase == "done":
                     self._phase = "full"
-        if scene_msg is not None:
-            self._apply_scene(*scene_msg[1:])
-        if camera_msg is not None:
-            self._apply_camera(*camera_msg[1:])
-        if settings_msg is not None:
-            self._apply_settings(*settings_msg[1:])
-        for msg in messages:
-            if msg[0] == "pick":
-                self._pick(*msg[1:])
-            elif msg[0] == "export":
-                self._start_export(*msg[1:])
-            elif msg[0] == "cancel_export":
-                self._cancel_export(msg[1])
+        if scene_edit is not None:
+            self._apply_scene(scene_edit)
+        if camera_edit is not None:
+            self._apply_camera(camera_edit)
+        if settings_edit is not None:
+            self._apply_settings(settings_edit)
+        for message in messages:
+            if isinstance(message, PickRequest):
+                self._pick(message)
+            elif isinstance(message, ExportStart):
+                self._start_export(message)
+            elif isinstance(message, ExportCancel):
+                self._cancel_export(message.request_id)
 
     # -- applying edits ------------------------------------------------------------------------------------
-    def _apply_scene(self, scene, size, generation) -> None:
+    def _apply_scene(self, edit: SceneEdit) -> None:
         from lenslab.render.tracer import RenderSession
 
+        scene, size, generation = edit.scene, edit.size, edit.generation
         try:
             if self._session is None:
                 self._session = RenderSession(self._renderer, scene, width=size[0], height=size[1],
@@ -283,11 +342,12 @@ class RenderWorker(QThread):
         self._size = size
         self._restart(generation, view_changed=True)
 
-    def _apply_camera(self, camera, size, generation, view_changed) -> None:
+    def _apply_camera(self, edit: CameraEdit) -> None:
         if self._session is None:
             return
+        generation = edit.generation
         try:
-            self._session.set_camera(camera)
+            self._session.set_camera(edit.camera)
         except Exception as exc:
             self._camera_ok = False
             self._phase = "error"
@@ -298,15 +358,15 @@ class RenderWorker(QThread):
         if not self._scene_ok:
             self._generation = generation
             return
-        self._size = size
-        self._restart(generation, view_changed=view_changed or size != self._gbuffer_size)
+        self._size = edit.size
+        self._restart(generation, view_changed=edit.view_changed or edit.size != self._gbuffer_size)
 
-    def _apply_settings(self, settings, generation) -> None:
+    def _apply_settings(self, edit: SettingsEdit) -> None:
         if self._session is None:
             return
-        self._session.set_settings(settings)
+        self._session.set_settings(edit.settings)
         if self._scene_ok and self._camera_ok:
-            self._restart(generation, view_changed=False)
+            self._restart(edit.generation, view_changed=False)
 
     def _resize(self, width: int, height: int) -> None:
         # RenderSession keeps the scene on the GPU; a new size only needs a new accumulation buffer, which
@@ -385,107 +445,90 @@ class RenderWorker(QThread):
         if signal:
             self.frame_ready.emit()
 
-    def _gpu_scene(self):
-        session = self._session
-        return getattr(session, "gpu_scene", None) or getattr(session, "_gpu_scene", None)
-
     def _compute_gbuffer(self) -> None:
         from lenslab.render.raycast import cast_rays
 
         session = self._session
-        gpu_scene = self._gpu_scene()
-        if gpu_scene is None:
-            return
         w, h = self._size
         frame = session.camera.frame(w, h)
         origins, directions = frame.rays(frame.pixel_centres())
-        hits = cast_rays(self._renderer, gpu_scene, origins, directions)
+        hits = cast_rays(self._renderer, session.gpu_scene, origins, directions)
         prim_node = session.flat_scene.prim_node
         node_index = np.where(hits.prim >= 0, prim_node[np.maximum(hits.prim, 0)], -1).astype(np.int32)
         depth = np.where(hits.prim >= 0, hits.t * (directions @ frame.forward), np.inf).astype(np.float32)
         self._gbuffer_size = (w, h)
         self.gbuffer_ready.emit(GBuffer(node_index.reshape(h, w), depth.reshape(h, w), self._generation))
 
-    def _pick(self, u: float, v: float, request_id: int) -> None:
+    def _pick(self, request: PickRequest) -> None:
         session = self._session
         if session is None or not (self._scene_ok and self._camera_ok):
-            self.pick_ready.emit(PickResult(request_id, self._generation, False))
+            self.pick_ready.emit(PickResult(request.request_id, self._generation, False))
             return
-        pick = session.pick(u * session.width, v * session.height)
+        pick = session.pick(request.u * session.width, request.v * session.height)
         if pick is None:
-            self.pick_ready.emit(PickResult(request_id, self._generation, False))
+            self.pick_ready.emit(PickResult(request.request_id, self._generation, False))
             return
         node_index = int(session.flat_scene.prim_node[pick.prim])
-        self.pick_ready.emit(PickResult(request_id, self._generation, True, float(pick.depth),
+        self.pick_ready.emit(PickResult(request.request_id, self._generation, True, float(pick.depth),
                                         tuple(float(c) for c in pick.point), node_index))
 
     # -- export ----------------------------------------------------------------------------------------------
-    def _start_export(self, request_id: int, request: ExportRequest) -> None:
-        from lenslab.render.tracer import RenderSession
+    def _start_export(self, start: ExportStart) -> None:
+        from lenslab.render.job import RenderJob
 
         if self._export is not None:
-            self.export_failed.emit(request_id, "another export is still running")
+            self.export_failed.emit(start.request_id, "another export is still running")
             return
+        request = start.request
         try:
-            w, h = request.scene.camera.resolution
-            session = RenderSession(self._renderer, request.scene, width=w, height=h,
-                                    dispatch_seconds=self.dispatch_seconds)
+            job = RenderJob(self._renderer, request.scene, spp=request.target_spp, time_limit=request.seconds,
+                            dispatch_seconds=self.dispatch_seconds)
         except Exception as exc:
-            self.export_failed.emit(request_id, _one_line(exc))
+            self.export_failed.emit(start.request_id, _one_line(exc))
             return
-        self._export = {"id": request_id, "request": request, "session": session,
-                        "start": time.perf_counter(), "last": 0.0}
+        self._export = _Export(start.request_id, request, job)
 
     def _cancel_export(self, request_id: int) -> None:
         export = self._export
-        if export is None or export["id"] != request_id:
+        if export is None or export.request_id != request_id:
             return
-        export["session"].release()
+        export.job.release()
         self._export = None
         self.export_cancelled.emit(request_id)
 
     def _export_step(self) -> None:
-        from lenslab.cli import image_metadata
-        from lenslab.render.film import write_image
-
         export = self._export
-        request: ExportRequest = export["request"]
-        session = export["session"]
-        elapsed = time.perf_counter() - export["start"]
-        out_of_time = request.seconds is not None and elapsed >= request.seconds
-        enough = request.target_spp is not None and session.samples_per_pixel >= request.target_spp
-        if not (out_of_time or enough):
-            budget = self.dispatch_seconds
-            if request.seconds is not None:
-                budget = max(0.0, min(budget, request.seconds - elapsed))
-            progress = session.step(budget, request.target_spp)
+        job = export.job
+        if not job.finished:
+            progress = job.step(self.dispatch_seconds)
             now = time.perf_counter()
-            if now - export["last"] >= EXPORT_PROGRESS_INTERVAL:
-                export["last"] = now
-                elapsed = now - export["start"]
-                fractions = []
-                if request.target_spp:
-                    fractions.append(progress.samples_per_pixel / request.target_spp)
-                if request.seconds:
-                    fractions.append(elapsed / request.seconds)
+            if now - export.last_report >= EXPORT_PROGRESS_INTERVAL:
+                export.last_report = now
                 self.export_progress.emit(ExportProgress(
-                    export["id"], progress.samples_per_pixel, request.target_spp, elapsed, request.seconds,
-                    min(1.0, max(fractions) if fractions else 0.0), progress.samples_per_second))
+                    export.request_id, progress.samples_per_pixel, progress.target_spp, progress.elapsed_seconds,
+                    progress.time_limit, progress.fraction, progress.samples_per_second))
             return
-        # Done: every pixel gets at least one sample, then the file is written whole (or not at all).
+        # Done: the job has a sample in every pixel; the file is written whole or not at all.
         self._export = None
         try:
-            if session.samples_per_pixel == 0:
-                session.step(0.0, 1)
-            spp = session.samples_per_pixel
-            path = write_image(request.path, session.image(), image_metadata(request.scene, spp),
-                               exposure_stops=request.exposure_stops, tone_map_operator=request.tone_map)
+            path = job.write(export.request.path, exposure_stops=export.request.exposure_stops,
+                             tone_map=export.request.tone_map)
         except Exception as exc:
-            self.export_failed.emit(export["id"], _one_line(exc))
+            self.export_failed.emit(export.request_id, _one_line(exc))
         else:
-            self.export_finished.emit(export["id"], str(path))
+            self.export_finished.emit(export.request_id, str(path))
         finally:
-            session.release()
+            job.release()
+
+
+@dataclass
+class _Export:
+    """The export in progress (worker thread only)."""
+
+    request_id: int
+    request: ExportRequest
+    job: object  # lenslab.render.job.RenderJob
+    last_report: float = 0.0
 
 
 def _one_line(exc: BaseException) -> str:

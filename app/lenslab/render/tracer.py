@@ -180,6 +180,11 @@ class RenderSession:
         return max(1, min(SPLAT_MAX_LAYERS, SPLAT_LAYERS_BYTES // layer_bytes))
 
     @property
+    def gpu_scene(self) -> GpuScene:
+        """The scene's buffers on the GPU, for ray queries that share them (lenslab.render.raycast)."""
+        return self._gpu_scene
+
+    @property
     def kdtree(self):
         """The scene's kd-tree as built for the GPU (its size and build time, for progress reports)."""
         return self._gpu_scene.packed.kdtree

@@ -76,12 +76,6 @@ class ThinLensCamera:
             raise ValueError("aperture_blades must be 0 (round) or at least 3")
         self.basis()
 
-    @staticmethod
-    def accepted_range(field_name: str) -> tuple:
-        """The range a field accepts, as declared above: scene files, the command line and the studio's
-        fields all read it here."""
-        return ThinLensCamera.__dataclass_fields__[field_name].metadata["range"]
-
     def frame(self, width: int | None = None, height: int | None = None) -> "CameraFrame":
         """The camera as it makes an image of ``width`` x ``height`` pixels (default: its own resolution).
 

@@ -34,8 +34,8 @@ def _positive(text: str) -> int:
 def default_docs_dir() -> Path:
     from lenslab import resources
 
-    checkout_docs = resources._CHECKOUT_DIR / "docs"
-    return checkout_docs if checkout_docs.is_dir() else Path.cwd() / "docs"
+    checkout = resources.checkout_dir()
+    return checkout / "docs" if checkout is not None and (checkout / "docs").is_dir() else Path.cwd() / "docs"
 
 
 def build_parser() -> argparse.ArgumentParser:

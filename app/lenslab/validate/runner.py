@@ -10,15 +10,14 @@ Per scene (all images at the scene's film size, ``res`` x ``res``):
   16 x 16 block means against the reference. Mitsuba's own row is the floor that noise alone reaches;
 * **time**: wall seconds of the equal-sample render, loading and compiling included, as a user would wait.
 
-LensLab renders exactly as ``lenslab scene.xml --headless`` does: ``open_scene`` then a ``RenderSession``
-stepped until the samples are in. Mitsuba loads the same file with ``mi.load_file`` and renders with
+LensLab renders exactly as ``lenslab scene.xml --headless`` does: the same overrides and the same
+:class:`~lenslab.render.job.RenderJob`, stepped until the samples are in. Mitsuba loads the same file with ``mi.load_file`` and renders with
 ``mi.render``, in a child process of its own (:func:`render_mitsuba_file`).
 """
 
 from __future__ import annotations
 
 import concurrent.futures
-import dataclasses
 import multiprocessing
 import time
 from dataclasses import dataclass, field
@@ -71,21 +70,18 @@ def scene_path(name: str) -> Path:
 
 
 def render_lenslab(path: Path, spp: int, seed: int, res: int, renderer, warn: Callable[[str], None]) -> Render:
-    from lenslab.render.tracer import RenderSession
-    from lenslab.scene.io.loader import open_scene
+    from lenslab.render.job import RenderJob
+    from lenslab.scene.overrides import SceneOverrides
 
     start = time.perf_counter()
-    scene = open_scene(path, defines={"res": str(res), "spp": str(spp)}, warn=warn)
-    scene = dataclasses.replace(scene, render=dataclasses.replace(scene.render, spp=spp, seed=seed))
-    session = RenderSession(renderer, scene, dispatch_seconds=LENSLAB_DISPATCH_SECONDS)
-    for message in session.warnings:
+    scene = SceneOverrides(spp=spp, seed=seed, defines={"res": str(res), "spp": str(spp)}).open(path, warn=warn)
+    job = RenderJob(renderer, scene, spp=spp, dispatch_seconds=LENSLAB_DISPATCH_SECONDS)
+    for message in job.session.warnings:
         warn(message)
     try:
-        while not session.done(spp):
-            session.step(0.5, spp)
-        image = session.image()
+        image = job.run()
     finally:
-        session.release()
+        job.release()
     return Render(image, spp, time.perf_counter() - start)
 
 
