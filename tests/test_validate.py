@@ -129,11 +129,14 @@ def test_validate_command_prints_the_table_and_writes_docs(mitsuba, tmp_path, ca
 
     status = main(["--scenes", "point_sun,bokeh", "--spp", "2", "--reference-spp", "8", "--bias-spp", "2",
                    "--resolution", "32", "--write-docs", "--docs-dir", str(tmp_path)])
-    assert status in (0, 1)  # at 2 spp the goal may well be missed: the figures are what is checked
     out = capsys.readouterr().out
     lines = out.splitlines()
     assert lines[0].split()[:2] == ["scene", "size"]
     assert lines[2].startswith("point_sun") and lines[3].startswith("bokeh") and "32x32" in lines[2]
+    # At 2 spp a goal may well be missed; whatever the table says, the exit status says the same.
+    verdicts = [lines[2].split()[-1], lines[3].split()[-1]]
+    assert set(verdicts) <= {"met", "MISSED"}
+    assert status == (0 if verdicts == ["met", "met"] else 1)
     doc = (tmp_path / "validation.md").read_text()
     assert "| point_sun | 32x32 |" in doc and "Machine: CPU:" in doc
     for name in ("point_sun", "bokeh"):
