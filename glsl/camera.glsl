@@ -1,4 +1,5 @@
-// The thin-lens camera (DESIGN.md, "Camera conventions").
+// The thin-lens camera (docs/architecture.md, "The camera"). Mirrors the host's
+// CameraFrame.rays (app/lenslab/scene/camera.py); glsl/camera_probe.comp and tests/test_camera_rays.py compare them.
 //
 // The camera looks down its local -Z. A pinhole ray through the image point (x, y) has the direction
 // (x tan(fov_x/2), y tan(fov_y/2), -1), so it meets the plane of focus z = -focus_distance at that direction

@@ -1,7 +1,8 @@
 // Warping uniform random numbers onto the shapes we integrate over. Each function's pdf is stated beside it.
 
 // Shirley-Chiu concentric mapping of [0,1)^2 onto the unit disk: area-preserving, low distortion, so a
-// stratified (Sobol) pattern stays stratified on the lens. pdf = 1 / pi per unit area.
+// stratified (Sobol) pattern stays stratified on the lens. pdf = 1 / pi per unit area. This and
+// sample_polygon have numpy twins in app/lenslab/optics/aperture.py (the camera's rays on the host).
 vec2 sample_concentric_disk(vec2 u) {
     vec2 o = 2.0 * u - 1.0;
     if (o.x == 0.0 && o.y == 0.0) return vec2(0.0);

@@ -87,7 +87,7 @@ def test_lens_radius_rejects_zero_f_number():
         lens_radius_m(50, 0)
 
 
-# --- defocus blur (DESIGN.md: c = (f/N) |d - s| / d * f / s) --------------------------------
+# --- defocus blur (docs/architecture.md: c = (f/N) |d - s| / d * f / s) ------------------
 
 def test_blur_of_point_at_half_the_focus_distance():
     # 50 mm f/2 focused at 2 m, point at 1 m: A = 25 mm, |d - s| / d = 1,

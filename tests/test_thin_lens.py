@@ -1,4 +1,4 @@
-"""The thin-lens camera against the conventions in DESIGN.md, measured on rendered images.
+"""The thin-lens camera against the conventions in docs/architecture.md, measured on rendered images.
 
 A point at depth d, with focus at s, blurs to a disk of diameter (f/N) |d - s| / d * f / s on the sensor.
 We render a tiny emitting sphere and measure its disk from the image's second moment: a uniform disk of

@@ -14,7 +14,7 @@ Two models, which differ only in where the sensor sits (see :mod:`.thinlens`):
     These are the exact solutions of ``textbook_blur_diameter_mm(..., d) == c``.
 
 ``model="planar"``
-    What the renderer actually draws (DESIGN.md: sensor fixed at ``f``, planar
+    What the renderer actually draws (docs/architecture.md, "The camera": sensor fixed at ``f``, planar
     focus).  Solving ``blur_diameter_mm(..., d) == c`` gives::
 
         H0   = f^2 / (N c)

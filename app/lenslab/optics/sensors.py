@@ -81,7 +81,7 @@ class SensorPreset:
         return circle_of_confusion_mm(self.width_mm, self.height_mm)
 
 
-#: Name of the default sensor in the shipped list (DESIGN.md: full frame 36 x 24 mm).
+#: Name of the default sensor in the shipped list (docs/architecture.md, "The camera": full frame 36 x 24 mm).
 DEFAULT_SENSOR_NAME = "Full frame"
 
 #: The default sensor, available without reading any file.

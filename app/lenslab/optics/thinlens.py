@@ -1,7 +1,7 @@
 """Thin-lens camera geometry: field of view, aperture and defocus blur.
 
-This module is the numeric twin of the renderer's camera (DESIGN.md, "Camera
-conventions"); if the shader and these formulas ever disagree, one of them is wrong.
+This module is the numeric twin of the renderer's camera (docs/architecture.md, "The
+camera"); if the shader and these formulas ever disagree, one of them is wrong.
 
 The model, in the form used by pbrt-v4 (``PerspectiveCamera``) and Mitsuba 3
 (``thinlens``):
@@ -57,7 +57,7 @@ def require_positive(name: str, value: float) -> float:
 def field_of_view_x(focal_length_mm: float, sensor_width_mm: float) -> float:
     """Horizontal field of view in radians: ``2 atan(w / (2 f))``.
 
-    Pinhole focused at infinity (DESIGN.md); the same angle pbrt and Mitsuba
+    Pinhole focused at infinity (docs/architecture.md); the same angle pbrt and Mitsuba
     derive from a 35 mm-equivalent focal length.  Example: 50 mm on a 36 mm
     wide sensor gives 39.6 degrees.
     """
@@ -108,7 +108,7 @@ def f_number_for_lens_radius(focal_length_mm: float, lens_radius: float) -> floa
 def blur_diameter_mm(focal_length_mm, f_number, focus_distance_m, depth_m):
     """Diameter on the sensor (mm) of the blur disk of a point at ``depth_m``.
 
-    ``c = (f / N) * |d - s| / d * f / s``   (DESIGN.md, planar focus, sensor at f)
+    ``c = (f / N) * |d - s| / d * f / s``   (docs/architecture.md: planar focus, sensor at f)
 
     Derivation, by similar triangles: the rays from a pupil of diameter
     ``A = f/N`` that converge on a point at depth ``d`` cut the plane of focus
