@@ -4,16 +4,11 @@
 // local shading frame (normal = +Z), which surface_at() has already turned towards wo: reflecting
 // materials are two-sided without the user having to say so, and dielectrics know from front_face
 // whether the ray is entering or leaving.
+//
+// A material is MATERIAL_ROWS vec4 rows (render/buffers.py's pack_material); its type, one of the MATERIAL_*
+// codes, is in row 0, w. Both come from render/gpu_layout.py as #defines.
 
-const int MATERIAL_DIFFUSE = 0;
-const int MATERIAL_EMISSIVE = 1;
-const int MATERIAL_CONDUCTOR = 2;
-const int MATERIAL_PLASTIC = 3;
-const int MATERIAL_DIELECTRIC = 4;
-const int MATERIAL_THIN_DIELECTRIC = 5;
-const int MATERIAL_STRIDE = 8;  // vec4 rows per material; see render/buffers.py
-
-vec4 material_row(int m, int row) { return materials[MATERIAL_STRIDE * m + row]; }
+vec4 material_row(int m, int row) { return materials[MATERIAL_ROWS * m + row]; }
 int material_type(int m) { return int(material_row(m, 0).w); }
 bool material_scatters(int m) { return material_type(m) != MATERIAL_EMISSIVE; }
 
@@ -38,7 +33,7 @@ struct Bsdf {
     vec3 eta3;    // conductors: complex index
     vec3 k;
     float internal_reflectance;  // plastic: diffuse Fresnel reflectance inside the coating
-    int reflectance_table;       // rough plastic: the coating's directional reflectance, 64 entries in image_data
+    int reflectance_table;       // rough plastic: the coating's reflectance, ROUGH_TABLE_SIZE entries in image_data
     mat3 frame;   // local shading frame: columns tangent, bitangent, normal
 };
 
@@ -82,8 +77,8 @@ vec3 to_world(Bsdf b, vec3 w) { return b.frame * w; }
 // directional reflectance of the rough interface otherwise (as Mitsuba's roughplastic).
 float plastic_transmittance(Bsdf b, float cos_theta) {
     if (b.alpha == 0.0) return 1.0 - fresnel_dielectric(cos_theta, b.eta);
-    float x = clamp(cos_theta, 0.0, 1.0) * 63.0;
-    int i = min(int(x), 62);
+    float x = clamp(cos_theta, 0.0, 1.0) * float(ROUGH_TABLE_SIZE - 1);
+    int i = min(int(x), ROUGH_TABLE_SIZE - 2);
     uint at = uint(b.reflectance_table + i);
     float r = mix(uintBitsToFloat(image_data[at]), uintBitsToFloat(image_data[at + 1u]), x - float(i));
     return 1.0 - r;

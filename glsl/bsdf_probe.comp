@@ -2,7 +2,7 @@
 // Calls the BSDF code directly, for tests: at a surface with normal +Z, for each item either sample a
 // direction (mode 0) or evaluate a given one (mode 1). Not used while rendering.
 
-layout(local_size_x = 64) in;
+layout(local_size_x = LOCAL_SIZE_X) in;
 
 #include "common.glsl"
 #include "sampling.glsl"
@@ -12,9 +12,9 @@ layout(local_size_x = 64) in;
 #include "bsdf.glsl"
 
 // In, two vec4 per item: (wo, front face), (u0, u1, u2, mode) in sample mode or (wi, mode) in eval mode.
-layout(std430, binding = 6) readonly buffer ProbeIn { vec4 probe_in[]; };
+layout(std430, binding = PROBE_IN_BINDING) readonly buffer ProbeIn { vec4 probe_in[]; };
 // Out, two vec4 per item: (wi, pdf), (weight or f|cos|, delta or success).
-layout(std430, binding = 8) writeonly buffer ProbeOut { vec4 probe_out[]; };
+layout(std430, binding = PROBE_OUT_BINDING) writeonly buffer ProbeOut { vec4 probe_out[]; };
 
 uniform int item_count;
 uniform int probe_material;

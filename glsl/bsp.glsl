@@ -44,7 +44,7 @@ bool trace_bsp(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
         // Down to a leaf, in a loop of its own ("while-while", Aila and Laine 2009): lanes in lockstep then
         // descend together instead of each interior step also paying for the leaf code below.
         uvec2 n = kd_nodes[node];
-        while ((n.y & 3u) != 3u) {
+        while ((n.y & 3u) != uint(KD_LEAF)) {  // the low two bits: the split axis, or KD_LEAF
             uint axis = n.y & 3u;
             float split = uintBitsToFloat(n.x);
             float t_plane = (split - ray.o[axis]) * inv_dir[axis];

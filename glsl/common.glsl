@@ -1,5 +1,7 @@
 // Shared declarations: constants, the scene's storage buffers and the uniforms every kernel reads.
-// Buffer layouts are written by app/lenslab/render/buffers.py; keep the two in step.
+// The buffers are packed by app/lenslab/render/buffers.py. Their record sizes, type codes and binding points
+// (MATERIAL_ROWS, GEOMETRY_ROWS, LIGHT_AREA, KD_NODES_BINDING ...) are not typed here: the host passes
+// each as a #define from app/lenslab/render/gpu_layout.py to every shader it compiles.
 
 #include "features.glsl"
 
@@ -10,22 +12,22 @@ const int NO_HIT = -1;
 const float ONE_MINUS_EPSILON = 0.99999994;  // the largest float below 1
 
 // kd-tree nodes (see bsp.py): interior x = split (float bits), y = (above child << 2) | axis;
-// leaf x = first reference, y = (count << 2) | 3. The below child of node i is node i + 1.
-layout(std430, binding = 0) readonly buffer KdNodes { uvec2 kd_nodes[]; };
-layout(std430, binding = 1) readonly buffer PrimRefs { int prim_refs[]; };
-// Three vec4 per primitive. Triangle: (v0, -), (e1, material), (e2, light).
+// leaf x = first reference, y = (count << 2) | KD_LEAF. The below child of node i is node i + 1.
+layout(std430, binding = KD_NODES_BINDING) readonly buffer KdNodes { uvec2 kd_nodes[]; };
+layout(std430, binding = PRIM_REFS_BINDING) readonly buffer PrimRefs { int prim_refs[]; };
+// GEOMETRY_ROWS (three) vec4 per primitive. Triangle: (v0, -), (e1, material), (e2, light).
 // Sphere: (centre, radius), (-, material), (-, light). Material and light (the primitive's row in the light
 // table, -1 if it emits nothing) are ints stored as float bits.
-layout(std430, binding = 2) readonly buffer Geometry { vec4 geometry[]; };
-// Four vec4 per triangle (spheres have none): (n0, u0), (n1, v0), (n2, u1), (v1, u2, v2, -).
-layout(std430, binding = 3) readonly buffer Shading { vec4 shading[]; };
-// Eight vec4 per material (see bsdf.glsl), then four per texture from row texture_base (textures.glsl).
-layout(std430, binding = 4) readonly buffer Materials { vec4 materials[]; };
-// Three vec4 per light (see lights.glsl).
-layout(std430, binding = 5) readonly buffer Lights { vec4 lights[]; };
+layout(std430, binding = GEOMETRY_BINDING) readonly buffer Geometry { vec4 geometry[]; };
+// SHADING_ROWS (four) vec4 per triangle (spheres have none): (n0, u0), (n1, v0), (n2, u1), (v1, u2, v2, -).
+layout(std430, binding = SHADING_BINDING) readonly buffer Shading { vec4 shading[]; };
+// MATERIAL_ROWS vec4 per material (see bsdf.glsl), then TEXTURE_ROWS per texture from row texture_base
+// (textures.glsl).
+layout(std430, binding = MATERIALS_BINDING) readonly buffer Materials { vec4 materials[]; };
+// LIGHT_ROWS vec4 per light (see lights.glsl).
+layout(std430, binding = LIGHTS_BINDING) readonly buffer Lights { vec4 lights[]; };
 
 uniform int triangle_count;
-uniform int prim_count;
 uniform vec3 scene_min;
 uniform vec3 scene_max;
 
@@ -43,8 +45,8 @@ struct Hit {
     vec2 uv;  // barycentrics (b1, b2) on triangles
 };
 
-int material_of(int prim) { return floatBitsToInt(geometry[3 * prim + 1].w); }
-int light_of(int prim) { return floatBitsToInt(geometry[3 * prim + 2].w); }
+int material_of(int prim) { return floatBitsToInt(geometry[GEOMETRY_ROWS * prim + 1].w); }
+int light_of(int prim) { return floatBitsToInt(geometry[GEOMETRY_ROWS * prim + 2].w); }
 bool is_sphere(int prim) { return HAS_SPHERES != 0 && prim >= triangle_count; }
 
 float luminance(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }

@@ -35,6 +35,6 @@
 #define MATERIAL_TYPES 0xFFFF
 #endif
 
-// Whether material type `code` (bsdf.glsl's MATERIAL_* codes) can occur: a constant, so the compiler drops
-// the code of every type the scene does not use.
+// Whether material type `code` (one of render/gpu_layout.py's MATERIAL_* codes) can occur: a constant, so
+// the compiler drops the code of every type the scene does not use.
 #define HAS_MATERIAL(code) (((MATERIAL_TYPES) >> (code) & 1) != 0)

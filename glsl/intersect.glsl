@@ -2,9 +2,9 @@
 
 // Moller-Trumbore on the stored (v0, e1, e2) form; also returns the barycentrics (b1, b2).
 float intersect_triangle(Ray ray, int prim, float t_min, float t_max, out vec2 bary) {
-    vec3 v0 = geometry[3 * prim].xyz;
-    vec3 e1 = geometry[3 * prim + 1].xyz;
-    vec3 e2 = geometry[3 * prim + 2].xyz;
+    vec3 v0 = geometry[GEOMETRY_ROWS * prim].xyz;
+    vec3 e1 = geometry[GEOMETRY_ROWS * prim + 1].xyz;
+    vec3 e2 = geometry[GEOMETRY_ROWS * prim + 2].xyz;
     vec3 p = cross(ray.d, e2);
     float det = dot(e1, p);
     if (det == 0.0) return INFINITY;
@@ -24,7 +24,7 @@ float intersect_triangle(Ray ray, int prim, float t_min, float t_max, out vec2 b
 // Analytic sphere. The discriminant is computed as r^2 - |f - (f.d)d|^2 rather than b^2 - c, which keeps
 // its precision for small spheres far away (Haines et al., Ray Tracing Gems ch. 7).
 float intersect_sphere(Ray ray, int prim, float t_min, float t_max) {
-    vec4 sphere = geometry[3 * prim];
+    vec4 sphere = geometry[GEOMETRY_ROWS * prim];
     vec3 f = ray.o - sphere.xyz;
     float a = dot(ray.d, ray.d);
     float b = -dot(f, ray.d);

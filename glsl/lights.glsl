@@ -2,16 +2,11 @@
 // Every pdf here is with respect to solid angle at the shading point and includes the probability of
 // choosing the light, so that MIS against BSDF sampling compares like with like.
 //
-// The light table (render/buffers.py) holds three vec4 per light:
+// The light table (render/buffers.py) holds LIGHT_ROWS (three) vec4 per light:
 //   (type, primitive index as float bits, cumulative power share, power share), (position | direction, -),
-//   (rgb, -).
+//   (rgb, -). The type is one of LIGHT_AREA, LIGHT_POINT, LIGHT_SUN, LIGHT_ENVIRONMENT (render/gpu_layout.py).
 
-const int LIGHT_AREA = 0;
-const int LIGHT_POINT = 1;
-const int LIGHT_SUN = 2;
-const int LIGHT_ENVIRONMENT = 3;
-
-uniform int env_type;           // 0: constant (env_radiance), 1: lat-long map
+uniform int env_type;           // ENV_CONSTANT (env_radiance) or ENV_MAP (a lat-long map)
 uniform float env_strength;
 uniform int env_texture;        // the map's texture record
 uniform float env_rotation;     // radians about +Y
@@ -50,9 +45,8 @@ bool choosing_at_point() {
 }
 
 // What the choice reads, in a uniform block (render/buffers.py's light_choice array): every lane reads the
-// same light at the same time, which uniform blocks serve best.
-const int LIGHT_PLACES = 32;  // buffers.py's
-layout(std140, binding = 0) uniform LightPlaces {
+// same light at the same time, which uniform blocks serve best. It holds LIGHT_PLACES lights.
+layout(std140, binding = LIGHT_CHOICE_BINDING) uniform LightPlaces {
     vec4 light_place[LIGHT_PLACES];     // (centre, reach^2); reach^2 < 0: at infinity
     vec4 light_scale[LIGHT_PLACES / 4]; // power share x falloff, four lights to a vec4
 };
@@ -70,7 +64,7 @@ float light_weight_at(int i, vec3 p) {
 float light_choice_pmf(int i, vec3 p, float weights) {
     if (i < 0) return 0.0;
     if (choosing_at_point()) return weights > 0.0 ? light_weight_at(i, p) / weights : 0.0;
-    return lights[3 * i].w;
+    return lights[LIGHT_ROWS * i].w;
 }
 
 // The light whose cumulative power share first exceeds u (binary search over the table).
@@ -78,7 +72,7 @@ int pick_light(float u) {
     int lo = 0, hi = light_count - 1;
     while (lo < hi) {
         int mid = (lo + hi) / 2;
-        if (lights[3 * mid].z <= u) lo = mid + 1; else hi = mid;
+        if (lights[LIGHT_ROWS * mid].z <= u) lo = mid + 1; else hi = mid;
     }
     return lo;
 }
@@ -131,7 +125,7 @@ float sphere_cone_one_minus_cos(float r, float d) {
 }
 
 float triangle_area(int prim) {
-    return 0.5 * length(cross(geometry[3 * prim + 1].xyz, geometry[3 * prim + 2].xyz));
+    return 0.5 * length(cross(geometry[GEOMETRY_ROWS * prim + 1].xyz, geometry[GEOMETRY_ROWS * prim + 2].xyz));
 }
 
 // Density (solid angle) of reaching point q with normal nq on emissive prim from p, where `pmf` is the
@@ -141,7 +135,7 @@ float area_light_pdf(int prim, vec3 p, vec3 q, vec3 nq, float pmf) {
     vec3 to_q = q - p;
     float dist2 = dot(to_q, to_q);
     if (is_sphere(prim)) {
-        vec4 sphere = geometry[3 * prim];
+        vec4 sphere = geometry[GEOMETRY_ROWS * prim];
         float dc = distance(p, sphere.xyz);
         if (dc > sphere.w * 1.0001) return pmf / (2.0 * PI * sphere_cone_one_minus_cos(sphere.w, dc));
         float cos_l = abs(dot(nq, to_q)) / sqrt(dist2);
@@ -167,7 +161,7 @@ vec3 environment_direction(vec2 uv) {
 float env_table(int i) { return uintBitsToFloat(image_data[env_dist_offset + i]); }
 
 vec3 environment_radiance(vec3 dir) {
-    if (HAS_ENVIRONMENT_MAP == 0 || env_type == 0) return env_radiance;
+    if (HAS_ENVIRONMENT_MAP == 0 || env_type == ENV_CONSTANT) return env_radiance;
     vec2 uv = environment_uv(dir);
     float h = float(env_size.y);
     if (env_rows_pole_to_pole != 0) {
@@ -183,7 +177,7 @@ vec3 environment_radiance(vec3 dir) {
 // Density (solid angle) of sampling dir from the environment, chosen with probability `pmf`.
 float environment_pdf(vec3 dir, float pmf) {
     if (pmf <= 0.0) return 0.0;
-    if (HAS_ENVIRONMENT_MAP == 0 || env_type == 0) return pmf * (0.25 * INV_PI);
+    if (HAS_ENVIRONMENT_MAP == 0 || env_type == ENV_CONSTANT) return pmf * (0.25 * INV_PI);
     vec2 uv = environment_uv(dir);
     float sin_theta = sin(uv.y * PI);
     if (sin_theta <= 0.0) return 0.0;
@@ -204,7 +198,7 @@ int search_cdf(int first, int count, float u) {
 }
 
 vec3 sample_environment_direction(vec2 u) {
-    if (HAS_ENVIRONMENT_MAP == 0 || env_type == 0) return sample_uniform_sphere(u);
+    if (HAS_ENVIRONMENT_MAP == 0 || env_type == ENV_CONSTANT) return sample_uniform_sphere(u);
     int w = env_table_size.x, h = env_table_size.y;
     int row = search_cdf(0, h, u.y);
     float r0 = env_table(row), r1 = env_table(row + 1);
@@ -230,7 +224,7 @@ bool sample_area_light(int prim, vec3 p, vec2 u, float pmf, out LightSample ls) 
     ls.delta = false;  // `out` starts undefined: every field must be written
     vec3 q, nq;
     if (is_sphere(prim)) {
-        vec4 sphere = geometry[3 * prim];
+        vec4 sphere = geometry[GEOMETRY_ROWS * prim];
         vec3 axis = sphere.xyz - p;
         float dc = length(axis);
         if (dc > sphere.w * 1.0001) {  // outside: sample the cone of directions the sphere subtends
@@ -245,8 +239,8 @@ bool sample_area_light(int prim, vec3 p, vec2 u, float pmf, out LightSample ls) 
         nq = normalize(q - sphere.xyz);
     } else {
         vec2 b = sample_triangle(u);
-        vec3 e1 = geometry[3 * prim + 1].xyz, e2 = geometry[3 * prim + 2].xyz;
-        q = geometry[3 * prim].xyz + b.x * e1 + b.y * e2;
+        vec3 e1 = geometry[GEOMETRY_ROWS * prim + 1].xyz, e2 = geometry[GEOMETRY_ROWS * prim + 2].xyz;
+        q = geometry[GEOMETRY_ROWS * prim].xyz + b.x * e1 + b.y * e2;
         nq = normalize(cross(e1, e2));
     }
     vec3 to_q = q - p;
@@ -265,7 +259,7 @@ bool sample_light(vec3 p, LightChoice choice, vec2 u, out LightSample ls) {
     float pmf = choice.pmf;
     if (pmf <= 0.0) return false;
     int i = choice.light;
-    vec4 l0 = lights[3 * i], l1 = lights[3 * i + 1], l2 = lights[3 * i + 2];
+    vec4 l0 = lights[LIGHT_ROWS * i], l1 = lights[LIGHT_ROWS * i + 1], l2 = lights[LIGHT_ROWS * i + 2];
     int type = int(l0.x);
     if (HAS_AREA_LIGHTS != 0 && type == LIGHT_AREA) return sample_area_light(floatBitsToInt(l0.y), p, u, pmf, ls);
     if (HAS_POINT_LIGHTS != 0 && type == LIGHT_POINT) {

@@ -9,8 +9,8 @@ layout(local_size_x = LOCAL_SIZE_X) in;
 #include "bsp.glsl"
 
 // In: two vec4 per ray, (origin, t_min), (direction, t_max). Out: (t, primitive as float bits, b1, b2).
-layout(std430, binding = 6) readonly buffer Rays { vec4 rays[]; };
-layout(std430, binding = 7) writeonly buffer Hits { vec4 hits[]; };
+layout(std430, binding = RAYS_BINDING) readonly buffer Rays { vec4 rays[]; };
+layout(std430, binding = HITS_BINDING) writeonly buffer Hits { vec4 hits[]; };
 
 uniform int ray_count;
 

@@ -18,8 +18,8 @@
 
 layout(local_size_x = LOCAL_SIZE_X) in;
 
-layout(std430, binding = 6) readonly buffer Samples { vec4 samples[]; };  // trace.comp's slots
-layout(std430, binding = 0) buffer Accumulation { vec4 accumulation[]; };
+layout(std430, binding = ACCUMULATION_BINDING) readonly buffer Samples { vec4 samples[]; };  // trace.comp's slots
+layout(std430, binding = SPLAT_IMAGE_BINDING) buffer Accumulation { vec4 accumulation[]; };
 
 uniform ivec2 image_size;
 uniform int tile_start;  // first pixel (row-major index) of this dispatch

@@ -18,20 +18,20 @@ SurfaceHit surface_at(Ray ray, Hit hit) {
     s.wo = -ray.d;
     s.uv = vec2(0.0);
     if (is_sphere(hit.prim)) {
-        vec4 sphere = geometry[3 * hit.prim];
+        vec4 sphere = geometry[GEOMETRY_ROWS * hit.prim];
         vec3 n = normalize(ray.o + hit.t * ray.d - sphere.xyz);
         s.p = sphere.xyz + sphere.w * n;  // re-project onto the surface: less error than o + t d
         s.ng = n;
         s.ns = n;
         s.uv = vec2(atan(n.z, n.x) * (0.5 * INV_PI) + 0.5, acos(clamp(n.y, -1.0, 1.0)) * INV_PI);
     } else {
-        int i = 3 * hit.prim;
+        int i = GEOMETRY_ROWS * hit.prim;
         vec3 e1 = geometry[i + 1].xyz;
         vec3 e2 = geometry[i + 2].xyz;
         float b1 = hit.uv.x, b2 = hit.uv.y, b0 = 1.0 - b1 - b2;
         s.p = geometry[i].xyz + b1 * e1 + b2 * e2;
         s.ng = normalize(cross(e1, e2));
-        int j = 4 * hit.prim;
+        int j = SHADING_ROWS * hit.prim;
         vec4 s0 = shading[j], s1 = shading[j + 1], s2 = shading[j + 2], s3 = shading[j + 3];
         vec3 n = b0 * s0.xyz + b1 * s1.xyz + b2 * s2.xyz;
         s.ns = dot(n, n) > 0.0 ? normalize(n) : s.ng;

@@ -1,16 +1,12 @@
-// Texture lookups by surface (u, v). Records (four vec4 each, from render/textures.py) follow the materials
-// in the Materials buffer, starting at row texture_base: (type, first texel, width, height),
-// (tiles u, tiles v, texel format, -), colour a, colour b. Image texels are linear RGB in image_data, as
-// half floats (two uints a texel: (r, g), (b, -)) or, for values beyond the half range, as 32-bit floats
-// (three uints a texel).
+// Texture lookups by surface (u, v). Records (TEXTURE_ROWS vec4 each, from render/textures.py) follow the
+// materials in the Materials buffer, starting at row texture_base: (type, first texel, width, height),
+// (tiles u, tiles v, texel format, -), colour a, colour b. The type is TEXTURE_IMAGE or TEXTURE_CHECKER.
+// Image texels are linear RGB in image_data, as half floats (TEXELS_HALF: two uints a texel: (r, g), (b, -))
+// or, for values beyond the half range, as 32-bit floats (TEXELS_FLOAT: three uints a texel).
 
-layout(std430, binding = 7) readonly buffer ImageData { uint image_data[]; };
+layout(std430, binding = IMAGE_DATA_BINDING) readonly buffer ImageData { uint image_data[]; };
 
 uniform int texture_base;
-
-const int TEXTURE_IMAGE = 0;
-const int TEXTURE_CHECKER = 1;
-const int TEXELS_FLOAT = 1;
 
 vec3 texel(int first, int width, int height, bool full_float, int x, int y) {
     x = ((x % width) + width) % width;  // repeat
@@ -25,12 +21,12 @@ vec3 texel(int first, int width, int height, bool full_float, int x, int y) {
 }
 
 vec3 texture_rgb(int t, vec2 uv) {
-    vec4 r0 = materials[texture_base + 4 * t];
-    vec4 r1 = materials[texture_base + 4 * t + 1];
+    vec4 r0 = materials[texture_base + TEXTURE_ROWS * t];
+    vec4 r1 = materials[texture_base + TEXTURE_ROWS * t + 1];
     vec2 st = uv * r1.xy;  // tiles
     if (int(r0.x) == TEXTURE_CHECKER) {
         bool odd = (int(floor(st.x)) + int(floor(st.y))) % 2 != 0;
-        return materials[texture_base + 4 * t + (odd ? 3 : 2)].xyz;
+        return materials[texture_base + TEXTURE_ROWS * t + (odd ? 3 : 2)].xyz;
     }
     // Bilinear filtering between the four nearest texel centres; image row 0 is the top (v = 1).
     int first = floatBitsToInt(r0.y), width = int(r0.z), height = int(r0.w);

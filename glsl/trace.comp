@@ -28,7 +28,7 @@ layout(local_size_x = LOCAL_SIZE_X) in;
 // splat_pixels == 0: rgb = sum of radiance samples, a = their count (the film's accumulation).
 // splat_pixels > 0: one sample per slot, slot = (sample index - sample_start) * splat_pixels + pixel: its
 // radiance, and where in the pixel it was taken (encode_pixel_position).
-layout(std430, binding = 6) buffer Accumulation { vec4 accumulation[]; };
+layout(std430, binding = ACCUMULATION_BINDING) buffer Accumulation { vec4 accumulation[]; };
 
 uniform int tile_start;   // first pixel (row-major index) of this dispatch
 uniform int tile_pixels;

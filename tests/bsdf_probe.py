@@ -6,9 +6,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lenslab.render.buffers import MATERIAL_ROWS, pack_material
+from lenslab.render.buffers import pack_material
 from lenslab.render.gl import make_current
+from lenslab.render.gpu_layout import (IMAGE_DATA_BINDING, MATERIAL_ROWS, MATERIALS_BINDING, PROBE_IN_BINDING,
+                                       PROBE_OUT_BINDING)
 from lenslab.render.textures import TextureTable
+
+LOCAL_SIZE_X = 64
 
 
 @dataclass
@@ -30,22 +34,21 @@ class BsdfProbe:
         self.materials = ctx.buffer(np.concatenate([rows, textures.records()]).astype(np.float32).tobytes())
         texels = textures.texels()
         self.image_data = ctx.buffer(texels.tobytes() if texels.size else np.zeros(4, np.uint32).tobytes())
-        self.program = renderer.program("bsdf_probe.comp")
-        if "texture_base" in self.program:
-            self.program["texture_base"].value = MATERIAL_ROWS
+        self.program = renderer.program("bsdf_probe.comp", LOCAL_SIZE_X=LOCAL_SIZE_X)
+        self.program["texture_base"].value = MATERIAL_ROWS  # the one material's record, then its textures
 
     def _run(self, items: np.ndarray) -> np.ndarray:
         ctx, n = self.renderer.ctx, len(items)
         make_current(ctx)
         inp = ctx.buffer(items.astype(np.float32).tobytes())
         out = ctx.buffer(reserve=n * 32)
-        self.materials.bind_to_storage_buffer(4)
-        self.image_data.bind_to_storage_buffer(7)
-        inp.bind_to_storage_buffer(6)
-        out.bind_to_storage_buffer(8)
+        self.materials.bind_to_storage_buffer(MATERIALS_BINDING)
+        self.image_data.bind_to_storage_buffer(IMAGE_DATA_BINDING)
+        inp.bind_to_storage_buffer(PROBE_IN_BINDING)
+        out.bind_to_storage_buffer(PROBE_OUT_BINDING)
         self.program["item_count"].value = n
         self.program["probe_material"].value = 0
-        self.program.run((n + 63) // 64, 1, 1)
+        self.program.run((n + LOCAL_SIZE_X - 1) // LOCAL_SIZE_X, 1, 1)
         result = np.frombuffer(out.read(), np.float32).reshape(n, 2, 4).copy()
         inp.release()
         out.release()

@@ -75,8 +75,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-LEAF = 3
-"""Value of the two low bits of ``nodes[i, 1]`` that marks a leaf (axes are 0, 1 and 2)."""
+from lenslab.render.gpu_layout import KD_LEAF as LEAF  # the two low bits of nodes[i, 1] of a leaf (axes: 0-2)
 
 # Default SAH constants, in units of one traversal step.
 #

@@ -18,6 +18,12 @@ from lenslab.render.bsp import KdTree, build_kdtree
 from lenslab.render.fresnel import internal_diffuse_reflectance, rough_internal_reflectance, rough_reflectance_table
 from lenslab.render.environment import EnvironmentDistribution, environment_power, infinite_light_power
 from lenslab.render.gl import make_current
+from lenslab.render.gpu_layout import (ENV_CONSTANT, ENV_MAP, GEOMETRY_BINDING, GEOMETRY_ROWS,
+                                       IMAGE_DATA_BINDING, KD_NODES_BINDING, LIGHT_AREA, LIGHT_CHOICE_BINDING,
+                                       LIGHT_ENVIRONMENT, LIGHT_PLACES, LIGHT_POINT, LIGHT_ROWS, LIGHT_SUN,
+                                       LIGHTS_BINDING, MATERIAL_CONDUCTOR, MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE,
+                                       MATERIAL_EMISSIVE, MATERIAL_PLASTIC, MATERIAL_ROWS, MATERIAL_THIN_DIELECTRIC,
+                                       MATERIALS_BINDING, PRIM_REFS_BINDING, SHADING_BINDING, SHADING_ROWS)
 from lenslab.render.textures import TextureTable, read_texture_image
 from lenslab.scene.flatten import FlatScene
 from lenslab.scene.materials import Conductor, Diffuse, Dielectric, Emissive, Material, Plastic, ThinDielectric
@@ -25,14 +31,15 @@ from lenslab.scene.lights import Light, PointLight, SunLight
 from lenslab.scene.scene import ConstantEnvironment, Environment, EnvironmentMap
 from lenslab.scene.textures import InlineImageTexture
 
-# glsl/bsdf.glsl's material type codes and record size.
-MATERIAL_CODES = {Diffuse: 0, Emissive: 1, Conductor: 2, Plastic: 3, Dielectric: 4, ThinDielectric: 5}
-MATERIAL_ROWS = 8
+# Each material class's type code in its GPU record.
+MATERIAL_CODES = {Diffuse: MATERIAL_DIFFUSE, Emissive: MATERIAL_EMISSIVE, Conductor: MATERIAL_CONDUCTOR,
+                  Plastic: MATERIAL_PLASTIC, Dielectric: MATERIAL_DIELECTRIC, ThinDielectric: MATERIAL_THIN_DIELECTRIC}
 
-# Binding points, as declared in glsl/common.glsl, glsl/textures.glsl and glsl/trace.comp.
-BINDINGS = {"kd_nodes": 0, "prim_refs": 1, "geometry": 2, "shading": 3, "materials": 4, "lights": 5, "image_data": 7}
-UNIFORM_BINDINGS = {"light_choice": 0}  # uniform blocks (glsl/lights.glsl's LightPlaces)
-ACCUMULATION_BINDING = 6
+# Where each of the packed scene's arrays is bound.
+BINDINGS = {"kd_nodes": KD_NODES_BINDING, "prim_refs": PRIM_REFS_BINDING, "geometry": GEOMETRY_BINDING,
+            "shading": SHADING_BINDING, "materials": MATERIALS_BINDING, "lights": LIGHTS_BINDING,
+            "image_data": IMAGE_DATA_BINDING}
+UNIFORM_BINDINGS = {"light_choice": LIGHT_CHOICE_BINDING}  # uniform blocks (glsl/lights.glsl's LightPlaces)
 MISSING_SKY = (0.2, 0.0, 0.2)  # what a scene whose environment map cannot be read is lit by
 
 
@@ -50,7 +57,7 @@ def _luminance(rgb) -> float:
 
 
 def pack_material(material: Material, textures: TextureTable) -> np.ndarray:
-    """Eight vec4 rows, read by glsl/bsdf.glsl's bsdf_at():
+    """MATERIAL_ROWS (eight) vec4 rows, read by glsl/bsdf.glsl's bsdf_at():
     0 (albedo, type), 1 (emission, two-sided), 2 (eta rgb | ior, internal reflectance, reflectance table, alpha),
     3 (k rgb, albedo texture), 4 (specular tint, roughness texture), 5 (absorption per metre), 6-7 spare."""
     record = np.zeros((MATERIAL_ROWS, 4), np.float32)
@@ -116,13 +123,9 @@ def _emitted_power(flat: FlatScene) -> np.ndarray:
     return power
 
 
-LIGHT_AREA, LIGHT_POINT, LIGHT_SUN, LIGHT_ENVIRONMENT = 0, 1, 2, 3  # glsl/lights.glsl
-
-
 # Next-event estimation chooses among at most this many lights by what each brings to the shading point
 # (glsl/lights.glsl, "Choosing a light"), which costs a pass over the table per choice; more lights (an
-# emissive mesh) are chosen by power alone.
-LIGHT_PLACES = 32  # the lights glsl/lights.glsl's LightPlaces block holds
+# emissive mesh) are chosen by power alone. No more than the LightPlaces block holds.
 LIGHTS_AT_POINT_LIMIT = LIGHT_PLACES
 
 
@@ -167,7 +170,7 @@ def _area_light_entries(flat: FlatScene, power: np.ndarray) -> list[_LightEntry]
 def _environment_uniforms(environment: Environment, textures: TextureTable, scene_radius: float,
                           importance: bool = True):
     """(uniform values, power for light selection, sampling tables to append to image_data)."""
-    uniforms = {"env_type": 0, "env_radiance": (0.0, 0.0, 0.0), "env_strength": 1.0, "env_texture": -1,
+    uniforms = {"env_type": ENV_CONSTANT, "env_radiance": (0.0, 0.0, 0.0), "env_strength": 1.0, "env_texture": -1,
                 "env_rotation": 0.0, "env_dist_offset": 0, "env_size": (1, 1), "env_table_size": (1, 1),
                 "env_rows_pole_to_pole": 0}
     if isinstance(environment, ConstantEnvironment):
@@ -186,7 +189,7 @@ def _environment_uniforms(environment: Environment, textures: TextureTable, scen
         # Without importance sampling (for comparisons) the tables describe a uniform image.
         distribution = EnvironmentDistribution.from_image(rgb if importance else np.ones_like(rgb))
         uniforms.update(
-            env_type=1, env_strength=float(environment.strength),
+            env_type=ENV_MAP, env_strength=float(environment.strength),
             env_texture=textures.index_of(InlineImageTexture(pixels=rgb, name=str(path))),
             env_rotation=math.radians(environment.rotation_deg),
             env_dist_offset=textures.add_floats(distribution.packed()), env_size=(rgb.shape[1], rgb.shape[0]),
@@ -204,6 +207,7 @@ class PackedScene:
     arrays: dict[str, np.ndarray]
     uniforms: dict[str, object]
     kdtree: KdTree
+    prim_count: int  # triangles, then spheres (the kernels need only the uniform triangle_count)
     warnings: tuple[str, ...] = ()  # problems the render survives (a missing texture): show them to the user
 
     @property
@@ -255,7 +259,7 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
     total = sum(e.power for e in entries)
     pmfs = np.array([e.power / total for e in entries]) if total > 0 else np.zeros(len(entries))
     light_of_prim = np.full(n_prim, -1, np.int32)  # each primitive's row in the light table, or -1
-    lights_table = np.zeros((len(entries), 3, 4), np.float32)
+    lights_table = np.zeros((len(entries), LIGHT_ROWS, 4), np.float32)
     for row, (entry, pmf, cdf) in enumerate(zip(entries, pmfs, np.cumsum(pmfs))):
         lights_table[row, 0] = (entry.kind, np.int32(entry.prim).view(np.float32), cdf, pmf)
         lights_table[row, 1, :3], lights_table[row, 2, :3] = entry.vector, entry.rgb
@@ -274,7 +278,7 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
     env_row = next((row for row, e in enumerate(entries) if e.kind == LIGHT_ENVIRONMENT), -1)
     sun_row = next((row for row, e in enumerate(entries) if e.kind == LIGHT_SUN), -1)
 
-    geometry = np.zeros((n_prim, 3, 4), np.float32)
+    geometry = np.zeros((n_prim, GEOMETRY_ROWS, 4), np.float32)
     tris = flat.triangles
     geometry[:n_tri, 0, :3] = tris[:, 0]
     geometry[:n_tri, 1, :3] = tris[:, 1] - tris[:, 0]
@@ -283,7 +287,7 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
     geometry[:, 1, 3] = material_ids.view(np.float32)
     geometry[:, 2, 3] = light_of_prim.view(np.float32)
 
-    shading = np.zeros((n_tri, 4, 4), np.float32)
+    shading = np.zeros((n_tri, SHADING_ROWS, 4), np.float32)
     shading[:, :3, :3] = flat.triangle_normals
     uv = flat.triangle_uvs.reshape(n_tri, 6)  # u0 v0 u1 v1 u2 v2
     shading[:, 0, 3], shading[:, 1, 3], shading[:, 2, 3] = uv[:, 0], uv[:, 1], uv[:, 2]
@@ -308,7 +312,6 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
     arrays = {name: at_least_one(np.ascontiguousarray(a)) for name, a in arrays.items()}
     uniforms = {
         "triangle_count": n_tri,
-        "prim_count": n_prim,
         "scene_min": tuple(float(v) for v in kdtree.bounds[0]),
         "scene_max": tuple(float(v) for v in kdtree.bounds[1]),
         "light_count": len(entries),
@@ -319,7 +322,7 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
         **env_uniforms,
         **sun_uniforms,
     }
-    return PackedScene(arrays, uniforms, kdtree, tuple(textures.warnings))
+    return PackedScene(arrays, uniforms, kdtree, n_prim, tuple(textures.warnings))
 
 
 class GpuScene:

@@ -16,8 +16,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lenslab.render.buffers import (LIGHT_AREA, LIGHT_ENVIRONMENT, LIGHT_POINT, LIGHT_SUN, MATERIAL_CODES,
-                                    MATERIAL_ROWS, PackedScene)
+from lenslab.render.buffers import MATERIAL_CODES, PackedScene
+from lenslab.render.gpu_layout import (ENV_MAP, GEOMETRY_ROWS, LIGHT_AREA, LIGHT_ENVIRONMENT, LIGHT_POINT, LIGHT_ROWS,
+                                       LIGHT_SUN, MATERIAL_ROWS)
 
 ALL_MATERIAL_TYPES = frozenset(MATERIAL_CODES.values())
 
@@ -60,17 +61,18 @@ GENERAL = KernelFeatures()
 def scene_features(packed: PackedScene) -> KernelFeatures:
     """The features the packed scene uses (materials only as far as some primitive uses them)."""
     uniforms, arrays = packed.uniforms, packed.arrays
-    prim_count, triangle_count = int(uniforms["prim_count"]), int(uniforms["triangle_count"])
+    prim_count, triangle_count = packed.prim_count, int(uniforms["triangle_count"])
     materials = arrays["materials"][: int(uniforms["texture_base"])].reshape(-1, MATERIAL_ROWS, 4)
-    used = np.unique(arrays["geometry"].reshape(-1, 3, 4)[:prim_count, 1, 3].view(np.int32)) if prim_count else []
+    used = (np.unique(arrays["geometry"].reshape(-1, GEOMETRY_ROWS, 4)[:prim_count, 1, 3].view(np.int32))
+            if prim_count else [])
     records = materials[np.asarray(used, dtype=np.int64)]
-    # Three rows per light; a scene without lights still has one (GL refuses empty buffers).
-    light_rows = arrays["lights"].reshape(-1, 4)[0::3][: int(uniforms["light_count"])]
+    # A scene without lights still has a row (GL refuses empty buffers).
+    light_rows = arrays["lights"].reshape(-1, 4)[0::LIGHT_ROWS][: int(uniforms["light_count"])]
     light_kinds = set(light_rows[:, 0].astype(int).tolist())
     return KernelFeatures(
         spheres=prim_count > triangle_count,
         textures=bool((records[:, 3, 3] >= 0).any() or (records[:, 4, 3] >= 0).any()),
-        environment_map=int(uniforms["env_type"]) == 1,
+        environment_map=int(uniforms["env_type"]) == ENV_MAP,
         environment_light=LIGHT_ENVIRONMENT in light_kinds,
         area_lights=LIGHT_AREA in light_kinds,
         point_lights=LIGHT_POINT in light_kinds,

@@ -6,6 +6,8 @@ from functools import lru_cache
 
 import numpy as np
 
+from lenslab.render.gpu_layout import ROUGH_TABLE_SIZE  # the table's entries, as glsl/bsdf.glsl reads them
+
 
 def fresnel_dielectric(cos_i, eta):
     """Unpolarised reflectance for light arriving at cos_i from the side of index 1 into index eta."""
@@ -30,9 +32,6 @@ def internal_diffuse_reflectance(eta: float) -> float:
     """The same seen from inside a medium of index eta (used by plastic's diffuse base): by reciprocity,
     1 - F_int = (1 - F_ext) / eta^2."""
     return 1.0 - (1.0 - diffuse_fresnel_reflectance(eta)) / eta**2
-
-
-ROUGH_TABLE_SIZE = 64  # entries of a rough interface's transmittance table, over cos theta in [0, 1]
 
 
 def _visible_normals(wo: np.ndarray, alpha: float, u1: np.ndarray, u2: np.ndarray) -> np.ndarray:

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
+from lenslab.render.gpu_layout import glsl_defines
 from lenslab.resources import glsl_dir
 
 REQUIRED_GL = 430  # compute shaders and shader storage buffers
@@ -115,7 +116,14 @@ def _read(path: Path) -> str:
 
 
 def load_shader_source(name: str, defines: dict[str, object] | None = None, directory: Path | None = None) -> str:
-    """Read ``glsl/<name>``, expand ``#include "file"`` (each file once) and put ``#define``s after #version."""
+    """Read ``glsl/<name>``, expand ``#include "file"`` (each file once) and put ``#define``s after #version:
+    the buffer layout every shader shares (gpu_layout.glsl_defines), then the caller's ``defines``."""
+    layout = glsl_defines()
+    clash = sorted(layout.keys() & (defines or {}).keys())
+    if clash:
+        raise ValueError(f"{', '.join(clash)}: part of the shared buffer layout (render/gpu_layout.py), "
+                         "not a per-kernel define")
+    defines = {**layout, **(defines or {})}
     directory = directory or glsl_dir()
     seen: set[str] = set()
 
@@ -132,5 +140,15 @@ def load_shader_source(name: str, defines: dict[str, object] | None = None, dire
     source = expand(name)
     lines = source.splitlines()
     version_at = next(i for i, line in enumerate(lines) if line.startswith("#version"))
-    define_lines = [f"#define {key} {value}" for key, value in (defines or {}).items()]
+    define_lines = [f"#define {key} {value}" for key, value in defines.items()]
     return "\n".join(lines[: version_at + 1] + define_lines + lines[version_at + 1 :]) + "\n"
+
+
+# A plain uniform's declaration: `uniform <type> <name>;` (with an optional array size). Uniform blocks
+# (`uniform Name {`) are bound by number, not set by name, and do not match.
+_UNIFORM = re.compile(r"^\s*uniform\s+\w+\s+(\w+)\s*(?:\[[^\]]*\])?\s*;", re.MULTILINE)
+
+
+def declared_uniforms(source: str) -> frozenset[str]:
+    """The names of the plain uniforms ``source`` declares, whether or not the compiled program keeps them."""
+    return frozenset(_UNIFORM.findall(source))

@@ -12,6 +12,7 @@ import numpy as np
 
 from lenslab.render.buffers import GpuScene
 from lenslab.render.gl import make_current
+from lenslab.render.gpu_layout import HITS_BINDING, RAYS_BINDING
 
 LOCAL_SIZE_X = 64
 
@@ -41,8 +42,10 @@ def cast_rays(renderer, gpu_scene: GpuScene, origins: np.ndarray, directions: np
     hits = ctx.buffer(reserve=n * 16)
     try:
         gpu_scene.bind()
-        rays.bind_to_storage_buffer(6)
-        hits.bind_to_storage_buffer(7)
+        rays.bind_to_storage_buffer(RAYS_BINDING)
+        hits.bind_to_storage_buffer(HITS_BINDING)
+        # Traversal reads a few of the scene's uniforms (no lights, no environment): set those it has. The
+        # trace kernel, which reads them all, is where a misspelt name is caught (Renderer.set_uniforms).
         for name, value in gpu_scene.packed.uniforms.items():
             if name in program:
                 program[name].value = value

@@ -15,13 +15,11 @@ from pathlib import Path
 import numpy as np
 
 from lenslab.color import srgb_to_linear
+from lenslab.render.gpu_layout import TEXELS_FLOAT, TEXELS_HALF, TEXTURE_CHECKER, TEXTURE_IMAGE, TEXTURE_ROWS
 from lenslab.scene.textures import Checkerboard, ImageTexture, InlineImageTexture, Texture
 
 log = logging.getLogger("lenslab.textures")
 
-TEXTURE_IMAGE, TEXTURE_CHECKER = 0, 1
-RECORD_ROWS = 4  # vec4 rows per texture record (glsl/textures.glsl)
-TEXELS_HALF, TEXELS_FLOAT = 0, 1  # how an image's texels are packed (record row 1, z)
 HALF_MAX = 65504.0
 MAX_SIDE = 4096  # larger images are downsampled: one storage buffer holds all texels
 MISSING = Checkerboard(color_a=(1.0, 0.0, 1.0), color_b=(0.0, 0.0, 0.0), tiles=(16.0, 16.0))
@@ -77,7 +75,7 @@ class TextureTable:
         return self._index[key]
 
     def _add(self, texture: Texture) -> int:
-        record = np.zeros((RECORD_ROWS, 4), np.float32)
+        record = np.zeros((TEXTURE_ROWS, 4), np.float32)
         if isinstance(texture, ImageTexture):
             path = Path(texture.file)
             path = path if path.is_absolute() else self.base_dir / path

@@ -20,8 +20,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from lenslab.render import gl
-from lenslab.render.buffers import ACCUMULATION_BINDING, GpuScene, pack_scene
+from lenslab.render.buffers import GpuScene, pack_scene
 from lenslab.render.features import GENERAL, KernelFeatures, scene_features
+from lenslab.render.gpu_layout import ACCUMULATION_BINDING, SPLAT_IMAGE_BINDING
 from lenslab.render.sobol import glsl_array_literal
 from lenslab.scene.camera import ThinLensCamera
 from lenslab.scene.scene import RenderSettings, Scene
@@ -55,14 +56,31 @@ class Renderer:
         self.ctx = ctx if ctx is not None else gl.create_context(device_index)
         self.limits = gl.device_limits(self.ctx)
         self._programs: dict[tuple, object] = {}
+        self._declared: dict[int, tuple[str, frozenset[str]]] = {}  # id(program): (shader, uniforms declared)
 
     @in_context
     def program(self, shader: str, **defines):
-        """The compute shader glsl/<shader> compiled with these #defines (compiled once, then cached)."""
+        """The compute shader glsl/<shader> compiled with these #defines, besides the buffer layout that
+        gl.load_shader_source gives every shader (compiled once, then cached)."""
         key = (shader, tuple(sorted(defines.items())))
         if key not in self._programs:
-            self._programs[key] = self.ctx.compute_shader(gl.load_shader_source(shader, defines))
+            source = gl.load_shader_source(shader, defines)
+            program = self.ctx.compute_shader(source)
+            self._programs[key] = program
+            self._declared[id(program)] = (shader, gl.declared_uniforms(source))
         return self._programs[key]
+
+    @in_context
+    def set_uniforms(self, program, values: dict[str, object]) -> None:
+        """Set uniforms of a program from :meth:`program` by name. The GLSL compiler drops the uniforms a
+        kernel never reads, as a kernel specialised to a scene does for every feature it leaves out: such a
+        name is skipped. A name the shader's source does not declare at all is misspelt or stale: it raises."""
+        shader, declared = self._declared[id(program)]
+        for name, value in values.items():
+            if name in program:
+                program[name].value = value
+            elif name not in declared:
+                raise KeyError(f"{shader} declares no uniform {name!r}")
 
     def trace_program(self, sampler: str, features: KernelFeatures = GENERAL):
         defines = {"LOCAL_SIZE_X": LOCAL_SIZE_X, "SOBOL_DIRECTIONS": glsl_array_literal(),
@@ -82,6 +100,7 @@ class Renderer:
         for program in self._programs.values():
             program.release()
         self._programs.clear()
+        self._declared.clear()
         self.ctx.release()
 
 
@@ -220,17 +239,19 @@ class RenderSession:
         self._samples_traced = 0
 
     # -- rendering ----------------------------------------------------------------------------------------
-    def _set_uniforms(self) -> None:
-        program = self.program
+    def trace_uniforms(self) -> dict[str, object]:
+        """The uniforms the trace kernel is given by name before each step: the scene's, the camera's and the
+        settings' (each dispatch then sets its own tile and samples). The general kernel reads every one."""
         values = dict(self._gpu_scene.packed.uniforms)
         values.update(camera_uniforms(self.camera, self.width, self.height))
         splat_pixels = self.width * self.height if self._splat_samples is not None else 0
         values.update(max_depth=self.settings.max_depth, rr_depth=self.settings.rr_depth, seed=self.settings.seed,
                       clamp_max=self.settings.clamp, splat_pixels=splat_pixels,
                       filter_stddev=self.settings.filter_stddev if self.settings.pixel_filter == "gaussian" else 0.0)
-        for name, value in values.items():
-            if name in program:  # the GLSL compiler drops uniforms a kernel never reads
-                program[name].value = value
+        return values
+
+    def _set_uniforms(self) -> None:
+        self.renderer.set_uniforms(self.program, self.trace_uniforms())
 
     def _plan_dispatch(self, target_spp: int | None) -> tuple[int, int]:
         """(pixels, samples) for the next dispatch, aiming at dispatch_seconds of GPU time."""
@@ -284,7 +305,7 @@ class RenderSession:
         terms_per_pixel = samples * (2 * reach + 1) ** 2
         pixels_total = self.width * self.height
         chunk = max(LOCAL_SIZE_X, SPLAT_GATHER_TERMS // terms_per_pixel // LOCAL_SIZE_X * LOCAL_SIZE_X)
-        self._accumulation.bind_to_storage_buffer(0)
+        self._accumulation.bind_to_storage_buffer(SPLAT_IMAGE_BINDING)
         for name, value in (("image_size", (self.width, self.height)), ("sample_count", samples),
                             ("filter_stddev", self.settings.filter_stddev),
                             ("sampled_weights", self.settings.filter_weights == "sampled")):

@@ -1,0 +1,74 @@
+"""What the host and the shaders must agree on, declared once: record sizes, type codes and binding points.
+
+Python packs the scene's buffers with these values (render/buffers.py, render/textures.py, render/bsp.py)
+and gl.load_shader_source hands every one of them to every compute shader as a #define of the same name
+(:func:`glsl_defines`). No GLSL file types these numbers itself, so a shader compiled without them fails to
+compile instead of reading the buffers askew.
+"""
+
+from __future__ import annotations
+
+# -- Materials: MATERIAL_ROWS vec4 rows per material (buffers.pack_material, glsl/bsdf.glsl), its type
+# code in row 0, w.
+MATERIAL_DIFFUSE = 0
+MATERIAL_EMISSIVE = 1
+MATERIAL_CONDUCTOR = 2
+MATERIAL_PLASTIC = 3
+MATERIAL_DIELECTRIC = 4
+MATERIAL_THIN_DIELECTRIC = 5
+MATERIAL_ROWS = 8
+
+# Entries of a rough plastic coating's reflectance table (render/fresnel.py), over cos theta in [0, 1].
+ROUGH_TABLE_SIZE = 64
+
+# -- Textures: TEXTURE_ROWS vec4 rows per texture record (render/textures.py, glsl/textures.glsl).
+TEXTURE_IMAGE = 0
+TEXTURE_CHECKER = 1
+TEXTURE_ROWS = 4
+TEXELS_HALF = 0  # how an image's texels are packed (record row 1, z): two half-float uints a texel
+TEXELS_FLOAT = 1  # three 32-bit float uints a texel, for values beyond the half-float range
+
+# -- Geometry: vec4 rows per primitive in the geometry buffer, per triangle in the shading buffer.
+GEOMETRY_ROWS = 3
+SHADING_ROWS = 4
+
+# kd-tree nodes (render/bsp.py): the low two bits of a node's second word are its split axis, or this.
+KD_LEAF = 3
+
+# -- Lights: LIGHT_ROWS vec4 rows per light in the light table (buffers.pack_scene, glsl/lights.glsl), its
+# kind in row 0, x.
+LIGHT_AREA = 0
+LIGHT_POINT = 1
+LIGHT_SUN = 2
+LIGHT_ENVIRONMENT = 3
+LIGHT_ROWS = 3
+# The lights the LightPlaces uniform block holds: next-event estimation chooses among at most this many by
+# what each brings to the shading point.
+LIGHT_PLACES = 32
+
+# The uniform env_type: a constant colour (env_radiance) or a lat-long map.
+ENV_CONSTANT = 0
+ENV_MAP = 1
+
+# -- Binding points of the storage buffers (and of the one uniform block) the kernels read and write.
+KD_NODES_BINDING = 0
+PRIM_REFS_BINDING = 1
+GEOMETRY_BINDING = 2
+SHADING_BINDING = 3
+MATERIALS_BINDING = 4
+LIGHTS_BINDING = 5
+ACCUMULATION_BINDING = 6  # trace.comp's output: the image's running sums, or one pass of splatted samples
+IMAGE_DATA_BINDING = 7
+LIGHT_CHOICE_BINDING = 0  # a uniform block: uniform-block bindings are numbered apart from storage buffers
+# splat.comp reads the samples trace.comp left at ACCUMULATION_BINDING and gathers them into the image here.
+SPLAT_IMAGE_BINDING = 0
+# raycast.comp's rays in and hits out; bsdf_probe.comp's items in and results out.
+RAYS_BINDING = 6
+HITS_BINDING = 7
+PROBE_IN_BINDING = 6
+PROBE_OUT_BINDING = 8
+
+
+def glsl_defines() -> dict[str, int]:
+    """Every constant above by its own name: the #defines each compute shader is compiled with."""
+    return {name: value for name, value in globals().items() if name.isupper() and type(value) is int}
