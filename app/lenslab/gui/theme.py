@@ -10,6 +10,8 @@ from PySide6.QtGui import QColor, QIcon, QPainter, QPalette, QPixmap
 from PySide6.QtSvg import QSvgRenderer
 from PySide6.QtWidgets import QApplication
 
+from lenslab.color import linear_to_srgb
+
 ACCENT = "#e8a23a"  # selection outline, active tool, focus marks (a warm amber, like Blender's)
 FOCUS = "#59d18c"  # depth-of-field overlay and focus readouts
 BACKGROUND = "#1e1f21"
@@ -136,7 +138,7 @@ def icon(name: str, colour: str = TEXT, size: int = 24) -> QIcon:
 
 def swatch(rgb, size: int = 14) -> QIcon:
     """A small round colour swatch (materials in the outliner), displayed as the sRGB of a linear colour."""
-    r, g, b = (max(0.0, min(1.0, float(c))) ** (1 / 2.2) for c in rgb)
+    r, g, b = (linear_to_srgb(float(c)) for c in rgb)
     pixmap = QPixmap(size * 2, size * 2)
     pixmap.fill(Qt.transparent)
     pixmap.setDevicePixelRatio(2)

@@ -19,6 +19,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from lenslab.color import linear_to_srgb, srgb_to_linear
 from lenslab.gui.theme import DIM_TEXT
 
 
@@ -243,16 +244,6 @@ class ColorSwatch(QToolButton):
         painter.setBrush(self.display_colour())
         painter.drawRoundedRect(self.rect().adjusted(1, 1, -1, -1), 3, 3)
         painter.end()
-
-
-def linear_to_srgb(c: float) -> float:
-    c = min(max(c, 0.0), 1.0)
-    return 12.92 * c if c <= 0.0031308 else 1.055 * c ** (1 / 2.4) - 0.055
-
-
-def srgb_to_linear(c: float) -> float:
-    c = min(max(c, 0.0), 1.0)
-    return c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
 
 
 class ColorEdit(QWidget):
