@@ -2,7 +2,7 @@
 // Entry kernel of the progressive renderer: one invocation per pixel of a tile of consecutive pixels,
 // taking `sample_count` samples (sample indices sample_start ...) of that pixel.
 //
-// Two ways to turn samples into pixels (DESIGN.md, "Rendering"):
+// Two ways to turn samples into pixels (docs/architecture.md, "Rendering"):
 // * splat_pixels == 0: each sample lands in its own pixel. The sum is loaded once and each sample added in
 //   index order, so the image is bit-identical however the host splits the work into dispatches. A box
 //   filter, or a gaussian by filter importance sampling.
