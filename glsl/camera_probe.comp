@@ -3,16 +3,16 @@
 // tests/test_camera_rays.py compares these rays with the Python camera's (lenslab.scene.camera.CameraFrame),
 // so the shader and the host can never disagree on where a pixel looks. Not used while rendering.
 
-layout(local_size_x = 64) in;
+layout(local_size_x = LOCAL_SIZE_X) in;
 
 #include "common.glsl"
 #include "sampling.glsl"
 #include "camera.glsl"
 
 // In, one vec4 per item: (pixel x, pixel y, lens u, lens v), pixels as in camera_ray().
-layout(std430, binding = 6) readonly buffer ProbeIn { vec4 probe_in[]; };
+layout(std430, binding = PROBE_IN_BINDING) readonly buffer ProbeIn { vec4 probe_in[]; };
 // Out, two vec4 per item: (origin, 0), (direction, 0).
-layout(std430, binding = 8) writeonly buffer ProbeOut { vec4 probe_out[]; };
+layout(std430, binding = PROBE_OUT_BINDING) writeonly buffer ProbeOut { vec4 probe_out[]; };
 
 uniform int item_count;
 

@@ -10,9 +10,11 @@ import pytest
 
 from lenslab.optics.aperture import sample_concentric_disk, sample_polygon
 from lenslab.render.gl import make_current
+from lenslab.render.gpu_layout import PROBE_IN_BINDING, PROBE_OUT_BINDING
 from lenslab.render.tracer import camera_uniforms
 from lenslab.scene.camera import ThinLensCamera
 
+PROBE_GROUP_SIZE = 64
 CAMERA = ThinLensCamera(position=(1.0, 2.0, 3.0), look_at=(-0.5, 0.3, -1.0), up=(0.2, 1.0, 0.1),
                         focal_length_mm=35.0, f_number=1.4, focus_distance_m=2.5, resolution=(300, 200))
 
@@ -109,15 +111,13 @@ def test_the_aperture_maps_are_uniform_and_stay_inside_their_shapes():
 def shader_rays(renderer, camera, width, height, items):
     ctx = renderer.ctx
     make_current(ctx)
-    program = renderer.program("camera_probe.comp")
-    for name, value in camera_uniforms(camera, width, height).items():
-        program[name].value = value
-    program["item_count"].value = len(items)
+    program = renderer.program("camera_probe.comp", LOCAL_SIZE_X=PROBE_GROUP_SIZE)
+    renderer.set_uniforms(program, {**camera_uniforms(camera, width, height), "item_count": len(items)})
     source = ctx.buffer(np.asarray(items, np.float32).tobytes())
     result = ctx.buffer(reserve=len(items) * 32)
-    source.bind_to_storage_buffer(6)
-    result.bind_to_storage_buffer(8)
-    program.run((len(items) + 63) // 64, 1, 1)
+    source.bind_to_storage_buffer(PROBE_IN_BINDING)
+    result.bind_to_storage_buffer(PROBE_OUT_BINDING)
+    program.run((len(items) + PROBE_GROUP_SIZE - 1) // PROBE_GROUP_SIZE, 1, 1)
     out = np.frombuffer(result.read(), np.float32).reshape(-1, 2, 4).copy()
     source.release()
     result.release()
