@@ -1,4 +1,4 @@
-"""The scene's event emitter: plain Python, no Qt."""
+"""The scene's events: a plain Python emitter, no Qt, that the studio's widgets listen to directly."""
 
 import subprocess
 import sys
@@ -36,7 +36,67 @@ def test_events_module_does_not_import_qt():
     code = "import sys, lenslab.scene.events; print(any(m.startswith('PySide6') for m in sys.modules))"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "False"
-    assert isinstance(SceneEvents().changed, EventEmitter)
+
+
+def test_a_failing_listener_is_reported_and_the_others_still_hear_the_change(monkeypatch):
+    """As with a Qt signal's slots: one broken observer neither silences the rest nor unwinds the edit."""
+    changed = SceneEvents().changed
+    reported, heard = [], []
+    monkeypatch.setattr(sys, "excepthook", lambda kind, error, trace: reported.append(error))
+
+    def broken(change):
+        raise RuntimeError("a bug in one listener")
+
+    changed.connect(broken)
+    changed.connect(heard.append)
+    change = SceneChange("camera", ("camera",), ("f_number",))
+    changed.emit(change)
+    assert heard == [change]
+    assert [str(e) for e in reported] == ["a bug in one listener"]
+
+
+def test_a_listening_widget_is_disconnected_when_it_is_destroyed(qtbot):
+    from PySide6.QtCore import QCoreApplication, QEvent
+    from PySide6.QtWidgets import QWidget
+
+    from lenslab.gui.document import listen
+
+    changed = SceneEvents().changed
+
+    class Listener(QWidget):
+        def __init__(self):
+            super().__init__()
+            self.heard = []
+
+        def on_change(self, change):
+            self.heard.append(change)
+
+    widget = Listener()
+    listen(changed, widget, widget.on_change)
+    changed.emit(SceneChange("scene"))
+    assert len(widget.heard) == 1 and len(changed) == 1
+    widget.deleteLater()
+    QCoreApplication.sendPostedEvents(None, QEvent.DeferredDelete)
+    assert len(changed) == 0
+    changed.emit(SceneChange("scene"))  # would call into a deleted widget, and raise, if still connected
+
+
+@pytest.mark.gl
+def test_the_studio_hears_an_edit_made_on_the_scene_itself(qtbot, window):
+    """No Qt signal in between: an edit made on the model, as a script would, reaches the property editor, the
+    camera panel, the viewport's tag and the render worker's feeder."""
+    doc = window.doc
+    assert not hasattr(doc, "changed")  # nothing re-emits the scene's events as a Qt signal
+    tall = next(p for p, n in doc.walk_nodes() if n.name == "tall box")
+    doc.set_selection([("node", tall)])
+    generation = window.controller.generation
+    doc.model.apply_value(("node", tall), ("name",), "giant box")
+    assert window.properties.title.text() == "giant box"
+    assert window.controller.generation == generation + 1
+    doc.model.apply_value(("camera",), ("f_number",), 5.6)
+    assert window.camera_panel.aperture_combo.currentText() == "f/5.6"
+    assert "f/5.6" in window.viewport.hud_text
+    assert window.controller.generation == generation + 2
 
 
 def test_qt_calls_do_not_exhaust_none_and_true(qtbot):

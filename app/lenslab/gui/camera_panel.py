@@ -23,6 +23,7 @@ from PySide6.QtWidgets import (
 
 from lenslab.gui import theme
 from lenslab.gui.commands import LensCommand
+from lenslab.gui.document import listen
 from lenslab.gui.widgets import IntEdit, NumberEdit, Section, hint, log_to_slider, readout, slider_to_log
 from lenslab.optics import (
     THIRD_STOPS,
@@ -261,7 +262,7 @@ class CameraPanel(QWidget):
         layout.addWidget(self._dof_section())
         layout.addWidget(self._sensor_section())
         layout.addStretch(1)
-        doc.changed.connect(self._on_change)
+        listen(doc.model.events.changed, self, self._on_change)
         doc.lens_changed.connect(self.refresh)
         self.refresh()
 

@@ -1,7 +1,8 @@
 """Undo commands: every edit the studio makes to a scene is one of these, pushed on the document's QUndoStack.
 
-Commands address what they change by target and field (see ``lenslab.gui.document``), never by holding on to
-objects, so that any order of undo and redo finds the right thing. Values are deep-copied in and out.
+Commands address what they change by target and field (see ``lenslab.scene.editable``), never by holding on to
+objects, so that any order of undo and redo finds the right thing. Values are deep-copied in and out. Each
+announces what it changed on the scene's own events (``doc.model``), whichever way it runs.
 
 Consecutive edits of the same fields from a slider or a spin box drag merge into one step (``mergeWith``) when
 they arrive within :data:`MERGE_SECONDS` of each other, so one Ctrl+Z undoes one gesture.
@@ -58,9 +59,9 @@ class SetValuesCommand(QUndoCommand):
 
     def _apply(self, values: dict) -> None:
         for field, value in values.items():
-            self.doc.apply_value(self.target, field, value, notify=False)
+            self.doc.model.apply_value(self.target, field, value, notify=False)
         for field in values:
-            self.doc.notify_target(self.target, field)
+            self.doc.model.notify_target(self.target, field)
 
     def id(self) -> int:
         return _SET_VALUES_ID
@@ -97,9 +98,9 @@ class LensCommand(QUndoCommand):
 
     def _apply(self, lens, values) -> None:
         for key, value in values.items():
-            self.doc.apply_value(("camera",), (key,), value, notify=False)
+            self.doc.model.apply_value(("camera",), (key,), value, notify=False)
         self.doc.set_lens_state(lens)
-        self.doc.notify(SceneChange("camera", ("camera",), ("focal_length_mm",)))
+        self.doc.model.notify(SceneChange("camera", ("camera",), ("focal_length_mm",)))
 
     def redo(self) -> None:
         self._apply(self.new_lens, self.new)
@@ -123,13 +124,13 @@ class AddNodeCommand(QUndoCommand):
 
     def redo(self) -> None:
         self.doc.children_of(self.parent_path).insert(self.index, copy.deepcopy(self.node))
-        self.doc.notify(SceneChange("structure", ("node", self.path)))
+        self.doc.model.notify(SceneChange("structure", ("node", self.path)))
         self.doc.set_selection([("node", self.path)])
 
     def undo(self) -> None:
         del self.doc.children_of(self.parent_path)[self.index]
         self.doc.set_selection([t for t in self.old_selection if self.doc.exists(t)])
-        self.doc.notify(SceneChange("structure", ("node", self.parent_path)))
+        self.doc.model.notify(SceneChange("structure", ("node", self.parent_path)))
 
 
 class RemoveNodesCommand(QUndoCommand):
@@ -145,13 +146,13 @@ class RemoveNodesCommand(QUndoCommand):
         for path, _node in sorted(self.removed, reverse=True):  # deepest and last first: paths stay valid
             del self.doc.children_of(path[:-1])[path[-1]]
         self.doc.set_selection([])
-        self.doc.notify(SceneChange("structure"))
+        self.doc.model.notify(SceneChange("structure"))
 
     def undo(self) -> None:
         for path, node in sorted(self.removed):
             self.doc.children_of(path[:-1]).insert(path[-1], copy.deepcopy(node))
         self.doc.set_selection(self.old_selection)
-        self.doc.notify(SceneChange("structure"))
+        self.doc.model.notify(SceneChange("structure"))
 
 
 class AddLightCommand(QUndoCommand):
@@ -166,13 +167,13 @@ class AddLightCommand(QUndoCommand):
 
     def redo(self) -> None:
         self.doc.scene.lights.insert(self.index, copy.deepcopy(self.light))
-        self.doc.notify(SceneChange("structure", ("light", self.index)))
+        self.doc.model.notify(SceneChange("structure", ("light", self.index)))
         self.doc.set_selection([("light", self.index)])
 
     def undo(self) -> None:
         del self.doc.scene.lights[self.index]
         self.doc.set_selection([t for t in self.old_selection if self.doc.exists(t)])
-        self.doc.notify(SceneChange("structure"))
+        self.doc.model.notify(SceneChange("structure"))
 
 
 class RemoveLightsCommand(QUndoCommand):
@@ -188,13 +189,13 @@ class RemoveLightsCommand(QUndoCommand):
         for index, _light in reversed(self.removed):  # last first: the other indices stay valid
             del self.doc.scene.lights[index]
         self.doc.set_selection([t for t in self.doc.selection if t[0] != "light"])
-        self.doc.notify(SceneChange("structure"))
+        self.doc.model.notify(SceneChange("structure"))
 
     def undo(self) -> None:
         for index, light in self.removed:
             self.doc.scene.lights.insert(index, copy.deepcopy(light))
         self.doc.set_selection(self.old_selection)
-        self.doc.notify(SceneChange("structure"))
+        self.doc.model.notify(SceneChange("structure"))
 
 
 def _outermost(paths: list[tuple]) -> list[tuple]:
@@ -234,14 +235,14 @@ class MoveNodeCommand(QUndoCommand):
         node = self.doc.children_of(self.src[:-1]).pop(self.src[-1])
         node.transform = copy.deepcopy(self.new_transform)
         self.doc.children_of(self.final[:-1]).insert(self.final[-1], node)
-        self.doc.notify(SceneChange("structure", ("node", self.final)))
+        self.doc.model.notify(SceneChange("structure", ("node", self.final)))
         self.doc.set_selection([("node", self.final)])
 
     def undo(self) -> None:
         node = self.doc.children_of(self.final[:-1]).pop(self.final[-1])
         node.transform = copy.deepcopy(self.old_transform)
         self.doc.children_of(self.src[:-1]).insert(self.src[-1], node)
-        self.doc.notify(SceneChange("structure", ("node", self.src)))
+        self.doc.model.notify(SceneChange("structure", ("node", self.src)))
         self.doc.set_selection([("node", self.src)])
 
 
@@ -257,14 +258,14 @@ class AddMaterialCommand(QUndoCommand):
         self.doc.scene.materials[self.name] = copy.deepcopy(self.material)
         for path, _old in self.assign:
             self.doc.node(path).material = self.name
-        self.doc.notify(SceneChange("structure", ("material", self.name)))
+        self.doc.model.notify(SceneChange("structure", ("material", self.name)))
 
     def undo(self) -> None:
         for path, old in self.assign:
             self.doc.node(path).material = old
         del self.doc.scene.materials[self.name]
         self.doc.set_selection([t for t in self.doc.selection if self.doc.exists(t)])
-        self.doc.notify(SceneChange("structure"))
+        self.doc.model.notify(SceneChange("structure"))
 
 
 class RemoveMaterialCommand(QUndoCommand):
@@ -283,7 +284,7 @@ class RemoveMaterialCommand(QUndoCommand):
         for path in self.users:
             self.doc.node(path).material = ""
         self.doc.set_selection([t for t in self.doc.selection if self.doc.exists(t)])
-        self.doc.notify(SceneChange("structure"))
+        self.doc.model.notify(SceneChange("structure"))
 
     def undo(self) -> None:
         items = list(self.doc.scene.materials.items())
@@ -292,7 +293,7 @@ class RemoveMaterialCommand(QUndoCommand):
         self.doc.scene.materials.update(items)
         for path in self.users:
             self.doc.node(path).material = self.name
-        self.doc.notify(SceneChange("structure", ("material", self.name)))
+        self.doc.model.notify(SceneChange("structure", ("material", self.name)))
 
 
 class RenameMaterialCommand(QUndoCommand):
@@ -311,7 +312,7 @@ class RenameMaterialCommand(QUndoCommand):
         for path in self.users:
             self.doc.node(path).material = b
         self.doc.selection = [("material", b) if t == ("material", a) else t for t in self.doc.selection]
-        self.doc.notify(SceneChange("structure", ("material", b)))
+        self.doc.model.notify(SceneChange("structure", ("material", b)))
         self.doc.selection_changed.emit()
 
     def redo(self) -> None:

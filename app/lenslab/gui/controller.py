@@ -1,9 +1,10 @@
 """The link between the open document and the render worker, on the GUI thread.
 
-It listens to the document's scene events and sends the worker the cheapest message that brings it up to date
-(a camera, the render settings, or a copy of the whole scene), numbering each edit (its *generation*) so that the
-GUI can tell which frames already show it. It also decides the viewport's render size from the camera's
-resolution and the chosen viewport quality, routes pick answers to whoever asked, and runs exports.
+It listens to the scene's own events (``doc.model.events``) and sends the worker the cheapest message that
+brings it up to date (a camera, the render settings, or a copy of the whole scene), numbering each edit (its
+*generation*) so that the GUI can tell which frames already show it. It also decides the viewport's render size
+from the camera's resolution and the chosen viewport quality, routes pick answers to whoever asked, and runs
+exports.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from typing import Callable
 
 from PySide6.QtCore import QObject, Signal
 
-from lenslab.gui.document import copy_scene
+from lenslab.gui.document import copy_scene, listen
 from lenslab.gui.worker import ExportRequest, Frame, RenderWorker
 
 #: Viewport quality: a fraction of the camera's resolution, or "auto" (at most AUTO_LONG_EDGE pixels wide).
@@ -76,7 +77,7 @@ class RenderController(QObject):
         w.export_failed.connect(self.export_failed)
         w.export_cancelled.connect(self.export_cancelled)
         w.set_target_spp(target_spp)
-        doc.changed.connect(self._on_change)
+        listen(doc.model.events.changed, self, self._on_change)
         w.start()
         self.send_scene()
 
@@ -185,10 +186,7 @@ class RenderController(QObject):
         """Stop the worker (within a dispatch) and wait for it to release its GL context."""
         if not self._shut_down:
             self._shut_down = True
-            try:
-                self.doc.changed.disconnect(self._on_change)
-            except (RuntimeError, TypeError):
-                pass
+            self.doc.model.events.changed.disconnect(self._on_change)
         if not self.worker.isRunning():
             return True
         self.worker.stop()

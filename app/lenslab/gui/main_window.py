@@ -9,7 +9,6 @@ import os
 import threading
 from pathlib import Path
 
-import numpy as np
 from PySide6.QtCore import QPointF, QSettings, Qt, QTimer, Signal
 from PySide6.QtGui import QAction, QActionGroup, QKeySequence
 from PySide6.QtWidgets import (
@@ -38,21 +37,18 @@ from lenslab.gui.commands import (AddLightCommand, AddMaterialCommand, AddNodeCo
                                   RemoveMaterialCommand, RemoveNodesCommand)
 from lenslab.gui.controller import QUALITIES, SAMPLE_LIMITS, RenderController, elapsed_text, rate_text, samples_text
 from lenslab.gui.defaults import studio_scene
-from lenslab.gui.document import Document, is_shipped
+from lenslab.gui.document import Document, is_shipped, listen
 from lenslab.gui.export_dialog import ExportDialog
 from lenslab.gui.properties import PropertyEditor
 from lenslab.gui.scene_tree import SceneTreeView, node_context_menu
 from lenslab.gui.viewport import Viewport
 from lenslab.optics import circle_of_confusion_mm, depth_of_field, format_f_number, format_focal_length
 from lenslab.render.film import TONE_MAPS
+from lenslab.scene import editing
 from lenslab.scene.io.loader import open_scene, resolve_scene_path, shipped_scene_names
 from lenslab.scene.io.meshes import MESH_SUFFIXES, MeshLoadError, load_mesh
 from lenslab.scene.io.native import SCENE_SUFFIX, save_scene
-from lenslab.scene.lights import PointLight, SunLight
-from lenslab.scene.materials import Diffuse, Emissive
-from lenslab.scene.scene import Node, SceneError
-from lenslab.scene.shapes import Box, MeshFile, Rectangle, Sphere
-from lenslab.scene.transform import Transform
+from lenslab.scene.scene import SceneError
 
 MAX_RECENT = 10
 APP_NAME = "LensLab"
@@ -373,7 +369,7 @@ class MainWindow(QMainWindow):
         doc, c = self.doc, self.controller
         doc.file_changed.connect(self._update_title)
         doc.selection_changed.connect(self._selection_changed)
-        doc.changed.connect(self._scene_changed)
+        listen(doc.model.events.changed, self, self._scene_changed)
         doc.undo_stack.indexChanged.connect(lambda _i: self._update_actions())
         c.frame_ready.connect(self._frame)
         c.gbuffer_ready.connect(self._gbuffer)
@@ -663,13 +659,15 @@ class MainWindow(QMainWindow):
 
     def _write(self, path: Path) -> bool:
         path = Path(path)
-        rebase_mesh_paths(self.doc.scene, path.resolve().parent)
+        # Relative mesh paths are rewritten for the new folder in the copy that is written; the open scene takes
+        # them on only once the file is there, so a failed save leaves it exactly as it was.
+        mesh_paths = editing.rebased_mesh_paths(self.doc.model, path.resolve().parent)
         try:
-            save_scene(self.doc.scene, path)
+            save_scene(editing.with_mesh_paths(self.doc.scene, mesh_paths), path)
         except OSError as exc:
             QMessageBox.critical(self, "Cannot save scene", f"{path}: {exc.strerror or exc}")
             return False
-        self.doc.saved_as(path)
+        self.doc.saved_as(path, mesh_paths)
         self._add_recent(path)
         self.statusBar().showMessage(f"Saved {path}", 4000)
         return True
@@ -701,66 +699,24 @@ class MainWindow(QMainWindow):
             menu.addAction("No recent scenes").setEnabled(False)
 
     # -- adding, importing, deleting --------------------------------------------------------------------------------
-    def focus_point(self) -> np.ndarray:
-        return self.doc.scene.camera.frame().focus_point()
-
-    def view_width_at_focus(self) -> float:
-        cam = self.doc.scene.camera
-        return cam.frame().view_size_at(cam.focus_distance_m)[0]
-
-    def _insertion_parent(self) -> tuple:
-        paths = self.doc.selected_node_paths()
-        if len(paths) == 1 and self.doc.node(paths[0]).shape is None:
-            return paths[0]  # a selected group receives new objects
-        return ()
-
     def add_primitive(self, kind: str) -> None:
-        size = max(0.05, round(self.view_width_at_focus() * 0.12, 3))
-        at = tuple(float(round(c, 4)) for c in self.focus_point())
-        if kind == "group":
-            node = Node(self.doc.unique_node_name("group"), Transform(), None)
-        elif kind == "sphere":
-            node = Node(self.doc.unique_node_name("sphere"), Transform(translate=at), Sphere(radius=size / 2))
-        elif kind == "box":
-            node = Node(self.doc.unique_node_name("box"), Transform(translate=at), Box(size=(size, size, size)))
-        elif kind == "rectangle":
-            node = Node(self.doc.unique_node_name("rectangle"), Transform(translate=at), Rectangle(size=(size, size)))
-        elif kind == "light":
-            cam = self.doc.scene.camera
-            up = cam.basis()[1]
-            above = tuple(float(round(c, 4)) for c in self.focus_point() + up * size * 3)
-            stack = self.doc.undo_stack
-            stack.beginMacro("Add area light")
-            name = self.doc.unique_material_name("light")
-            self.doc.push(AddMaterialCommand(self.doc, name, Emissive(radiance=(10.0, 10.0, 10.0))))
-            node = Node(self.doc.unique_node_name("area light"), Transform(translate=above, rotate_deg=(90.0, 0.0, 0.0)),
-                        Rectangle(size=(size * 2, size * 2)), name)
-            self.doc.push(AddNodeCommand(self.doc, node, self._insertion_parent()))
-            stack.endMacro()
+        new = editing.new_primitive(self.doc.model, kind)
+        parent = editing.insertion_parent(self.doc.model, self.doc.selected_node_paths())
+        if new.material is None:
+            self.doc.push(AddNodeCommand(self.doc, new.node, parent))
             return
-        else:
-            raise ValueError(kind)
-        self.doc.push(AddNodeCommand(self.doc, node, self._insertion_parent()))
+        stack = self.doc.undo_stack
+        stack.beginMacro(f"Add {new.node.name}")
+        self.doc.push(AddMaterialCommand(self.doc, *new.material))
+        self.doc.push(AddNodeCommand(self.doc, new.node, parent))
+        stack.endMacro()
 
     def add_light(self, kind: str) -> None:
-        """A point light above the point of focus, or a sun from behind the camera's right shoulder."""
-        name = self.doc.unique_light_name("sun" if kind == "sun" else "point light")
-        if kind == "sun":
-            cam = self.doc.scene.camera
-            right, up, back = cam.basis()
-            direction = tuple(float(round(c, 4)) for c in (0.5 * right + up + 0.7 * back))
-            light = SunLight(name=name, direction=direction)
-        else:
-            size = max(0.05, self.view_width_at_focus() * 0.12)
-            up = self.doc.scene.camera.basis()[1]
-            at = tuple(float(round(c, 4)) for c in self.focus_point() + up * size * 4)
-            light = PointLight(name=name, position=at, intensity=(size * 40.0,) * 3)
-        self.doc.push(AddLightCommand(self.doc, light))
+        self.doc.push(AddLightCommand(self.doc, editing.new_light(self.doc.model, kind)))
 
     def new_material(self) -> None:
-        name = self.doc.unique_material_name("material")
-        assign = self.doc.selected_node_paths()
-        self.doc.push(AddMaterialCommand(self.doc, name, Diffuse(), assign_to=assign))
+        name, material = editing.new_material(self.doc.model)
+        self.doc.push(AddMaterialCommand(self.doc, name, material, assign_to=self.doc.selected_node_paths()))
         self.doc.set_selection([("material", name)])
 
     def import_dialog(self) -> None:
@@ -801,33 +757,12 @@ class MainWindow(QMainWindow):
             if not self._closing:
                 QMessageBox.critical(self, "Cannot import mesh", error)
             return
-        node, scale = self.mesh_node(path, mesh)
-        self.doc.push(AddNodeCommand(self.doc, node, self._insertion_parent(), text=f"Import {path.name}"))
+        node, scale = editing.mesh_node(self.doc.model, path, mesh.vertices, self.doc.path)
+        parent = editing.insertion_parent(self.doc.model, self.doc.selected_node_paths())
+        self.doc.push(AddNodeCommand(self.doc, node, parent, text=f"Import {path.name}"))
         note = f", scaled ×{scale:g} to fit the view" if scale != 1.0 else ""
         self.statusBar().showMessage(f"Imported {path.name}: {mesh.triangle_count:,} triangles{note}", 6000)
         self.mesh_imported.emit(str(path))
-
-    def mesh_node(self, path: Path, mesh) -> tuple[Node, float]:
-        """A node for a mesh, standing at the plane of focus, scaled to fit the view if its units are far off
-        (a model in millimetres would otherwise fill the sky)."""
-        lo, hi = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
-        extent = float(np.max(hi - lo)) or 1.0
-        wanted = self.view_width_at_focus() * 0.4
-        scale = 1.0 if wanted / 10 <= extent <= wanted * 1.5 else wanted / extent
-        scale = float(f"{scale:.3g}")
-        centre = (lo + hi) / 2
-        at = self.focus_point() - scale * centre
-        at[1] += scale * (centre[1] - lo[1])  # standing on its lowest point at the focus point's height
-        file_text = str(path)
-        if self.doc.path is not None:
-            try:
-                file_text = os.path.relpath(path, Path(self.doc.path).resolve().parent)
-            except ValueError:
-                pass
-        node = Node(self.doc.unique_node_name(path.stem),
-                    Transform(translate=tuple(float(round(c, 5)) for c in at), scale=(scale, scale, scale)),
-                    MeshFile(file=file_text, smooth=True))
-        return node, scale
 
     def _warm_up_mesh_library(self) -> None:
         """Start importing the mesh library (trimesh, scipy: seconds the first time) while the user picks a file."""
@@ -856,14 +791,11 @@ class MainWindow(QMainWindow):
         paths = self.doc.selected_node_paths()
         if not paths:
             return
-        import copy
-
         stack = self.doc.undo_stack
         stack.beginMacro("Duplicate")
         new_targets = []
-        for path in sorted(paths, reverse=True):
-            node = copy.deepcopy(self.doc.node(path))
-            node.name = self.doc.unique_node_name(node.name)
+        for path in sorted(paths, reverse=True):  # last first: the paths still to copy stay valid
+            node = editing.duplicate(self.doc.model, path)
             command = AddNodeCommand(self.doc, node, path[:-1], path[-1] + 1, text=f"Duplicate {node.name}")
             self.doc.push(command)
             new_targets.append(("node", command.path))
@@ -883,25 +815,14 @@ class MainWindow(QMainWindow):
         paths = self.doc.selected_node_paths()
         if not paths:
             return
-        depth = None
         g = self.viewport.gbuffer
-        indices = []
-        for path in paths:
-            indices.extend(self.doc.subtree_indices(path))
-        if g is not None and g.generation >= self._structure_generation:
-            mask = np.isin(g.node_index, np.asarray(indices, np.int32)) & np.isfinite(g.depth)
-            if mask.any():
-                depth = float(np.median(g.depth[mask]))
-        if depth is None:  # not in view: the depth of its origin
-            from lenslab.gui.scene_tree import world_matrix
-
-            origin = world_matrix(self.doc, paths[0])[:3, 3]
-            depth = self.doc.scene.camera.frame().depth_of(origin)
-        if depth <= 0.01:
+        fresh = g is not None and g.generation >= self._structure_generation  # its node numbers are today's
+        distance = editing.focus_distance_for(self.doc.model, paths, g if fresh else None)
+        if distance is None:
             self.statusBar().showMessage("The selection is behind the camera", 4000)
             return
         name = self.doc.node(paths[0]).name
-        self.doc.set_camera(f"Focus on {name}", False, focus_distance_m=round(depth, 4))
+        self.doc.set_camera(f"Focus on {name}", False, focus_distance_m=distance)
 
     # -- export -----------------------------------------------------------------------------------------------------
     def export_dialog(self) -> None:
@@ -1032,27 +953,9 @@ class MainWindow(QMainWindow):
         stopped = self.controller.shutdown()
         if not stopped:  # a very long kd-tree build: do not hang the desktop; the process exit will end it
             self.statusBar().showMessage("The renderer is still busy; closing anyway")
-        # The document outlives the widgets by a little while Qt tears the window down: silence it.
-        self.doc.blockSignals(True)
-        self.doc.undo_stack.blockSignals(True)
+        self.doc.silence()
         event.accept()
         self.closed.emit()
-
-
-def rebase_mesh_paths(scene, new_folder: Path) -> None:
-    """Keep relative mesh paths pointing at the same files when a scene is saved into another folder."""
-    old_folder = scene.base_dir().resolve()
-    new_folder = Path(new_folder).resolve()
-    if old_folder == new_folder:
-        return
-    for node, _matrix in scene.walk():
-        shape = node.shape
-        if isinstance(shape, MeshFile) and shape.file and not Path(shape.file).is_absolute():
-            absolute = (old_folder / shape.file).resolve()
-            try:
-                shape.file = os.path.relpath(absolute, new_folder)
-            except ValueError:  # another drive (Windows)
-                shape.file = str(absolute)
 
 
 def app_icon():
@@ -1066,4 +969,4 @@ def app_icon():
     return icon
 
 
-__all__ = ["MainWindow", "studio_settings", "rebase_mesh_paths", "QPointF", "QHBoxLayout"]
+__all__ = ["MainWindow", "studio_settings", "QPointF", "QHBoxLayout"]

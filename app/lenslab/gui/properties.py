@@ -33,6 +33,7 @@ from PySide6.QtWidgets import (
 
 from lenslab.gui import theme
 from lenslab.gui.commands import AddMaterialCommand, RenameMaterialCommand
+from lenslab.gui.document import listen
 from lenslab.gui.widgets import ColorEdit, IntEdit, NumberEdit, Section, VectorEdit, hint
 from lenslab.scene.lights import LIGHT_TYPES, Light
 from lenslab.scene.materials import MATERIAL_TYPES, Diffuse, Material
@@ -146,7 +147,7 @@ class PropertyEditor(QWidget):
         layout.addWidget(self.subtitle)
         layout.addWidget(self.scroll, 1)
         doc.selection_changed.connect(self.rebuild)
-        doc.changed.connect(self._on_change)
+        listen(doc.model.events.changed, self, self._on_change)
         self.rebuild()
 
     # -- building --------------------------------------------------------------------------------------------

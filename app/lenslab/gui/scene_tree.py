@@ -6,18 +6,17 @@ keeping where they are in the world, as in Blender's outliner."""
 from __future__ import annotations
 
 import json
-import math
 
-import numpy as np
 from PySide6.QtCore import QAbstractItemModel, QItemSelection, QItemSelectionModel, QMimeData, QModelIndex, Qt, Signal
 from PySide6.QtGui import QColor, QFont
 from PySide6.QtWidgets import QAbstractItemView, QMenu, QTreeView
 
 from lenslab.gui import theme
 from lenslab.gui.commands import MoveNodeCommand, RenameMaterialCommand
+from lenslab.gui.document import listen
 from lenslab.gui.properties import display_rgb
+from lenslab.scene.editing import can_move, reparented_transform
 from lenslab.scene.shapes import Box, MeshFile, Rectangle, Sphere
-from lenslab.scene.transform import Transform
 
 NODE_MIME = "application/x-lenslab-node-paths"
 
@@ -51,7 +50,7 @@ class SceneTreeModel(QAbstractItemModel):
         self._root = _Item(("root",), None)
         self._by_key: dict[tuple, _Item] = {}
         self._build()
-        doc.changed.connect(self._on_change)
+        listen(doc.model.events.changed, self, self._on_change)
 
     # -- structure -------------------------------------------------------------------------------------------
     def _build(self) -> None:
@@ -276,51 +275,12 @@ class SceneTreeModel(QAbstractItemModel):
         return False  # we moved it ourselves; Qt must not remove the source row
 
 
-def world_matrix(doc, path: tuple) -> np.ndarray:
-    m = np.eye(4)
-    for i in range(1, len(path) + 1):
-        m = m @ doc.node(path[:i]).transform.matrix()
-    return m
-
-
-def decompose(matrix: np.ndarray) -> Transform | None:
-    """Translate, Euler XYZ rotation and scale of a 4x4 matrix; None when it holds a shear we cannot express."""
-    t = matrix[:3, 3]
-    a = matrix[:3, :3]
-    scale = np.linalg.norm(a, axis=0)
-    if np.any(scale < 1e-12):
-        return None
-    if np.linalg.det(a) < 0:
-        scale[0] = -scale[0]
-    r = a / scale
-    ry = math.asin(max(-1.0, min(1.0, -r[2, 0])))
-    if abs(r[2, 0]) < 0.999999:
-        rx = math.atan2(r[2, 1], r[2, 2])
-        rz = math.atan2(r[1, 0], r[0, 0])
-    else:  # gimbal lock: put it all in x
-        rx = math.atan2(-r[1, 2], r[1, 1])
-        rz = 0.0
-    clean = lambda v: 0.0 if abs(v) < 1e-9 else float(round(v, 9))  # noqa: E731
-    out = Transform(translate=tuple(clean(v) for v in t),
-                    rotate_deg=tuple(clean(math.degrees(v)) for v in (rx, ry, rz)),
-                    scale=tuple(clean(v) for v in scale))
-    if not np.allclose(out.matrix(), matrix, atol=1e-6):
-        return None
-    return out
-
-
 def move_node(doc, src: tuple, dst_parent: tuple, index: int) -> bool:
     """Re-parent ``src`` under ``dst_parent`` at ``index``, keeping its place in the world when possible."""
-    src, dst_parent = tuple(src), tuple(dst_parent)
-    if dst_parent[: len(src)] == src:
-        return False  # into itself or its own subtree
-    if dst_parent == src[:-1] and index in (src[-1], src[-1] + 1):
-        return False  # dropped where it already is
-    transform = None
-    if dst_parent != src[:-1]:
-        local = np.linalg.inv(world_matrix(doc, dst_parent)) @ world_matrix(doc, src) if dst_parent else world_matrix(doc, src)
-        transform = decompose(local)
-    doc.push(MoveNodeCommand(doc, src, dst_parent, index, transform))
+    if not can_move(src, dst_parent, index):
+        return False
+    transform = reparented_transform(doc.model, src, dst_parent)
+    doc.push(MoveNodeCommand(doc, tuple(src), tuple(dst_parent), index, transform))
     return True
 
 

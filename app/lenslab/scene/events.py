@@ -1,9 +1,10 @@
 """Observing a scene while it is edited: a small event emitter with no GUI toolkit in it.
 
-The scene classes are plain dataclasses; whoever edits them (the studio's undo commands, a script) says what
-changed by emitting a :class:`SceneChange` on a :class:`SceneEvents`. Observers (the viewport, the outliner,
-the render worker's feeder) connect callables and decide for themselves what to refresh, as napari's layers
-do with their event groups. Nothing here imports Qt, so a headless tool can observe a scene the same way.
+The scene classes are plain dataclasses; the scene open for editing (:class:`~lenslab.scene.editable.EditableScene`)
+owns a :class:`SceneEvents` and says what each edit changed by emitting a :class:`SceneChange` on it. Observers
+(the viewport, the outliner, the render worker's feeder, a script) connect callables to it directly and decide
+for themselves what to refresh, as napari's widgets listen to its layers' event groups. Nothing here imports
+Qt, so a headless tool observes a scene the same way the studio does.
 
     events = SceneEvents()
     events.changed.connect(lambda change: print(change.kind, change.field))
@@ -12,6 +13,7 @@ do with their event groups. Nothing here imports Qt, so a headless tool can obse
 
 from __future__ import annotations
 
+import sys
 from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any, Callable, Iterator
@@ -46,7 +48,11 @@ class SceneChange:
 
 
 class EventEmitter:
-    """Callables connected to one kind of event; ``emit`` calls them in the order they were connected."""
+    """Callables connected to one kind of event; ``emit`` calls them in the order they were connected.
+
+    A callback that raises does not stop the others, nor unwind the edit that is announcing itself half way
+    through: its error goes to ``sys.excepthook`` (which prints it, or fails the test under pytest-qt) and the
+    next callback runs, as with a Qt signal's slots."""
 
     def __init__(self) -> None:
         self._callbacks: list[Callable[[Any], None]] = []
@@ -68,7 +74,10 @@ class EventEmitter:
         if self._blocked:
             return
         for callback in list(self._callbacks):  # a callback may disconnect itself
-            callback(event)
+            try:
+                callback(event)
+            except Exception:  # noqa: BLE001 (reported, not swallowed: see the class's docstring)
+                sys.excepthook(*sys.exc_info())
 
     @contextmanager
     def blocked(self) -> Iterator[None]:
@@ -84,7 +93,7 @@ class EventEmitter:
 
 
 class SceneEvents:
-    """The events of one edited scene: ``changed`` carries a :class:`SceneChange`."""
+    """The events of one edited scene: ``changed`` carries a :class:`SceneChange` after each edit."""
 
     def __init__(self) -> None:
         self.changed = EventEmitter()
