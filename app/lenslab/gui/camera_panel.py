@@ -39,6 +39,7 @@ from lenslab.optics import (
     parse_f_number,
     step_stop,
 )
+from lenslab.optics.sensors import crop_factor
 from lenslab.scene.camera import ThinLensCamera
 from lenslab.scene.fields import declared_range
 
@@ -604,7 +605,7 @@ class CameraPanel(QWidget):
             self.sensor_combo.setCurrentIndex(index)
             self.sensor_w.set_quietly(sw)
             self.sensor_h.set_quietly(sh)
-            crop = math.hypot(36, 24) / math.hypot(sw, sh)
+            crop = crop_factor(sw, sh)
             coc = circle_of_confusion_mm(sw, sh)
             self.sensor_info.setText(f"Crop factor {crop:.2f} · circle of confusion {coc * 1000:.0f} µm · "
                                      f"{cam.focal_length_mm * crop:.0f} mm full-frame equivalent")

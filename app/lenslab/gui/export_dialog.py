@@ -31,6 +31,9 @@ from lenslab.gui.controller import rate_text
 from lenslab.gui.document import copy_scene
 from lenslab.gui.worker import ExportRequest
 from lenslab.render.film import TONE_MAPS
+from lenslab.scene.camera import MAX_IMAGE_SIDE
+from lenslab.scene.fields import declared_range
+from lenslab.scene.scene import RenderSettings
 
 FORMATS = (("OpenEXR — linear float, for grading", ".exr"), ("PNG — sRGB, tone mapped", ".png"))
 
@@ -73,7 +76,7 @@ class ExportDialog(QDialog):
         self.width_spin = QSpinBox()
         self.height_spin = QSpinBox()
         for spin, value in ((self.width_spin, cam.resolution[0]), (self.height_spin, cam.resolution[1])):
-            spin.setRange(1, 16384)
+            spin.setRange(1, MAX_IMAGE_SIDE)
             spin.setValue(value)
             spin.setSuffix(" px")
         self.lock_aspect = QCheckBox("Keep aspect")
@@ -99,7 +102,7 @@ class ExportDialog(QDialog):
         group.addButton(self.by_time)
         self.by_samples.setChecked(True)
         self.spp_spin = QSpinBox()
-        self.spp_spin.setRange(1, 1 << 24)
+        self.spp_spin.setRange(*declared_range(RenderSettings, "spp"))
         self.spp_spin.setValue(doc.scene.render.spp)
         self.seconds_spin = QDoubleSpinBox()
         self.seconds_spin.setRange(0.1, 1e6)
