@@ -35,7 +35,7 @@ from lenslab.gui import theme
 from lenslab.gui.camera_panel import CameraPanel, format_distance
 from lenslab.gui.commands import (AddLightCommand, AddMaterialCommand, AddNodeCommand, RemoveLightsCommand,
                                   RemoveMaterialCommand, RemoveNodesCommand)
-from lenslab.gui.controller import QUALITIES, SAMPLE_LIMITS, RenderController, elapsed_text, rate_text, samples_text
+from lenslab.gui.controller import SAMPLE_LIMITS, RenderController, elapsed_text, rate_text, samples_text
 from lenslab.gui.defaults import studio_scene
 from lenslab.gui.document import Document, is_shipped, listen
 from lenslab.gui.export_dialog import ExportDialog
@@ -665,7 +665,8 @@ class MainWindow(QMainWindow):
         try:
             save_scene(editing.with_mesh_paths(self.doc.scene, mesh_paths), path)
         except OSError as exc:
-            QMessageBox.critical(self, "Cannot save scene", f"{path}: {exc.strerror or exc}")
+            reason = exc.strerror or str(exc)  # the writer's own messages name the file already
+            QMessageBox.critical(self, "Cannot save scene", reason if str(path) in reason else f"{path}: {reason}")
             return False
         self.doc.saved_as(path, mesh_paths)
         self._add_recent(path)

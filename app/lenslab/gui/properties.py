@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import os
 import typing
 from pathlib import Path
 from typing import Any, Callable
@@ -35,11 +34,12 @@ from lenslab.gui import theme
 from lenslab.gui.commands import AddMaterialCommand, RenameMaterialCommand
 from lenslab.gui.document import listen
 from lenslab.gui.widgets import ColorEdit, IntEdit, NumberEdit, Section, VectorEdit, hint
+from lenslab.scene.editing import file_reference
 from lenslab.scene.lights import LIGHT_TYPES, Light
 from lenslab.scene.materials import MATERIAL_TYPES, Diffuse, Material
 from lenslab.scene.io.meshes import MESH_SUFFIXES
 from lenslab.scene.scene import ENVIRONMENT_TYPES, Environment, Node
-from lenslab.scene.shapes import SHAPE_TYPES, Box, Disk, MeshFile, Rectangle, Relief, Shape, Sphere
+from lenslab.scene.shapes import SHAPE_TYPES, Box, Disk, Rectangle, Relief, Shape, Sphere
 
 #: Polymorphic slots: the base class picks the registry of concrete types to choose from.
 TAGGED_TYPES: dict[type, dict[str, type]] = {Shape: SHAPE_TYPES, Material: MATERIAL_TYPES,
@@ -445,7 +445,7 @@ class PropertyEditor(QWidget):
             pattern = "Meshes (" + " ".join("*" + s for s in MESH_SUFFIXES) + ")"
             name, _ = QFileDialog.getOpenFileName(self, "Mesh file", start, pattern)
             if name:
-                self._commit(target, path, _relative_to_scene(self.doc, name), False)
+                self._commit(target, path, file_reference(Path(name), self.doc.path), False)
 
         line.editingFinished.connect(
             lambda: self._commit(target, path, line.text(), False) if line.text() != self.doc.get_value(target, path) else None)
@@ -514,17 +514,6 @@ def _display_rgb(material) -> tuple:
             peak = max(max(rgb), 1e-9)
             return tuple(c / peak for c in rgb) if peak > 1 else rgb
     return (0.5, 0.5, 0.5)
-
-
-def _relative_to_scene(doc, file_name: str) -> str:
-    """Mesh paths are stored relative to the scene file when it has one and the mesh is beside or below it."""
-    path = Path(file_name).resolve()
-    if doc.path is not None:
-        try:
-            return os.path.relpath(path, Path(doc.path).resolve().parent)
-        except ValueError:
-            pass
-    return str(path)
 
 
 def display_rgb(material) -> tuple:
