@@ -20,8 +20,9 @@ from lenslab.scene.editable import EditableScene, unique_name
 from lenslab.scene.events import SceneChange
 from lenslab.scene.lights import PointLight, SunLight
 from lenslab.scene.materials import Diffuse, Emissive
-from lenslab.scene.scene import Node, Scene
+from lenslab.scene.scene import EnvironmentMap, Node, Scene
 from lenslab.scene.shapes import Box, MeshFile, Rectangle, Sphere
+from lenslab.scene.textures import Checkerboard, ImageTexture
 from lenslab.scene.transform import Transform
 
 VIEW_WIDTH = 1.8
@@ -255,21 +256,31 @@ def test_decomposing_a_sheared_matrix_gives_none():
 
 
 # -- saving -----------------------------------------------------------------------------------------------------
-def test_saving_elsewhere_renames_relative_mesh_paths_in_a_copy_only(tmp_path):
+def test_saving_elsewhere_renames_relative_file_names_in_a_copy_only(tmp_path):
     absolute = str((tmp_path / "library" / "statue.obj").resolve())
     model = model_of(Node("vase", shape=MeshFile(file="meshes/vase.obj")),
                      Node("group", children=[Node("statue", shape=MeshFile(file=absolute)),
                                              Node("cup", shape=MeshFile(file="../cups/cup.obj"))]))
+    model.scene.materials["wood"] = Diffuse(albedo_texture=ImageTexture(file="textures/wood.png"))
+    model.scene.materials["checks"] = Diffuse(albedo_texture=Checkerboard())
+    model.scene.environment = EnvironmentMap(file="sky.exr")
     model.scene.source_path = tmp_path / "shots" / "a" / "scene.json"
     new_folder = tmp_path / "shots" / "b" / "c"
-    moved = editing.rebased_mesh_paths(model, new_folder)
-    assert set(moved) == {(0,), (1, 1)}  # the absolute path stays as it is
-    for path, file in moved.items():
-        before = (tmp_path / "shots" / "a" / model.node(path).shape.file).resolve()
-        assert (new_folder / file).resolve() == before  # the same file, named from the new folder
-    copy = editing.with_mesh_paths(model.scene, moved)
-    assert copy.nodes[0].shape.file == moved[(0,)] and copy.nodes[1].children[1].shape.file == moved[(1, 1)]
+    moved = editing.rebased_file_paths(model, new_folder)
+    # The absolute path stays as it is; a checkerboard names no file.
+    assert set(moved) == {(("node", (0,)), ("shape", "file")), (("node", (1, 1)), ("shape", "file")),
+                          (("material", "wood"), ("albedo_texture", "file")), (("environment",), ("file",))}
+    for (target, field), name in moved.items():
+        before = (tmp_path / "shots" / "a" / model.get_value(target, field)).resolve()
+        assert (new_folder / name).resolve() == before  # the same file, named from the new folder
+    copy = editing.with_file_paths(model.scene, moved)
+    assert copy.nodes[0].shape.file == "../../a/meshes/vase.obj"
+    assert copy.nodes[1].children[1].shape.file == "../../cups/cup.obj"
+    assert copy.materials["wood"].albedo_texture.file == "../../a/textures/wood.png"
+    assert copy.environment.file == "../../a/sky.exr"
     assert copy.source_path == model.scene.source_path
     # The open scene is as it was.
     assert model.node((0,)).shape.file == "meshes/vase.obj" and model.node((1, 1)).shape.file == "../cups/cup.obj"
-    assert editing.rebased_mesh_paths(model, tmp_path / "shots" / "a") == {}
+    assert model.scene.materials["wood"].albedo_texture.file == "textures/wood.png"
+    assert model.scene.environment.file == "sky.exr"
+    assert editing.rebased_file_paths(model, tmp_path / "shots" / "a") == {}

@@ -1,4 +1,4 @@
-"""Saving in the studio: relative mesh paths follow the scene into a new folder, and a save that fails leaves the
+"""Saving in the studio: relative file names (meshes, textures, the environment map) follow the scene into a new folder, and a save that fails leaves the
 open scene exactly as it was (mesh paths, file, modified state, history)."""
 
 from __future__ import annotations
@@ -7,12 +7,14 @@ import copy
 import errno
 from pathlib import Path
 
+import numpy as np
 import pytest
 from PySide6.QtWidgets import QLineEdit, QMessageBox
 
+from lenslab.render.film import write_image
 from lenslab.scene.events import SceneChange
 from lenslab.scene.io.native import load_scene, save_scene
-from lenslab.scene.scene import Node
+from lenslab.scene.scene import EnvironmentMap, Node
 from lenslab.scene.shapes import MeshFile
 from lenslab.scene.transform import Transform
 
@@ -30,6 +32,8 @@ def studio(make_window, small_scene, tmp_path):
     folder = tmp_path / "shots" / "a"
     (folder / "meshes").mkdir(parents=True)
     (folder / "meshes" / "tetra.obj").write_text(TETRAHEDRON)
+    write_image(folder / "sky.exr", np.full((4, 8, 3), 0.5, np.float32))
+    small_scene.environment = EnvironmentMap(file="sky.exr")
     small_scene.nodes.append(Node("tetra", Transform(translate=(0.2, 0.1, 0.2), scale=(0.1, 0.1, 0.1)),
                                   MeshFile(file="meshes/tetra.obj")))
     small_scene.source_path = (folder / "scene.json").resolve()
@@ -112,6 +116,8 @@ def test_saving_into_another_folder_renames_mesh_paths_and_the_studio_hears_of_i
     assert doc.node(mesh).shape.file == renamed
     assert doc.scene.source_path == target.resolve() and doc.path == target
     assert SceneChange("node", ("node", mesh), ("shape", "file")) in heard
+    # Every file the scene names follows it, not only meshes: here the environment map.
+    assert saved.environment.file == str(Path("..") / "a" / "sky.exr") == doc.scene.environment.file
     assert file_field(studio).text() == renamed  # the property editor shows the new name
     assert not doc.modified and doc.undo_stack.undoText() == "Aperture f/4"
     # The renderer still finds the mesh.

@@ -90,14 +90,15 @@ class Document(QObject):
         self.selection_changed.emit()
         self.file_changed.emit()
 
-    def saved_as(self, path: Path, mesh_paths: dict[tuple[int, ...], str] | None = None) -> None:
-        """The scene has been written to ``path``; ``mesh_paths`` are the mesh files the written copy names
-        differently (``lenslab.scene.editing.rebased_mesh_paths``), which the open scene now takes on: the same
-        files, named from the new folder. That is announced but is no undo step: nothing a user sees changed."""
+    def saved_as(self, path: Path, file_paths: dict | None = None) -> None:
+        """The scene has been written to ``path``; ``file_paths`` are the files (meshes, textures, the
+        environment map) the written copy names differently (``lenslab.scene.editing.rebased_file_paths``),
+        which the open scene now takes on: the same files, named from the new folder. That is announced but is
+        no undo step: nothing a user sees changed."""
         self.path = Path(path)
         self.scene.source_path = self.path.resolve()
-        for node_path, file in (mesh_paths or {}).items():
-            self.model.apply_value(("node", node_path), ("shape", "file"), file)
+        for (target, field), name in (file_paths or {}).items():
+            self.model.apply_value(target, field, name)
         self.display_name = self.path.parent.name if self.path.name == "scene.json" else self.path.stem
         self.undo_stack.setClean()
         self.file_changed.emit()

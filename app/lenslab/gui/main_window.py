@@ -659,16 +659,16 @@ class MainWindow(QMainWindow):
 
     def _write(self, path: Path) -> bool:
         path = Path(path)
-        # Relative mesh paths are rewritten for the new folder in the copy that is written; the open scene takes
-        # them on only once the file is there, so a failed save leaves it exactly as it was.
-        mesh_paths = editing.rebased_mesh_paths(self.doc.model, path.resolve().parent)
+        # Relative file names (meshes, textures, the environment map) are rewritten for the new folder in the
+        # copy that is written; the open scene takes them on only once the file is there, so a failed save leaves it exactly as it was.
+        file_paths = editing.rebased_file_paths(self.doc.model, path.resolve().parent)
         try:
-            save_scene(editing.with_mesh_paths(self.doc.scene, mesh_paths), path)
+            save_scene(editing.with_file_paths(self.doc.scene, file_paths), path)
         except OSError as exc:
             reason = exc.strerror or str(exc)  # the writer's own messages name the file already
             QMessageBox.critical(self, "Cannot save scene", reason if str(path) in reason else f"{path}: {reason}")
             return False
-        self.doc.saved_as(path, mesh_paths)
+        self.doc.saved_as(path, file_paths)
         self._add_recent(path)
         self.statusBar().showMessage(f"Saved {path}", 4000)
         return True

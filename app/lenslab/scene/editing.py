@@ -2,7 +2,7 @@
 
 Each function looks at an :class:`~lenslab.scene.editable.EditableScene` and returns what an edit should be:
 the node to add and where it goes, the focus distance that makes a selection sharp, the transform that keeps a
-re-parented node where it is, the mesh paths a save must rewrite. None of them changes the scene: the studio
+re-parented node where it is, the file names a save must rewrite. None of them changes the scene: the studio
 wraps what they return in undo commands (``lenslab.gui.commands``); a script may apply it directly. Camera
 geometry comes from the camera's frame (``ThinLensCamera.frame()``), its one home. No Qt here
 (tests/test_editing.py checks).
@@ -11,11 +11,12 @@ geometry comes from the camera's frame (``ThinLensCamera.frame()``), its one hom
 from __future__ import annotations
 
 import copy
+import dataclasses
 import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Iterable
+from typing import Iterable, Iterator
 
 import numpy as np
 
@@ -24,8 +25,9 @@ from lenslab.scene.camera import CameraFrame
 from lenslab.scene.editable import EditableScene
 from lenslab.scene.lights import Light, PointLight, SunLight
 from lenslab.scene.materials import Diffuse, Emissive, Material
-from lenslab.scene.scene import Node, Scene
+from lenslab.scene.scene import EnvironmentMap, Node, Scene
 from lenslab.scene.shapes import Box, MeshFile, Rectangle, Sphere
+from lenslab.scene.textures import ImageTexture
 from lenslab.scene.transform import Transform
 
 #: What Edit > Add makes; "light" is an area light (an emissive rectangle), "group" a node without a shape.
@@ -135,12 +137,16 @@ def mesh_node(model: EditableScene, path: Path, vertices: np.ndarray,
 def file_reference(path: Path, scene_file: Path | None) -> str:
     """How a scene names a file: relative to the scene file's folder when it has one, else absolute."""
     path = Path(path).resolve()
-    if scene_file is not None:
-        try:
-            return os.path.relpath(path, Path(scene_file).resolve().parent)
-        except ValueError:  # another drive (Windows)
-            pass
-    return str(path)
+    return relative_file_name(path, Path(scene_file).resolve().parent) if scene_file is not None else str(path)
+
+
+def relative_file_name(path: Path, folder: Path) -> str:
+    """``path`` named from ``folder`` (``../textures/wood.png``), or absolute where no relative name exists."""
+    path = Path(path).resolve()
+    try:
+        return os.path.relpath(path, Path(folder).resolve())
+    except ValueError:  # another drive (Windows)
+        return str(path)
 
 
 # -- focusing ---------------------------------------------------------------------------------------------------
@@ -222,33 +228,46 @@ def reparented_transform(model: EditableScene, src: tuple, dst_parent: tuple) ->
 
 
 # -- saving -----------------------------------------------------------------------------------------------------
-def rebased_mesh_paths(model: EditableScene, new_folder: Path) -> dict[tuple[int, ...], str]:
-    """The mesh paths that change when the scene is saved into ``new_folder``: each relative path, by node
-    path, re-expressed from there so that it still names the same file. Absolute paths stay as they are."""
+#: Where a file name sits in the scene: (target, field), as undo commands address values.
+FileField = tuple[tuple, tuple]
+
+
+def file_fields(model: EditableScene) -> Iterator[FileField]:
+    """Every file the scene names: mesh files, image textures of materials, the environment map."""
+    for path, node in model.walk_nodes():
+        if isinstance(node.shape, MeshFile):
+            yield ("node", path), ("shape", "file")
+    for name, material in model.scene.materials.items():
+        for field in dataclasses.fields(material):
+            if isinstance(getattr(material, field.name), ImageTexture):
+                yield ("material", name), (field.name, "file")
+    if isinstance(model.scene.environment, EnvironmentMap):
+        yield ("environment",), ("file",)
+
+
+def rebased_file_paths(model: EditableScene, new_folder: Path) -> dict[FileField, str]:
+    """The file names that change when the scene is saved into ``new_folder``: each relative name
+    re-expressed from there so that it still names the same file. Absolute names stay as they are."""
     old_folder = model.scene.base_dir().resolve()
     new_folder = Path(new_folder).resolve()
     if old_folder == new_folder:
         return {}
-    out: dict[tuple[int, ...], str] = {}
-    for path, node in model.walk_nodes():
-        shape = node.shape
-        if isinstance(shape, MeshFile) and shape.file and not Path(shape.file).is_absolute():
-            absolute = (old_folder / shape.file).resolve()
-            try:
-                out[path] = os.path.relpath(absolute, new_folder)
-            except ValueError:  # another drive (Windows)
-                out[path] = str(absolute)
+    out: dict[FileField, str] = {}
+    for target, field in file_fields(model):
+        name = model.get_value(target, field)
+        if name and not Path(name).is_absolute():
+            out[target, field] = relative_file_name(old_folder / name, new_folder)
     return out
 
 
-def with_mesh_paths(scene: Scene, mesh_paths: dict[tuple[int, ...], str]) -> Scene:
-    """A copy of ``scene`` whose meshes at the given node paths name the given files; ``scene`` is untouched
-    (a save writes the copy, so that a failed save leaves the open scene as it was)."""
+def with_file_paths(scene: Scene, file_paths: dict[FileField, str]) -> Scene:
+    """A copy of ``scene`` that names the given files at the given places; ``scene`` is untouched (a save
+    writes the copy, so that a failed save leaves the open scene as it was)."""
     out = copy.deepcopy(scene)
     out.source_path = scene.source_path
     copy_model = EditableScene(out)
-    for path, file in mesh_paths.items():
-        copy_model.node(path).shape.file = file
+    for (target, field), name in file_paths.items():
+        copy_model.apply_value(target, field, name, notify=False)
     return out
 
 
