@@ -87,7 +87,7 @@ def test_the_studio_hears_an_edit_made_on_the_scene_itself(qtbot, window):
     camera panel, the viewport's tag and the render worker's feeder."""
     doc = window.doc
     assert not hasattr(doc, "changed")  # nothing re-emits the scene's events as a Qt signal
-    tall = next(p for p, n in doc.walk_nodes() if n.name == "tall box")
+    tall = next(p for p, n in doc.model.walk_nodes() if n.name == "tall box")
     doc.set_selection([("node", tall)])
     generation = window.controller.generation
     doc.model.apply_value(("node", tall), ("name",), "giant box")

@@ -46,7 +46,7 @@ def studio(make_window, small_scene, tmp_path):
 
 
 def mesh_path(window) -> tuple:
-    return next(p for p, n in window.doc.walk_nodes() if n.name == "tetra")
+    return next(p for p, n in window.doc.model.walk_nodes() if n.name == "tetra")
 
 
 def file_field(window) -> QLineEdit:
@@ -63,7 +63,7 @@ def refuse_to_show(monkeypatch) -> list[str]:
 def assert_untouched(window, scene_before, path_before, source_before, steps_before, heard):
     doc = window.doc
     assert doc.scene == scene_before
-    assert doc.node(mesh_path(window)).shape.file == "meshes/tetra.obj"
+    assert doc.model.node(mesh_path(window)).shape.file == "meshes/tetra.obj"
     assert file_field(window).text() == "meshes/tetra.obj"
     assert doc.scene.source_path == source_before and doc.path == path_before
     assert doc.modified and window.isWindowModified()
@@ -113,7 +113,7 @@ def test_saving_into_another_folder_renames_mesh_paths_and_the_studio_hears_of_i
     # The file names the same mesh from its own folder; so does the open scene, which said so.
     saved = load_scene(target)
     assert saved.nodes[mesh[0]].shape.file == renamed and (target.parent / renamed).resolve() == original
-    assert doc.node(mesh).shape.file == renamed
+    assert doc.model.node(mesh).shape.file == renamed
     assert doc.scene.source_path == target.resolve() and doc.path == target
     assert SceneChange("node", ("node", mesh), ("shape", "file")) in heard
     # Every file the scene names follows it, not only meshes: here the environment map.

@@ -119,7 +119,7 @@ def test_clicking_an_object_focuses_at_its_depth(qtbot, window):
     clicks = []
     window.viewport.focus_clicked.connect(lambda u, v: clicks.append((u, v)))
     scene = copy.deepcopy(window.doc.scene)
-    names = [n.name for _p, n in window.doc.walk_nodes()]
+    names = [n.name for _p, n in window.doc.model.walk_nodes()]
     changes = []
     window.doc.model.events.changed.connect(changes.append)  # the scene's own events, no Qt signal
     for x, y, name in ((24.5, 28.5, "tall box"), (40.5, 40.5, "short box"), (36.5, 12.5, "back wall")):
@@ -148,10 +148,10 @@ def test_clicking_selects_and_the_viewport_outlines_the_selection(qtbot, window)
     wait_for_frame(qtbot, window)
     g = wait_for_gbuffer(qtbot, window)
     click_image(qtbot, window, 24.5, 28.5)
-    paths = window.doc.node_paths()
+    paths = window.doc.model.node_paths()
     index = int(g.node_index[28, 24])
     assert window.doc.selection == [("node", paths[index])]
-    assert window.doc.node(paths[index]).name == "tall box"
+    assert window.doc.model.node(paths[index]).name == "tall box"
     assert window.viewport._outline is not None
     # The outliner follows, and its selection drives the property editor.
     rows = window.scene_tree.selectionModel().selectedRows()
@@ -181,7 +181,7 @@ def test_undo_restores_each_edit(qtbot, window, tmp_path):
     edited()
     steps = doc.undo_stack.count()
     # Move a node through the property editor's transform fields.
-    tall = next(p for p, n in doc.walk_nodes() if n.name == "tall box")
+    tall = next(p for p, n in doc.model.walk_nodes() if n.name == "tall box")
     doc.set_selection([("node", tall)])
     translate = window.properties._editors[("transform", "translate")].widget
     translate.spins[0].setValue(0.05)
@@ -190,7 +190,7 @@ def test_undo_restores_each_edit(qtbot, window, tmp_path):
     material = window.properties._editors[("material",)].widget.findChild(type(combo))
     material.setCurrentIndex(material.findData("red"))
     edited()
-    assert doc.node(tall).material == "red"
+    assert doc.model.node(tall).material == "red"
     # Add, then delete.
     window.add_primitive("sphere")
     edited()
@@ -202,7 +202,7 @@ def test_undo_restores_each_edit(qtbot, window, tmp_path):
     obj.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n")
     with qtbot.waitSignal(window.mesh_imported, timeout=30000):
         drop_files(window, [obj])  # as if dragged from a file manager; read on a background thread
-    assert doc.node((len(doc.scene.nodes) - 1,)).shape.file == str(obj.resolve())
+    assert doc.model.node((len(doc.scene.nodes) - 1,)).shape.file == str(obj.resolve())
     edited()
     # Change a material's type (diffuse to emissive keeps its colour).
     doc.set_selection([("material", "green")])
@@ -232,21 +232,21 @@ def test_reparenting_in_the_outliner_keeps_the_world_position(window):
     from lenslab.scene.editing import world_matrix
 
     doc = window.doc
-    short = next(p for p, n in doc.walk_nodes() if n.name == "short box")
+    short = next(p for p, n in doc.model.walk_nodes() if n.name == "short box")
     before = world_matrix(doc.model, short)
-    walls = next(p for p, n in doc.walk_nodes() if n.name == "walls")
+    walls = next(p for p, n in doc.model.walk_nodes() if n.name == "walls")
     window.add_primitive("group")  # a new group at the plane of focus
     group = doc.selected_node_paths()[0]
-    group_name = doc.node(group).name
+    group_name = doc.model.node(group).name
     doc.set_value(("node", group), ("transform", "rotate_deg"), (0.0, 30.0, 0.0))
-    short = next(p for p, n in doc.walk_nodes() if n.name == "short box")
+    short = next(p for p, n in doc.model.walk_nodes() if n.name == "short box")
     assert move_node(doc, short, group, 0)
-    moved = next(p for p, n in doc.walk_nodes() if n.name == "short box")
-    assert doc.node(moved[:-1]).name == group_name  # the group moved up one place as the box left
+    moved = next(p for p, n in doc.model.walk_nodes() if n.name == "short box")
+    assert doc.model.node(moved[:-1]).name == group_name  # the group moved up one place as the box left
     assert abs(world_matrix(doc.model, moved) - before).max() < 1e-6
     assert not move_node(doc, walls, walls + (0,), 0)  # never into itself
     doc.undo_stack.undo()
-    assert doc.node(short).name == "short box"
+    assert doc.model.node(short).name == "short box"
 
 
 # -- export ---------------------------------------------------------------------------------------------------------

@@ -47,7 +47,7 @@ class SetValuesCommand(QUndoCommand):
         self.doc = doc
         self.target = tuple(target)
         self.new = {tuple(k): copy.deepcopy(v) for k, v in changes.items()}
-        self.old = {k: copy.deepcopy(doc.get_value(self.target, k)) for k in self.new}
+        self.old = {k: copy.deepcopy(doc.model.get_value(self.target, k)) for k in self.new}
         self.merge = merge
         self.stamp = time.monotonic()
 
@@ -115,7 +115,7 @@ class AddNodeCommand(QUndoCommand):
         self.doc = doc
         self.node = copy.deepcopy(node)
         self.parent_path = tuple(parent_path)
-        self.index = len(doc.children_of(self.parent_path)) if index is None else index
+        self.index = len(doc.model.children_of(self.parent_path)) if index is None else index
         self.old_selection = list(doc.selection)
 
     @property
@@ -123,34 +123,34 @@ class AddNodeCommand(QUndoCommand):
         return self.parent_path + (self.index,)
 
     def redo(self) -> None:
-        self.doc.children_of(self.parent_path).insert(self.index, copy.deepcopy(self.node))
+        self.doc.model.children_of(self.parent_path).insert(self.index, copy.deepcopy(self.node))
         self.doc.model.notify(SceneChange("structure", ("node", self.path)))
         self.doc.set_selection([("node", self.path)])
 
     def undo(self) -> None:
-        del self.doc.children_of(self.parent_path)[self.index]
-        self.doc.set_selection([t for t in self.old_selection if self.doc.exists(t)])
+        del self.doc.model.children_of(self.parent_path)[self.index]
+        self.doc.set_selection([t for t in self.old_selection if self.doc.model.exists(t)])
         self.doc.model.notify(SceneChange("structure", ("node", self.parent_path)))
 
 
 class RemoveNodesCommand(QUndoCommand):
     def __init__(self, doc, paths: list[tuple]):
         paths = _outermost(sorted({tuple(p) for p in paths}))
-        names = [doc.node(p).name for p in paths]
+        names = [doc.model.node(p).name for p in paths]
         super().__init__("Delete " + (names[0] if len(names) == 1 else f"{len(names)} nodes"))
         self.doc = doc
-        self.removed = [(p, copy.deepcopy(doc.node(p))) for p in paths]
+        self.removed = [(p, copy.deepcopy(doc.model.node(p))) for p in paths]
         self.old_selection = list(doc.selection)
 
     def redo(self) -> None:
         for path, _node in sorted(self.removed, reverse=True):  # deepest and last first: paths stay valid
-            del self.doc.children_of(path[:-1])[path[-1]]
+            del self.doc.model.children_of(path[:-1])[path[-1]]
         self.doc.set_selection([])
         self.doc.model.notify(SceneChange("structure"))
 
     def undo(self) -> None:
         for path, node in sorted(self.removed):
-            self.doc.children_of(path[:-1]).insert(path[-1], copy.deepcopy(node))
+            self.doc.model.children_of(path[:-1]).insert(path[-1], copy.deepcopy(node))
         self.doc.set_selection(self.old_selection)
         self.doc.model.notify(SceneChange("structure"))
 
@@ -172,7 +172,7 @@ class AddLightCommand(QUndoCommand):
 
     def undo(self) -> None:
         del self.doc.scene.lights[self.index]
-        self.doc.set_selection([t for t in self.old_selection if self.doc.exists(t)])
+        self.doc.set_selection([t for t in self.old_selection if self.doc.model.exists(t)])
         self.doc.model.notify(SceneChange("structure"))
 
 
@@ -212,7 +212,7 @@ class MoveNodeCommand(QUndoCommand):
     it where it was in the world."""
 
     def __init__(self, doc, src: tuple, dst_parent: tuple, dst_index: int, transform=None):
-        node = doc.node(src)
+        node = doc.model.node(src)
         super().__init__(f"Move {node.name}")
         self.doc = doc
         self.src = tuple(src)
@@ -232,16 +232,16 @@ class MoveNodeCommand(QUndoCommand):
         self.final = parent + (index,)
 
     def redo(self) -> None:
-        node = self.doc.children_of(self.src[:-1]).pop(self.src[-1])
+        node = self.doc.model.children_of(self.src[:-1]).pop(self.src[-1])
         node.transform = copy.deepcopy(self.new_transform)
-        self.doc.children_of(self.final[:-1]).insert(self.final[-1], node)
+        self.doc.model.children_of(self.final[:-1]).insert(self.final[-1], node)
         self.doc.model.notify(SceneChange("structure", ("node", self.final)))
         self.doc.set_selection([("node", self.final)])
 
     def undo(self) -> None:
-        node = self.doc.children_of(self.final[:-1]).pop(self.final[-1])
+        node = self.doc.model.children_of(self.final[:-1]).pop(self.final[-1])
         node.transform = copy.deepcopy(self.old_transform)
-        self.doc.children_of(self.src[:-1]).insert(self.src[-1], node)
+        self.doc.model.children_of(self.src[:-1]).insert(self.src[-1], node)
         self.doc.model.notify(SceneChange("structure", ("node", self.src)))
         self.doc.set_selection([("node", self.src)])
 
@@ -252,19 +252,19 @@ class AddMaterialCommand(QUndoCommand):
         self.doc = doc
         self.name = name
         self.material = copy.deepcopy(material)
-        self.assign = [(tuple(p), doc.node(p).material) for p in assign_to]
+        self.assign = [(tuple(p), doc.model.node(p).material) for p in assign_to]
 
     def redo(self) -> None:
         self.doc.scene.materials[self.name] = copy.deepcopy(self.material)
         for path, _old in self.assign:
-            self.doc.node(path).material = self.name
+            self.doc.model.node(path).material = self.name
         self.doc.model.notify(SceneChange("structure", ("material", self.name)))
 
     def undo(self) -> None:
         for path, old in self.assign:
-            self.doc.node(path).material = old
+            self.doc.model.node(path).material = old
         del self.doc.scene.materials[self.name]
-        self.doc.set_selection([t for t in self.doc.selection if self.doc.exists(t)])
+        self.doc.set_selection([t for t in self.doc.selection if self.doc.model.exists(t)])
         self.doc.model.notify(SceneChange("structure"))
 
 
@@ -277,13 +277,13 @@ class RemoveMaterialCommand(QUndoCommand):
         self.name = name
         self.material = copy.deepcopy(doc.scene.materials[name])
         self.position = list(doc.scene.materials).index(name)
-        self.users = doc.material_users(name)
+        self.users = doc.model.material_users(name)
 
     def redo(self) -> None:
         del self.doc.scene.materials[self.name]
         for path in self.users:
-            self.doc.node(path).material = ""
-        self.doc.set_selection([t for t in self.doc.selection if self.doc.exists(t)])
+            self.doc.model.node(path).material = ""
+        self.doc.set_selection([t for t in self.doc.selection if self.doc.model.exists(t)])
         self.doc.model.notify(SceneChange("structure"))
 
     def undo(self) -> None:
@@ -292,7 +292,7 @@ class RemoveMaterialCommand(QUndoCommand):
         self.doc.scene.materials.clear()
         self.doc.scene.materials.update(items)
         for path in self.users:
-            self.doc.node(path).material = self.name
+            self.doc.model.node(path).material = self.name
         self.doc.model.notify(SceneChange("structure", ("material", self.name)))
 
 
@@ -303,14 +303,14 @@ class RenameMaterialCommand(QUndoCommand):
         super().__init__(f"Rename material {old} to {new}")
         self.doc = doc
         self.old, self.new = old, new
-        self.users = doc.material_users(old)
+        self.users = doc.model.material_users(old)
 
     def _rename(self, a: str, b: str) -> None:
         items = [(b if k == a else k, v) for k, v in self.doc.scene.materials.items()]
         self.doc.scene.materials.clear()
         self.doc.scene.materials.update(items)
         for path in self.users:
-            self.doc.node(path).material = b
+            self.doc.model.node(path).material = b
         self.doc.selection = [("material", b) if t == ("material", a) else t for t in self.doc.selection]
         self.doc.model.notify(SceneChange("structure", ("material", b)))
         self.doc.selection_changed.emit()

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import copy
 from pathlib import Path
-from typing import Any, Callable, Iterator
+from typing import Any, Callable
 
 from PySide6.QtCore import QObject, Signal
 from PySide6.QtGui import QUndoStack
@@ -23,7 +23,7 @@ from lenslab.optics import LensPreset
 from lenslab.resources import scenes_dir
 from lenslab.scene.editable import CAMERA, EditableScene
 from lenslab.scene.events import EventEmitter
-from lenslab.scene.scene import Node, Scene
+from lenslab.scene.scene import Scene
 
 
 def is_shipped(path: Path | None) -> bool:
@@ -114,46 +114,9 @@ class Document(QObject):
         self.undo_stack.blockSignals(True)
         self.model.events.changed.disconnect()
 
-    # -- the scene by target (the model does the work; widgets ask here for short) --------------------------
-    def node(self, path) -> Node:
-        return self.model.node(path)
-
-    def children_of(self, parent_path) -> list[Node]:
-        return self.model.children_of(parent_path)
-
-    def resolve(self, target: tuple) -> Any:
-        return self.model.resolve(target)
-
-    def exists(self, target: tuple) -> bool:
-        return self.model.exists(target)
-
-    def get_value(self, target: tuple, field: tuple) -> Any:
-        return self.model.get_value(target, field)
-
-    def node_paths(self) -> list[tuple[int, ...]]:
-        return self.model.node_paths()
-
-    def walk_nodes(self) -> Iterator[tuple[tuple[int, ...], Node]]:
-        return self.model.walk_nodes()
-
-    def subtree_indices(self, path) -> list[int]:
-        return self.model.subtree_indices(path)
-
-    def material_users(self, name: str) -> list[tuple[int, ...]]:
-        return self.model.material_users(name)
-
-    def unique_node_name(self, base: str) -> str:
-        return self.model.unique_node_name(base)
-
-    def unique_material_name(self, base: str) -> str:
-        return self.model.unique_material_name(base)
-
-    def unique_light_name(self, base: str) -> str:
-        return self.model.unique_light_name(base)
-
     # -- selection -------------------------------------------------------------------------------------------
     def set_selection(self, targets: list[tuple]) -> None:
-        targets = [t for t in dict.fromkeys(tuple(t) for t in targets) if self.exists(t)]
+        targets = [t for t in dict.fromkeys(tuple(t) for t in targets) if self.model.exists(t)]
         if targets != self.selection:
             self.selection = targets
             self.selection_changed.emit()
@@ -174,7 +137,7 @@ class Document(QObject):
     def set_values(self, target: tuple, changes: dict[tuple, Any], text: str | None = None, merge: bool = False) -> None:
         from lenslab.gui.commands import SetValuesCommand  # commands know the document: import when used
 
-        changes = {tuple(k): v for k, v in changes.items() if self.get_value(target, tuple(k)) != v}
+        changes = {tuple(k): v for k, v in changes.items() if self.model.get_value(target, tuple(k)) != v}
         if not changes:
             return
         self.undo_stack.push(SetValuesCommand(self, target, changes, text, merge))
@@ -188,6 +151,4 @@ class Document(QObject):
 
 def copy_scene(scene: Scene) -> Scene:
     """An independent copy for another thread (the renderer never sees an object the GUI may still edit)."""
-    out = copy.deepcopy(scene)
-    out.source_path = scene.source_path
-    return out
+    return copy.deepcopy(scene)

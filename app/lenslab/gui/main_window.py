@@ -459,7 +459,7 @@ class MainWindow(QMainWindow):
     def _selection_changed(self) -> None:
         indices: list[int] = []
         for path in self.doc.selected_node_paths():
-            indices.extend(self.doc.subtree_indices(path))
+            indices.extend(self.doc.model.subtree_indices(path))
         self.viewport.set_selection(indices)
         self._update_actions()
 
@@ -527,14 +527,14 @@ class MainWindow(QMainWindow):
         if math.isfinite(depth):
             parts.append(f"depth {format_distance(depth)}")
         index = self.viewport.node_at(x, y)
-        paths = self.doc.node_paths()
+        paths = self.doc.model.node_paths()
         if 0 <= index < len(paths):
-            parts.append(self.doc.node(paths[index]).name)
+            parts.append(self.doc.model.node(paths[index]).name)
         self.readout.setText("   ·   ".join(parts))
 
     def _node_clicked(self, index: int, add: bool) -> None:
         g = self.viewport.gbuffer
-        paths = self.doc.node_paths()
+        paths = self.doc.model.node_paths()
         if g is not None and g.generation < self._structure_generation:
             return  # the picture's node numbers predate an edit of the tree
         target = [("node", paths[index])] if 0 <= index < len(paths) else []
@@ -558,8 +558,8 @@ class MainWindow(QMainWindow):
             self.viewport.hide_focus_overlay()
             self.statusBar().showMessage("Nothing there to focus on: that is the background.", 4000)
             return
-        paths = self.doc.node_paths()
-        name = self.doc.node(paths[result.node_index]).name if 0 <= result.node_index < len(paths) else "surface"
+        paths = self.doc.model.node_paths()
+        name = self.doc.model.node(paths[result.node_index]).name if 0 <= result.node_index < len(paths) else "surface"
         self.doc.set_camera(f"Focus on {name} ({result.depth:.2f} m)", False, focus_distance_m=float(result.depth))
         self.statusBar().showMessage(f"Focused on {name} at {format_distance(result.depth)}", 4000)
 
@@ -660,7 +660,8 @@ class MainWindow(QMainWindow):
     def _write(self, path: Path) -> bool:
         path = Path(path)
         # Relative file names (meshes, textures, the environment map) are rewritten for the new folder in the
-        # copy that is written; the open scene takes them on only once the file is there, so a failed save leaves it exactly as it was.
+        # copy that is written; the open scene takes them on only once the file is there, so a failed save
+        # leaves it exactly as it was.
         file_paths = editing.rebased_file_paths(self.doc.model, path.resolve().parent)
         try:
             save_scene(editing.with_file_paths(self.doc.scene, file_paths), path)
@@ -774,7 +775,7 @@ class MainWindow(QMainWindow):
     def delete_selection(self) -> None:
         nodes = self.doc.selected_node_paths()
         materials = [t[1] for t in self.doc.selection if t[0] == "material"]
-        lights = [t[1] for t in self.doc.selection if t[0] == "light" and self.doc.exists(t)]
+        lights = [t[1] for t in self.doc.selection if t[0] == "light" and self.doc.model.exists(t)]
         if not nodes and not materials and not lights:
             return
         stack = self.doc.undo_stack
@@ -822,7 +823,7 @@ class MainWindow(QMainWindow):
         if distance is None:
             self.statusBar().showMessage("The selection is behind the camera", 4000)
             return
-        name = self.doc.node(paths[0]).name
+        name = self.doc.model.node(paths[0]).name
         self.doc.set_camera(f"Focus on {name}", False, focus_distance_m=distance)
 
     # -- export -----------------------------------------------------------------------------------------------------
@@ -856,13 +857,14 @@ class MainWindow(QMainWindow):
         if self.export_id is not None:
             self.controller.cancel_export(self.export_id)
 
-    def _export_progress(self, progress) -> None:
+    def _export_progress(self, update) -> None:
         dialog = self.export_progress_dialog
-        if dialog is None or progress.request_id != self.export_id:
+        if dialog is None or update.request_id != self.export_id:
             return
+        progress = update.progress
         dialog.setValue(round(progress.fraction * 1000))
         goal = f" / {progress.target_spp}" if progress.target_spp else ""
-        limit = f" of {elapsed_text(progress.seconds)}" if progress.seconds else ""
+        limit = f" of {elapsed_text(progress.time_limit)}" if progress.time_limit else ""
         remaining = ""
         if 0.02 < progress.fraction < 1:
             remaining = f" · about {elapsed_text(progress.elapsed_seconds * (1 - progress.fraction) / progress.fraction)} left"

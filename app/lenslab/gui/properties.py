@@ -155,9 +155,9 @@ class PropertyEditor(QWidget):
         return self.doc.selection[0] if self.doc.selection else None
 
     def _structure_signature(self, target) -> tuple:
-        if target is None or not self.doc.exists(target):
+        if target is None or not self.doc.model.exists(target):
             return (None,)
-        obj = self.doc.resolve(target)
+        obj = self.doc.model.resolve(target)
         types = [type(obj)]
         for f in dataclasses.fields(obj):
             types.append(type(getattr(obj, f.name)))
@@ -173,13 +173,13 @@ class PropertyEditor(QWidget):
         layout = QVBoxLayout(container)
         layout.setContentsMargins(0, 0, 0, 0)
         layout.setSpacing(2)
-        if target is None or not self.doc.exists(target):
+        if target is None or not self.doc.model.exists(target):
             self.title.setText("Nothing selected")
             self.subtitle.setText("Select something in the scene tree or click it in the viewport (Q: select tool).")
             layout.addStretch(1)
             self._set_container(container)
             return
-        obj = self.doc.resolve(target)
+        obj = self.doc.model.resolve(target)
         kind = target[0]
         if kind == "node":
             self.title.setText(obj.name)
@@ -188,7 +188,7 @@ class PropertyEditor(QWidget):
             self._build_node(layout, obj)
         elif kind == "material":
             self.title.setText(target[1])
-            users = len(self.doc.material_users(target[1]))
+            users = len(self.doc.model.material_users(target[1]))
             self.subtitle.setText(f"Material · {type_name_of(obj)} · used by {users} node{'s' * (users != 1)}")
             self._build_material(layout, obj)
         elif kind == "light":
@@ -330,7 +330,7 @@ class PropertyEditor(QWidget):
 
         def changed(_index: int) -> None:
             chosen = combo.currentData()
-            current = self.doc.get_value(target, path)
+            current = self.doc.model.get_value(target, path)
             if chosen is None:
                 new = None
             else:
@@ -400,7 +400,7 @@ class PropertyEditor(QWidget):
             if path[-1] == "file" and len(path) >= 2 and path[-2] == "shape":
                 return self._file_editor(target, path, value)
             line = QLineEdit(value)
-            line.editingFinished.connect(lambda: commit(line.text(), False) if line.text() != self.doc.get_value(target, path) else None)
+            line.editingFinished.connect(lambda: commit(line.text(), False) if line.text() != self.doc.model.get_value(target, path) else None)
             return FieldEditor(line, lambda v: line.setText(v) if not line.hasFocus() else None)
         if origin is tuple and args and all(a in (int, float) for a in args):
             n = len(args)
@@ -420,7 +420,7 @@ class PropertyEditor(QWidget):
             def vec_commit(v, merge, vec=vec):
                 v = tuple(int(c) if integer else float(c) for c in v)
                 if nonzero and any(c == 0 for c in v):
-                    vec.set_value(self.doc.get_value(target, path))  # a zero scale would flatten the object
+                    vec.set_value(self.doc.model.get_value(target, path))  # a zero scale would flatten the object
                     return
                 commit(v, merge)
 
@@ -448,7 +448,7 @@ class PropertyEditor(QWidget):
                 self._commit(target, path, file_reference(Path(name), self.doc.path), False)
 
         line.editingFinished.connect(
-            lambda: self._commit(target, path, line.text(), False) if line.text() != self.doc.get_value(target, path) else None)
+            lambda: self._commit(target, path, line.text(), False) if line.text() != self.doc.model.get_value(target, path) else None)
         browse.clicked.connect(choose)
         layout.addWidget(line, 1)
         layout.addWidget(browse)
@@ -456,19 +456,19 @@ class PropertyEditor(QWidget):
 
     # -- editing and refreshing ----------------------------------------------------------------------------------
     def _commit(self, target, path, value, merge, text=None) -> None:
-        if target is None or not self.doc.exists(target):
+        if target is None or not self.doc.model.exists(target):
             return
-        if path and self.doc.get_value(target, path) == value:
+        if path and self.doc.model.get_value(target, path) == value:
             return
         self.doc.set_value(target, path, value, text=text, merge=merge)
 
     def _new_material_for_node(self) -> None:
         if self.target is None or self.target[0] != "node":
             return
-        node = self.doc.resolve(self.target)
+        node = self.doc.model.resolve(self.target)
         base = self.doc.scene.materials.get(node.material)
         material = convert_type(base, type(base)) if base is not None else Diffuse()
-        name = self.doc.unique_material_name(f"{node.name} material")
+        name = self.doc.model.unique_material_name(f"{node.name} material")
         self.doc.push(AddMaterialCommand(self.doc, name, material, assign_to=[self.target[1]]))
 
     def _on_change(self, change) -> None:
@@ -476,19 +476,19 @@ class PropertyEditor(QWidget):
         if target != self.target or self._structure_signature(target) != self._signature:
             self.rebuild()
             return
-        if target is None or not self.doc.exists(target):
+        if target is None or not self.doc.model.exists(target):
             return
         if change.kind in ("scene", "structure") or change.target == target:
             for path, editor in self._editors.items():
                 if path and path[-1] == "__type__":
                     continue
                 try:
-                    editor.refresh(self.doc.get_value(target, path))
+                    editor.refresh(self.doc.model.get_value(target, path))
                 except (AttributeError, KeyError):
                     self.rebuild()
                     return
             if target[0] in ("node", "light"):
-                self.title.setText(self.doc.resolve(target).name)
+                self.title.setText(self.doc.model.resolve(target).name)
 
 
 def _quiet(widget, setter, value) -> None:

@@ -145,7 +145,7 @@ class SceneTreeModel(QAbstractItemModel):
         key = index.internalPointer().key
         kind = key[0]
         try:
-            obj = self.doc.resolve(key) if kind in TARGET_KINDS else None
+            obj = self.doc.model.resolve(key) if kind in TARGET_KINDS else None
         except (KeyError, IndexError):
             return None
         group = key in GROUPS
@@ -198,7 +198,7 @@ class SceneTreeModel(QAbstractItemModel):
         if key == LIGHTS:
             return "Point lights and suns. Area lights are objects with an emissive material."
         if kind == "material":
-            users = len(self.doc.material_users(key[1]))
+            users = len(self.doc.model.material_users(key[1]))
             return f"<b>{key[1]}</b><br>{obj.type_name} · used by {users} node{'s' * (users != 1)}"
         if kind == "camera":
             from lenslab.optics import format_f_number, format_focal_length
@@ -229,7 +229,7 @@ class SceneTreeModel(QAbstractItemModel):
         if not text:
             return False
         if key[0] in ("node", "light"):
-            if text != self.doc.resolve(key).name:
+            if text != self.doc.model.resolve(key).name:
                 self.doc.set_value(key, ("name",), text, text=f"Rename to {text}")
             return True
         if key[0] == "material" and text != key[1]:
@@ -269,7 +269,7 @@ class SceneTreeModel(QAbstractItemModel):
             return False
         key = self.key(parent)
         dst_parent = key[1] if key is not None and key[0] == "node" else ()
-        count = len(self.doc.children_of(dst_parent))
+        count = len(self.doc.model.children_of(dst_parent))
         index = count if row < 0 else min(row, count)
         move_node(self.doc, paths[0], dst_parent, index)
         return False  # we moved it ourselves; Qt must not remove the source row

@@ -81,12 +81,7 @@ class ExportRequest:
 @dataclass(frozen=True)
 class ExportProgress:
     request_id: int
-    samples_per_pixel: int
-    target_spp: int | None
-    elapsed_seconds: float
-    seconds: float | None
-    fraction: float
-    samples_per_second: float
+    progress: object  # lenslab.render.job.JobProgress of the export's render job
 
 
 # -- messages from the GUI thread to the worker (through its queue) ---------------------------------------
@@ -504,9 +499,7 @@ class RenderWorker(QThread):
             now = time.perf_counter()
             if now - export.last_report >= EXPORT_PROGRESS_INTERVAL:
                 export.last_report = now
-                self.export_progress.emit(ExportProgress(
-                    export.request_id, progress.samples_per_pixel, progress.target_spp, progress.elapsed_seconds,
-                    progress.time_limit, progress.fraction, progress.samples_per_second))
+                self.export_progress.emit(ExportProgress(export.request_id, progress))
             return
         # Done: the job has a sample in every pixel; the file is written whole or not at all.
         self._export = None

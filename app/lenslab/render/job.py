@@ -24,8 +24,8 @@ from lenslab.optics.sensors import crop_factor
 from lenslab.render.tracer import DEFAULT_DISPATCH_SECONDS, Renderer, RenderSession
 from lenslab.scene.scene import Scene
 
-#: A slice of the first pass, finished after the time limit, renders for about this long between reports.
-FINISHING_SLICE_SECONDS = 0.5
+#: :meth:`RenderJob.run` renders for about this long between progress reports.
+REPORT_SECONDS = 0.5
 
 
 @dataclass(frozen=True)
@@ -88,7 +88,7 @@ class RenderJob:
         pass is still unfinished) and report. Does nothing once the job is finished."""
         if not self.finished:
             if self._out_of_time():  # only the first pass is left to finish
-                self.session.step(max(seconds, FINISHING_SLICE_SECONDS), 1)
+                self.session.step(seconds, 1)
                 if self.session.samples_per_pixel >= 1:
                     self.overran_time_limit = self.elapsed_seconds - self.time_limit
             else:
@@ -100,7 +100,7 @@ class RenderJob:
     def run(self, on_progress=None) -> np.ndarray:
         """Render until finished, calling ``on_progress(JobProgress)`` after each slice; the linear image."""
         while not self.finished:
-            progress = self.step(FINISHING_SLICE_SECONDS)
+            progress = self.step(REPORT_SECONDS)
             if on_progress is not None:
                 on_progress(progress)
         return self.image()

@@ -136,8 +136,7 @@ def mesh_node(model: EditableScene, path: Path, vertices: np.ndarray,
 
 def file_reference(path: Path, scene_file: Path | None) -> str:
     """How a scene names a file: relative to the scene file's folder when it has one, else absolute."""
-    path = Path(path).resolve()
-    return relative_file_name(path, Path(scene_file).resolve().parent) if scene_file is not None else str(path)
+    return relative_file_name(path, Path(scene_file).resolve().parent) if scene_file else str(Path(path).resolve())
 
 
 def relative_file_name(path: Path, folder: Path) -> str:
@@ -264,7 +263,6 @@ def with_file_paths(scene: Scene, file_paths: dict[FileField, str]) -> Scene:
     """A copy of ``scene`` that names the given files at the given places; ``scene`` is untouched (a save
     writes the copy, so that a failed save leaves the open scene as it was)."""
     out = copy.deepcopy(scene)
-    out.source_path = scene.source_path
     copy_model = EditableScene(out)
     for (target, field), name in file_paths.items():
         copy_model.apply_value(target, field, name, notify=False)
