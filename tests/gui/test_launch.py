@@ -41,7 +41,11 @@ def test_run_studio_opens_the_window_on_a_scene(qtbot, monkeypatch, tmp_path, gl
     seen = {}
 
     def look_and_close():
-        window = next(w for w in QApplication.topLevelWidgets() if isinstance(w, main_window.MainWindow))
+        if "title" in seen:  # scheduled twice (before and inside the event loop): the first call did it
+            return
+        # The window run_studio opened: the only one showing (earlier tests' closed windows may not be deleted yet).
+        window = next(w for w in QApplication.topLevelWidgets()
+                      if isinstance(w, main_window.MainWindow) and w.isVisible())
         seen["title"] = window.windowTitle()
         seen["f"] = window.doc.scene.camera.f_number
         seen["resolution"] = window.doc.scene.camera.resolution
