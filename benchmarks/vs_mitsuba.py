@@ -2,7 +2,8 @@
 
 For each scene (benchmarks/scenes/*.xml) at the same resolution, samples per pixel and pixel filter:
 
-* Mitsuba 3 (``llvm_ad_rgb``) with the independent sampler the files ask for;
+* Mitsuba 3 (``llvm_ad_rgb``; ``LENSLAB_MITSUBA_VARIANT=cuda_ad_rgb`` on an NVIDIA GPU) with the independent
+  sampler the files ask for;
 * LensLab with the same independent sampler, and with its default Owen-scrambled Sobol sampler;
 
 each against a converged reference (Mitsuba at ``--reference-spp``, cached under ``--cache``). Printed per
@@ -13,7 +14,8 @@ multiple of Mitsuba's. Ratios are what to compare across machines: these are sha
 Mitsuba renders in a child process of its own (lenslab.validate.runner.render_mitsuba_file says why).
 
 Usage: python benchmarks/vs_mitsuba.py [--res 256] [--spp 64] [--reference-spp 1024] [--scenes a,b]
-       python benchmarks/vs_mitsuba.py --lenslab-only --res 16 --spp 2 --triangles 2000   (no Mitsuba needed)
+       python benchmarks/vs_mitsuba.py --lenslab-only --res 16 --spp 2 --triangles 2000   (no Mitsuba needed;
+       relMSE against references already in the cache, made on another machine, say)
 The million-triangle scene's mesh (a bumpy torus) is written into the cache as a PLY the first time.
 """
 
@@ -84,10 +86,13 @@ def render_mitsuba(path: Path, defines: dict, spp: int, seed: int) -> Result:
     return Result(image, seconds, render_seconds, width * height * spp)
 
 
-def reference(path: Path, defines: dict, spp: int, cache: Path) -> np.ndarray:
-    """Mitsuba at ``spp`` (seeds from 1000, apart from the compared renders'), cached by scene file and settings."""
+def reference(path: Path, defines: dict, spp: int, cache: Path, render: bool = True) -> np.ndarray | None:
+    """Mitsuba at ``spp`` (seeds from 1000, apart from the compared renders'), cached by scene file and settings;
+    None when it is not cached and ``render`` is False."""
     key = hashlib.sha256(path.read_bytes() + repr(sorted(defines.items())).encode() + str(spp).encode()).hexdigest()[:16]
     file = cache / f"reference_{path.stem}_{key}.npy"
+    if not file.exists() and not render:
+        return None
     if not file.exists():
         print(f"  {path.stem}: Mitsuba reference at {spp} spp (cached in {file})", file=sys.stderr)
         np.save(file, render_mitsuba(path, defines, spp, 1000).image)
@@ -108,10 +113,12 @@ def main() -> None:
 
     from lenslab.render.tracer import Renderer
 
+    from lenslab.validate.mitsuba_env import VARIANT
+
     renderer = Renderer()
     device = renderer.describe()
     print(f"device: {device['renderer']}, {device['version']}; {args.res}x{args.res}, {args.spp} spp, box filter; "
-          f"reference: Mitsuba at {args.reference_spp} spp")
+          f"reference: Mitsuba at {args.reference_spp} spp" + ("" if args.lenslab_only else f"; Mitsuba {VARIANT}"))
     header = f"{'scene':<20} {'renderer':<22} {'seconds':>8} {'Msamples/s':>11} {'relMSE':>9} {'efficiency':>11}"
     print(header)
     print("-" * len(header))
@@ -121,18 +128,21 @@ def main() -> None:
         if name == "million_triangles":
             defines["mesh"] = str(torus_mesh(args.cache, args.triangles))
         runs: list[tuple[str, Result]] = []
+        ref = reference(path, defines, args.reference_spp, args.cache, render=not args.lenslab_only)
         if not args.lenslab_only:
-            ref = reference(path, defines, args.reference_spp, args.cache)
             runs.append(("mitsuba independent", render_mitsuba(path, defines, args.spp, 0)))
         for sampler in ("independent", "sobol"):
             runs.append((f"lenslab {sampler}", render_lenslab(renderer, path, defines, args.spp, sampler, 0)))
         baseline = None
         for label, result in runs:
             rate = result.samples / result.render_seconds / 1e6
-            if args.lenslab_only:
+            if ref is None:
                 print(f"{name:<20} {label:<22} {result.seconds:>8.2f} {rate:>11.3g} {'-':>9} {'-':>11}")
                 continue
             error = relative_mse(result.image, ref)
+            if args.lenslab_only:  # no Mitsuba time here to compare with
+                print(f"{name:<20} {label:<22} {result.seconds:>8.2f} {rate:>11.3g} {error:>9.5f} {'-':>11}")
+                continue
             efficiency = 1.0 / (result.seconds * error)
             baseline = baseline or efficiency
             print(f"{name:<20} {label:<22} {result.seconds:>8.2f} {rate:>11.3g} {error:>9.5f} {efficiency / baseline:>10.2f}x")

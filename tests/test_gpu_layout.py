@@ -85,7 +85,9 @@ def test_a_specialised_kernel_skips_the_uniforms_it_dropped(renderer):
     scene = open_scene("cornell_box")  # no environment map: its kernel never reads env_rotation
     session = RenderSession(renderer, scene, width=16, height=16)
     try:
-        assert "env_rotation" not in session.program
-        renderer.set_uniforms(session.program, {"env_rotation": 1.0})
+        dropped = "env_rotation" not in session.program  # Mesa drops it; NVIDIA's compiler keeps it, unread
+        renderer.set_uniforms(session.program, {"env_rotation": 1.0})  # declared: accepted either way
+        if not dropped:
+            assert session.program["env_rotation"].value == pytest.approx(1.0)
     finally:
         session.release()

@@ -44,8 +44,10 @@ def test_run_studio_opens_the_window_on_a_scene(qtbot, monkeypatch, tmp_path, gl
         if "title" in seen:  # scheduled twice (before and inside the event loop): the first call did it
             return
         # The window run_studio opened: the only one showing (earlier tests' closed windows may not be deleted yet).
-        window = next(w for w in QApplication.topLevelWidgets()
-                      if isinstance(w, main_window.MainWindow) and w.isVisible())
+        window = next((w for w in QApplication.topLevelWidgets()
+                       if isinstance(w, main_window.MainWindow) and w.isVisible()), None)
+        if window is None:  # not shown yet: the call scheduled inside the event loop will find it
+            return
         seen["title"] = window.windowTitle()
         seen["f"] = window.doc.scene.camera.f_number
         seen["resolution"] = window.doc.scene.camera.resolution

@@ -77,6 +77,32 @@ def test_choosing_f28_sets_the_f_number_and_restarts_accumulation(qtbot, window)
     assert window.doc.scene.camera.f_number == 3.2
 
 
+# -- the look on screen ----------------------------------------------------------------------------------------
+def test_the_worker_tone_maps_each_picture_with_the_viewports_look(qtbot, window):
+    import numpy as np
+
+    from lenslab.render.film import to_8bit, tone_map
+
+    window.controller.set_target_spp(6)
+    first = wait_for_frame(qtbot, window, min_spp=6)
+    assert first.converged and first.display_settings == (window.viewport.exposure, window.viewport.tone_map)
+    # A finished render makes no more frames by itself: a new look must still reach the screen, from the GPU.
+    window.exposure_slider.setValue(20)
+    window.tone_combo.setCurrentIndex(window.tone_combo.findData("reinhard"))
+    qtbot.waitUntil(lambda: window.controller.last_frame.display_settings == (2.0, "reinhard"), timeout=5000)
+    frame = window.controller.last_frame
+    assert frame.samples_per_pixel == first.samples_per_pixel and frame.image is not None  # no new samples
+    expected = to_8bit(tone_map(frame.image, 2.0, "reinhard"))
+    difference = np.abs(frame.display[..., :3].astype(int) - expected.astype(int))
+    assert difference.max() <= 1 and (frame.display[..., 3] == 255).all()
+    assert not np.array_equal(frame.display[..., :3], first.display[..., :3])
+    shown = window.viewport.display_image()
+    h, w = expected.shape[:2]
+    for x, y in ((0, 0), (w // 2, h // 2), (w - 1, h - 1)):
+        colour = shown.pixelColor(x, y)
+        assert (colour.red(), colour.green(), colour.blue()) == tuple(int(c) for c in frame.display[y, x, :3])
+
+
 # -- lens presets ----------------------------------------------------------------------------------------------
 def test_a_lens_preset_sets_the_focal_length_and_clamps_the_aperture(qtbot, window):
     cam = window.doc.scene.camera

@@ -120,6 +120,10 @@ class RenderController(QObject):
         self.paused = paused
         self.worker.set_paused(paused)
 
+    def set_display(self, exposure: float, tone_map: str) -> None:
+        """The viewport's look: the worker tone-maps its pictures with it (display only, no restart)."""
+        self.worker.set_display(exposure, tone_map)
+
     def restart(self) -> None:
         self.send_scene()
 

@@ -92,6 +92,7 @@ class MainWindow(QMainWindow):
         self.viewport = Viewport()
         self.viewport.set_display(float(self.settings.value("viewport/exposure", 0.0)),
                                   str(self.settings.value("viewport/tone_map", "filmic")))
+        self.controller.set_display(self.viewport.exposure, self.viewport.tone_map)
         self._create_actions()
         self.setCentralWidget(self._central())
         self._create_docks()
@@ -465,7 +466,7 @@ class MainWindow(QMainWindow):
 
     # -- render events -------------------------------------------------------------------------------------------
     def _frame(self, frame) -> None:
-        self.viewport.set_image(frame.image)
+        self.viewport.set_frame(frame.display, frame.display_settings, frame.image)
         if self.viewport.zoom is None:
             self.zoom_label.setText("Fit")
         self.spp_label.setText(samples_text(frame))
@@ -574,6 +575,7 @@ class MainWindow(QMainWindow):
 
     def _exposure_changed(self, value: int) -> None:
         self.viewport.set_display(exposure=value / 10)
+        self.controller.set_display(self.viewport.exposure, self.viewport.tone_map)
         self._update_exposure_label()
 
     def _update_exposure_label(self) -> None:
@@ -581,6 +583,7 @@ class MainWindow(QMainWindow):
 
     def _tone_changed(self, _index: int) -> None:
         self.viewport.set_display(operator=self.tone_combo.currentData())
+        self.controller.set_display(self.viewport.exposure, self.viewport.tone_map)
 
     def _quality_changed(self, _index: int) -> None:
         self.controller.set_quality(self.quality_combo.currentData())

@@ -104,16 +104,37 @@ class Viewport(QWidget):
 
     # -- content ---------------------------------------------------------------------------------------------
     def set_image(self, linear: np.ndarray) -> None:
+        """Show linear radiance, tone-mapped here with the viewport's exposure and tone curve."""
         size_changed = self.linear is None or self.linear.shape != linear.shape
         self.linear = linear
         self._redisplay()
         if size_changed:
             self._rebuild_outline()
 
+    def set_frame(self, picture: np.ndarray, settings: tuple[float, str], linear: np.ndarray | None) -> None:
+        """Show a picture the render worker already tone-mapped (RGBA8, made with ``settings``: exposure and
+        tone map). ``linear`` is the radiance behind it for the pixel readout, or None to keep the last one
+        (the render worker sends a picture of a new size with its own)."""
+        h, w = picture.shape[:2]
+        size_changed = self.linear is None or self.linear.shape[:2] != (h, w)
+        if linear is not None:
+            self.linear = linear
+        if self.linear is None or self.linear.shape[:2] != (h, w):
+            self.linear = None  # no readout until one comes; the picture is still shown
+            self.qimage = rgba_to_qimage(picture)
+            self.update()
+        elif settings == (self.exposure, self.tone_map):
+            self.qimage = rgba_to_qimage(picture)
+            self.update()
+        else:  # the user changed the look since the worker made it: the next frame will have it
+            self._redisplay()
+        if size_changed:
+            self._rebuild_outline()
+
     def _redisplay(self) -> None:
-        if self.linear is None:
-            self.qimage = None
-        else:
+        # Without a linear image (none yet, or the worker's newest picture came without one) the picture stays
+        # as it is until the worker's next one, made with the new look.
+        if self.linear is not None:
             self.qimage = numpy_to_qimage(to_8bit(tone_map(self.linear, self.exposure, self.tone_map)))
         self.update()
 
@@ -181,9 +202,9 @@ class Viewport(QWidget):
 
     # -- geometry ---------------------------------------------------------------------------------------------
     def image_size(self) -> tuple[int, int]:
-        if self.linear is None:
+        if self.qimage is None:
             return (0, 0)
-        return self.linear.shape[1], self.linear.shape[0]
+        return self.qimage.width(), self.qimage.height()
 
     def fit_scale(self) -> float:
         w, h = self.image_size()

@@ -7,7 +7,9 @@ Edits are therefore seen within one dispatch (about a tenth of a second) however
 
 After each restart the worker first renders one pass at a quarter of the resolution (a preview that appears
 within a fraction of a second), then the full resolution, whose first pass fills in over the preview tile by
-tile. Once per change of view it casts one ray per pixel through the same kd-tree to find the node and the depth
+tile. Each frame's picture is tone-mapped to 8 bits on the GPU with the viewport's exposure and tone curve
+(``RenderSession.display``), so neither thread does per-pixel work on the CPU; the linear image, for the
+viewport's pixel readout, comes along a few times a second. Once per change of view it casts one ray per pixel through the same kd-tree to find the node and the depth
 under every pixel: the viewport outlines the selection with the first and shows the plane of focus with the
 second. Click-to-focus picks and exports (a second ``RenderSession`` on the same context) run here too.
 
@@ -32,12 +34,15 @@ from PySide6.QtCore import QThread, Signal
 PREVIEW_DIVISOR = 4  # the preview pass renders at 1/4 of the width and height
 PREVIEW_MIN_PIXELS = 256 * 256  # images smaller than this skip the preview pass
 FRAME_INTERVAL = 0.25  # seconds between published frames while a pass is in progress
+LINEAR_INTERVAL = 0.5  # seconds between linear images (the pixel readout's) while the render goes on
 EXPORT_PROGRESS_INTERVAL = 0.1
 
 
 @dataclass(frozen=True)
 class Frame:
-    image: np.ndarray  # (H, W, 3) float32 linear radiance; pixels still without samples show the preview
+    display: np.ndarray  # (H, W, 4) uint8 RGBA, made with display_settings; unsampled pixels show the preview
+    display_settings: tuple[float, str]  # (exposure in stops, tone map) the picture was made with
+    image: np.ndarray | None  # (H, W, 3) float32 linear radiance, or None: the last frame's still holds
     width: int
     height: int
     samples_per_pixel: int
@@ -104,6 +109,12 @@ class CameraEdit:
 class SettingsEdit:
     settings: object  # RenderSettings
     generation: int
+
+
+@dataclass(frozen=True)
+class DisplayEdit:
+    exposure: float  # stops
+    tone_map: str  # one of lenslab.render.film.TONE_MAPS
 
 
 @dataclass(frozen=True)
@@ -185,6 +196,9 @@ class RenderWorker(QThread):
         self._scene_ok = False
         self._camera_ok = True
         self._preview_image = None
+        self._preview_display: tuple[tuple[float, str], np.ndarray] | None = None  # (settings, RGBA8 at full size)
+        self._display_settings: tuple[float, str] = (0.0, "filmic")
+        self._last_linear = 0.0
         self._gbuffer_due = False
         self._gbuffer_size: tuple[int, int] | None = None
         self._restart_time = 0.0
@@ -204,6 +218,10 @@ class RenderWorker(QThread):
 
     def set_paused(self, paused: bool) -> None:
         self._queue.put(Pause(bool(paused)))
+
+    def set_display(self, exposure: float, tone_map: str) -> None:
+        """The viewport's exposure and tone curve, for the pictures the worker makes from now on."""
+        self._queue.put(DisplayEdit(float(exposure), str(tone_map)))
 
     def set_target_spp(self, spp: int | None) -> None:
         self._queue.put(TargetSpp(spp))
@@ -282,6 +300,7 @@ class RenderWorker(QThread):
         scene_edit: SceneEdit | None = None
         camera_edit: CameraEdit | None = None
         settings_edit: SettingsEdit | None = None
+        display_edit: DisplayEdit | None = None
         for message in messages:
             if isinstance(message, Stop):
                 self._stop.set()
@@ -294,6 +313,8 @@ class RenderWorker(QThread):
                 camera_edit = dataclasses.replace(message, view_changed=moved)
             elif isinstance(message, SettingsEdit):
                 settings_edit = message
+            elif isinstance(message, DisplayEdit):
+                display_edit = message
             elif isinstance(message, Pause):
                 self._paused = message.paused
                 if not self._paused and self._phase == "done":
@@ -308,6 +329,8 @@ class RenderWorker(QThread):
             self._apply_camera(camera_edit)
         if settings_edit is not None:
             self._apply_settings(settings_edit)
+        if display_edit is not None:
+            self._apply_display(display_edit)
         for message in messages:
             if isinstance(message, PickRequest):
                 self._pick(message)
@@ -363,6 +386,13 @@ class RenderWorker(QThread):
         if self._scene_ok and self._camera_ok:
             self._restart(edit.generation, view_changed=False)
 
+    def _apply_display(self, edit: DisplayEdit) -> None:
+        self._display_settings = (edit.exposure, edit.tone_map)
+        # Show the picture in the new look now: a finished or paused render makes no more frames by itself.
+        if self._session is not None and self._scene_ok and self._camera_ok and self._phase in ("full", "done") \
+                and self._published_spp >= 0:
+            self._publish_session(converged=self._phase == "done")
+
     def _resize(self, width: int, height: int) -> None:
         # RenderSession keeps the scene on the GPU; a new size only needs a new accumulation buffer, which
         # reset() allocates when width * height changed.
@@ -373,6 +403,8 @@ class RenderWorker(QThread):
     def _restart(self, generation: int, view_changed: bool) -> None:
         self._generation = generation
         self._preview_image = None
+        self._preview_display = None
+        self._last_linear = 0.0
         self._published_spp = -1
         self._restart_time = time.perf_counter()
         w, h = self._size
@@ -394,7 +426,7 @@ class RenderWorker(QThread):
             if session.samples_per_pixel >= 1:
                 self._preview_image = session.image()
                 w, h = self._size
-                self._publish(upscale_nearest(self._preview_image, w, h), preview=True)
+                self._publish(self._preview_picture(), upscale_nearest(self._preview_image, w, h), preview=True)
                 self._resize(w, h)
                 self._phase = "full"
             return
@@ -411,29 +443,56 @@ class RenderWorker(QThread):
         if done:
             self._phase = "done"
 
+    def _preview_picture(self) -> np.ndarray:
+        """The preview pass tone-mapped at its own quarter size, then enlarged: RGBA8 at the viewport's size."""
+        from lenslab.render.film import to_8bit, tone_map
+
+        if self._preview_display is None or self._preview_display[0] != self._display_settings:
+            rgb = to_8bit(tone_map(self._preview_image, *self._display_settings))
+            rgba = np.concatenate([rgb, np.full(rgb.shape[:2] + (1,), 255, np.uint8)], axis=2)
+            w, h = self._size
+            self._preview_display = (self._display_settings, upscale_nearest(rgba, w, h))
+        return self._preview_display[1]
+
     def _publish_session(self, converged: bool) -> None:
         from lenslab.render.film import resolve
 
-        accumulation = self._session.accumulation()
-        image = resolve(accumulation)
-        if self._preview_image is not None:
-            empty = accumulation[..., 3] <= 0
-            if empty.any():
+        session = self._session
+        picture = session.display(*self._display_settings)
+        empty = picture[..., 3] == 0  # pixels the first full pass has not reached yet
+        has_empty = bool(empty.any())
+        if has_empty and self._preview_image is not None:
+            picture[empty] = self._preview_picture()[empty]
+        elif has_empty:
+            picture[empty, 3] = 255  # black
+        image = None
+        now = time.perf_counter()
+        if converged or self._paused or not self._busy() or now - self._last_linear >= LINEAR_INTERVAL:
+            accumulation = session.accumulation()
+            image = resolve(accumulation)
+            if has_empty and self._preview_image is not None:
                 w, h = self._size
                 image[empty] = upscale_nearest(self._preview_image, w, h)[empty]
-        self._publish(image, preview=False, converged=converged)
+            self._last_linear = now
+        self._publish(picture, image, preview=False, converged=converged)
 
-    def _publish(self, image: np.ndarray, preview: bool, converged: bool = False) -> None:
+    def _publish(self, picture: np.ndarray, image: np.ndarray | None, preview: bool, converged: bool = False) -> None:
         session = self._session
         progress = session.progress(self._target_spp)
         spp = 0 if preview else session.samples_per_pixel
-        frame = Frame(image=image, width=image.shape[1], height=image.shape[0], samples_per_pixel=spp,
+        frame = Frame(display=picture, display_settings=self._display_settings, image=image,
+                      width=picture.shape[1], height=picture.shape[0], samples_per_pixel=spp,
                       target_spp=self._target_spp, samples_per_second=progress.samples_per_second,
                       elapsed_seconds=time.perf_counter() - self._restart_time, generation=self._generation,
                       preview=preview, converged=converged)
         self._published_spp = spp
         self._last_publish = time.perf_counter()
         with self._frame_lock:
+            untaken = self._frame
+            if image is None and untaken is not None and untaken.image is not None \
+                    and untaken.image.shape[:2] == picture.shape[:2]:
+                # This frame replaces one the GUI never took: keep the linear image that one carried.
+                frame = dataclasses.replace(frame, image=untaken.image)
             self._frame = frame
             signal = not self._frame_signalled
             self._frame_signalled = True

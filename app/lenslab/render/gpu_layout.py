@@ -62,6 +62,12 @@ IMAGE_DATA_BINDING = 7
 LIGHT_CHOICE_BINDING = 0  # a uniform block: uniform-block bindings are numbered apart from storage buffers
 # splat.comp reads the samples trace.comp left at ACCUMULATION_BINDING and gathers them into the image here.
 SPLAT_IMAGE_BINDING = 0
+# display.comp reads the image's sums at ACCUMULATION_BINDING and writes 8-bit display pixels here.
+DISPLAY_BINDING = 8
+# display.comp's tone maps, in the order of lenslab.render.film.TONE_MAPS.
+TONE_MAP_CLAMP = 0
+TONE_MAP_REINHARD = 1
+TONE_MAP_FILMIC = 2
 # raycast.comp's rays in and hits out; bsdf_probe.comp's items in and results out.
 RAYS_BINDING = 6
 HITS_BINDING = 7

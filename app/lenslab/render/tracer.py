@@ -22,12 +22,15 @@ import numpy as np
 from lenslab.render import gl
 from lenslab.render.buffers import GpuScene, pack_scene
 from lenslab.render.features import GENERAL, KernelFeatures, scene_features
-from lenslab.render.gpu_layout import ACCUMULATION_BINDING, SPLAT_IMAGE_BINDING
+from lenslab.render.gpu_layout import (ACCUMULATION_BINDING, DISPLAY_BINDING, SPLAT_IMAGE_BINDING, TONE_MAP_CLAMP,
+                                      TONE_MAP_FILMIC, TONE_MAP_REINHARD)
 from lenslab.render.sobol import glsl_array_literal
 from lenslab.scene.camera import ThinLensCamera
 from lenslab.scene.scene import RenderSettings, Scene
 
 LOCAL_SIZE_X = 32  # GPU-NOTES: 32x1 work groups traversed the kd-tree fastest on llvmpipe
+DISPLAY_GROUP_X = 64  # display.comp's work groups: 64 pixels of a row
+TONE_MAP_CODES = {"clamp": TONE_MAP_CLAMP, "reinhard": TONE_MAP_REINHARD, "filmic": TONE_MAP_FILMIC}  # film.TONE_MAPS
 DEFAULT_DISPATCH_SECONDS = 0.1
 # A splatted gaussian keeps one pass of samples (16 bytes each) until splat.comp has spread them. One sample
 # per pixel may take up to SPLAT_MEMORY_BYTES (a 3840 x 2160 image: 127 MiB; never more than one storage
@@ -92,6 +95,9 @@ class Renderer:
     def splat_program(self):
         return self.program("splat.comp", LOCAL_SIZE_X=LOCAL_SIZE_X)
 
+    def display_program(self):
+        return self.program("display.comp", LOCAL_SIZE_X=DISPLAY_GROUP_X)
+
     def describe(self) -> dict[str, str]:
         return gl.describe_device(self.ctx)
 
@@ -149,6 +155,7 @@ class RenderSession:
         self._gpu_scene: GpuScene | None = None
         self._accumulation = None
         self._splat_samples = None  # one pass of radiance samples, while a gaussian filter is splatted
+        self._display_pixels = None  # display.comp's 8-bit picture
         self.set_scene(scene, width=width, height=height, settings=settings)
 
     # -- scene and camera ---------------------------------------------------------------------------------
@@ -260,7 +267,9 @@ class RenderSession:
         if self._seconds_per_pixel_sample is None:
             return min(remaining_pixels, 16384), 1  # a small first dispatch to measure the cost
         budget = self.dispatch_seconds / self._seconds_per_pixel_sample  # pixel-samples that fit
-        if self._pixels_done == 0 and budget >= 2 * pixels_total:
+        # A device runs at most so many work groups in one dispatch (65535 on some: 2 M pixels).
+        most_pixels = self.renderer.limits.max_work_group_count[0] * LOCAL_SIZE_X
+        if self._pixels_done == 0 and budget >= 2 * pixels_total and pixels_total <= most_pixels:
             # The whole image fits more than twice: take several samples per pixel in one dispatch.
             samples = max(1, int(budget // pixels_total))
             if target_spp is not None:
@@ -272,7 +281,7 @@ class RenderSession:
         if self._pixels_done == 0:
             self._pass_samples = 1
         pixels = int(max(LOCAL_SIZE_X, budget // self._pass_samples))
-        pixels = min(remaining_pixels, (pixels + LOCAL_SIZE_X - 1) // LOCAL_SIZE_X * LOCAL_SIZE_X)
+        pixels = min(remaining_pixels, most_pixels, (pixels + LOCAL_SIZE_X - 1) // LOCAL_SIZE_X * LOCAL_SIZE_X)
         return pixels, self._pass_samples
 
     def _dispatch(self, pixels: int, samples: int) -> None:
@@ -373,6 +382,32 @@ class RenderSession:
 
         return resolve(self.accumulation())
 
+    @in_context
+    def display(self, exposure_stops: float = 0.0, tone_map: str = "clamp") -> np.ndarray:
+        """(H, W, 4) uint8 RGBA: the image as a screen shows it, made on the GPU (display.comp: the steps of
+        film.resolve, film.tone_map and film.to_8bit); alpha 0 where a pixel has no sample yet. A quarter of
+        the bytes of :meth:`accumulation` cross to the CPU, and no per-pixel work is left for it."""
+        if tone_map not in TONE_MAP_CODES:
+            raise ValueError(f"unknown tone map '{tone_map}' (choose from {', '.join(TONE_MAP_CODES)})")
+        pixels = self.width * self.height
+        if self._display_pixels is None or self._display_pixels.size != 4 * pixels:
+            self._release_display_pixels()
+            self._display_pixels = self.ctx.buffer(reserve=4 * pixels)
+        program = self.renderer.display_program()
+        program["image_size"].value = (self.width, self.height)
+        program["exposure_scale"].value = float(2.0 ** exposure_stops)
+        program["tone_map"].value = TONE_MAP_CODES[tone_map]
+        self._accumulation.bind_to_storage_buffer(ACCUMULATION_BINDING)
+        self._display_pixels.bind_to_storage_buffer(DISPLAY_BINDING)
+        program.run((self.width + DISPLAY_GROUP_X - 1) // DISPLAY_GROUP_X, self.height, 1)
+        data = np.frombuffer(self._display_pixels.read(), dtype=np.uint8)
+        return data.reshape(self.height, self.width, 4).copy()
+
+    def _release_display_pixels(self) -> None:
+        if self._display_pixels is not None:
+            self._display_pixels.release()
+            self._display_pixels = None
+
     def _release_splat_samples(self) -> None:
         if self._splat_samples is not None:
             self._splat_samples.release()
@@ -381,6 +416,7 @@ class RenderSession:
     @in_context
     def release(self) -> None:
         self._release_splat_samples()
+        self._release_display_pixels()
         if self._gpu_scene is not None:
             self._gpu_scene.release()
             self._gpu_scene = None

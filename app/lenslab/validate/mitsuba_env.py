@@ -2,7 +2,8 @@
 
 On Debian 12 the system's only libLLVM is Mesa's LLVM 15, on which Dr.Jit's JIT aborts; with
 ``apt-get install libllvm19`` and ``DRJIT_LIBLLVM_PATH`` pointing at it, the ``llvm_ad_rgb`` variant works.
-We set that variable ourselves when it is unset and the library is there.
+We set that variable ourselves when it is unset and the library is there. On a machine with an NVIDIA GPU,
+``LENSLAB_MITSUBA_VARIANT=cuda_ad_rgb`` compares against Mitsuba on the same GPU (benchmarks/vs_mitsuba.py).
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-VARIANT = "llvm_ad_rgb"
+VARIANT = os.environ.get("LENSLAB_MITSUBA_VARIANT", "llvm_ad_rgb")
 LLVM19 = Path("/lib/x86_64-linux-gnu/libLLVM.so.19.1")
 MISSING_MITSUBA = "Mitsuba 3 is not installed: pip install 'lenslab[validate]'"
 NO_LLVM = ("Mitsuba 3 found no usable LLVM for its JIT ({detail}): install LLVM 19 (apt-get install libllvm19) "
@@ -29,7 +30,7 @@ def prepare_environment(environ=os.environ, llvm19: Path = LLVM19) -> None:
         environ["DRJIT_LIBLLVM_PATH"] = str(llvm19)
 
 
-PROBE = ("import mitsuba as mi; mi.set_variant('llvm_ad_rgb'); mi.render(mi.load_dict({'type': 'scene', "
+PROBE = (f"import mitsuba as mi; mi.set_variant('{VARIANT}'); " "mi.render(mi.load_dict({'type': 'scene', "
          "'integrator': {'type': 'path'}, 'light': {'type': 'constant'}, 'sensor': {'type': 'perspective', "
          "'film': {'type': 'hdrfilm', 'width': 4, 'height': 4}}}), spp=1)")
 
@@ -50,7 +51,7 @@ def _probe_jit() -> str | None:
 
 
 def load_mitsuba():
-    """The ``mitsuba`` module with the LLVM RGB variant set, or :class:`MitsubaUnavailable`."""
+    """The ``mitsuba`` module with its RGB variant set (LLVM unless chosen otherwise), or :class:`MitsubaUnavailable`."""
     global _mitsuba
     if _mitsuba is not None:
         return _mitsuba

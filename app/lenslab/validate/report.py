@@ -97,7 +97,9 @@ def machine_description(renderer=None) -> list[str]:
     try:
         import mitsuba
 
-        lines.append(f"Mitsuba {mitsuba.__version__}, variant llvm_ad_rgb")
+        from lenslab.validate.mitsuba_env import VARIANT
+
+        lines.append(f"Mitsuba {mitsuba.__version__}, variant {VARIANT}")
     except ImportError:
         pass
     return lines
