@@ -17,7 +17,7 @@ from typing import Callable
 from PySide6.QtCore import QObject, Signal
 
 from lenslab.gui.document import copy_scene, listen
-from lenslab.gui.worker import ExportRequest, Frame, RenderWorker
+from lenslab.gui.worker import VIEWPORT_DISPATCH_SECONDS, ExportRequest, Frame, RenderWorker
 
 #: Viewport quality: a fraction of the camera's resolution, or "auto" (at most AUTO_LONG_EDGE pixels wide).
 QUALITIES = {"auto": None, "full": 1.0, "half": 0.5, "quarter": 0.25}
@@ -44,7 +44,7 @@ class RenderController(QObject):
     export_failed = Signal(int, str)
     export_cancelled = Signal(int)
 
-    def __init__(self, doc, device_index: int | None = None, dispatch_seconds: float = 0.1,
+    def __init__(self, doc, device_index: int | None = None, dispatch_seconds: float = VIEWPORT_DISPATCH_SECONDS,
                  quality: str = "auto", target_spp: int | None = 1024, parent: QObject | None = None):
         super().__init__(parent)
         self.doc = doc

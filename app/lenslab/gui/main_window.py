@@ -42,6 +42,7 @@ from lenslab.gui.export_dialog import ExportDialog
 from lenslab.gui.properties import PropertyEditor
 from lenslab.gui.scene_tree import SceneTreeView, node_context_menu
 from lenslab.gui.viewport import Viewport
+from lenslab.gui.worker import VIEWPORT_DISPATCH_SECONDS
 from lenslab.optics import circle_of_confusion_mm, depth_of_field, format_f_number, format_focal_length
 from lenslab.render.film import TONE_MAPS
 from lenslab.scene import editing
@@ -65,7 +66,8 @@ class MainWindow(QMainWindow):
     _mesh_loaded = Signal(object, object, str)  # from the loading thread
 
     def __init__(self, scene=None, path: Path | None = None, *, device_index: int | None = None,
-                 settings: QSettings | None = None, dispatch_seconds: float = 0.1, restore_layout: bool = True):
+                 settings: QSettings | None = None, dispatch_seconds: float = VIEWPORT_DISPATCH_SECONDS,
+                 restore_layout: bool = True):
         super().__init__()
         from PySide6.QtWidgets import QApplication
 

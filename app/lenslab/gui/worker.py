@@ -3,7 +3,7 @@
 The GUI thread never touches the GPU. It sends the worker immutable copies of what changed (a whole scene, a
 camera, render settings) through a queue; the worker applies only the latest of each, restarts accumulation and
 goes on rendering in bounded dispatches (``RenderSession.step``), publishing the image several times a second.
-Edits are therefore seen within one dispatch (about a tenth of a second) however long a render has run.
+Edits are therefore seen within one dispatch (about a sixtieth of a second) however long a render has run.
 
 After each restart the worker first renders one pass at a quarter of the resolution (a preview that appears
 within a fraction of a second), then the full resolution, whose first pass fills in over the preview tile by
@@ -33,6 +33,9 @@ from PySide6.QtCore import QThread, Signal
 
 PREVIEW_DIVISOR = 4  # the preview pass renders at 1/4 of the width and height
 PREVIEW_MIN_PIXELS = 256 * 256  # images smaller than this skip the preview pass
+# The viewport's dispatches aim at a display frame: an edit is seen within one, and on a GPU that traces a
+# sample per pixel faster than that, each frame adds a pass. llvmpipe loses nothing by it (docs/performance.md).
+VIEWPORT_DISPATCH_SECONDS = 1 / 60
 FRAME_INTERVAL = 0.25  # seconds between published frames while a pass is in progress
 LINEAR_INTERVAL = 0.5  # seconds between linear images (the pixel readout's) while the render goes on
 EXPORT_PROGRESS_INTERVAL = 0.1
@@ -175,7 +178,8 @@ class RenderWorker(QThread):
     export_failed = Signal(int, str)
     export_cancelled = Signal(int)
 
-    def __init__(self, device_index: int | None = None, dispatch_seconds: float = 0.1, parent=None):
+    def __init__(self, device_index: int | None = None, dispatch_seconds: float = VIEWPORT_DISPATCH_SECONDS,
+                 parent=None):
         super().__init__(parent)
         self.setObjectName("LensLab render worker")
         self.device_index = device_index
