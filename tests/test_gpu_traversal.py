@@ -121,3 +121,31 @@ def test_a_floor_rotated_into_place_is_found_by_rays_that_reach_it(renderer):
             assert np.array_equal(np.isfinite(hits.t), np.isfinite(expected_t))
     finally:
         gpu.release()
+
+
+def test_a_batch_larger_than_one_dispatch_is_cast_in_chunks(renderer, monkeypatch):
+    # A 4K picture's rays exceed the 65535 work groups some devices allow in one dispatch. Pretend this device
+    # allows 3 groups (192 rays): a batch of 1000 must come back whole and in order, as one dispatch gives it
+    # where the device allows one.
+    import dataclasses
+
+    rng = np.random.default_rng(7)
+    flat = random_scene(rng, triangles=2000, spheres=20)
+    origins = rng.uniform(-0.5, 0.5, (1000, 3))
+    directions = rng.normal(size=(1000, 3))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    expected_t, _ = brute_force(flat, origins, directions)
+
+    gpu = GpuScene(renderer.ctx, pack_scene(flat, ConstantEnvironment()), renderer.limits.max_storage_block_bytes)
+    try:
+        whole = cast_rays(renderer, gpu, origins, directions)
+        monkeypatch.setattr(renderer, "limits", dataclasses.replace(renderer.limits, max_work_group_count=(3, 1, 1)))
+        chunked = cast_rays(renderer, gpu, origins, directions)
+    finally:
+        gpu.release()
+
+    found = np.isfinite(expected_t)
+    assert found.sum() > 500  # hits in every chunk
+    np.testing.assert_array_equal(chunked.prim, whole.prim)
+    np.testing.assert_array_equal(chunked.t, whole.t)
+    np.testing.assert_allclose(chunked.t[found], expected_t[found], rtol=1e-4, atol=1e-5)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import types
 
 import numpy as np
 import pytest
@@ -82,6 +83,29 @@ def test_step_returns_between_bounded_dispatches(renderer):
     session.step(30.0, target_spp=2)
     assert session.samples_per_pixel == 2
     assert np.all(session.accumulation()[..., 3] == 2)
+    session.release()
+
+
+def test_step_starts_no_dispatch_it_expects_to_end_past_its_deadline(renderer, monkeypatch):
+    """The studio asks for a frame's worth of work and must have its picture within the frame: a dispatch
+    that would end after the deadline waits for the next step instead of overrunning this one."""
+    from lenslab.render import tracer
+
+    session = RenderSession(renderer, furnace_scene(max_depth=1), width=64, height=64, dispatch_seconds=0.04)
+    clock = [0.0]
+    monkeypatch.setattr(tracer, "time", types.SimpleNamespace(perf_counter=lambda: clock[0]))
+    real_dispatch = session._dispatch
+
+    def dispatch_taking_40_ms(pixels, samples):  # a device on which every dispatch takes 0.04 s
+        real_dispatch(pixels, samples)
+        clock[0] += 0.04
+        session._seconds_per_pixel_sample = 0.04 / (pixels * samples)
+
+    monkeypatch.setattr(session, "_dispatch", dispatch_taking_40_ms)
+    session.step(0.1)  # dispatches end at 0.04 and 0.08 s; a third would end at 0.12 s
+    assert clock[0] == pytest.approx(0.08)
+    session.step(0.01)  # shorter than any dispatch: one all the same, or the render would never advance
+    assert clock[0] == pytest.approx(0.12)
     session.release()
 
 

@@ -104,6 +104,13 @@ def test_llvm_path_is_set_only_when_unset_and_present(tmp_path):
     assert "apt-get install libllvm19" in mitsuba_env.NO_LLVM
 
 
+def test_the_advice_when_mitsuba_cannot_render_fits_the_variant_chosen():
+    on_cpu = mitsuba_env.unavailable_message("jit aborted", "llvm_ad_rgb")
+    assert "jit aborted" in on_cpu and "apt-get install libllvm19" in on_cpu
+    on_gpu = mitsuba_env.unavailable_message("cuda_init failed", "cuda_ad_rgb")
+    assert "cuda_init failed" in on_gpu and "NVIDIA" in on_gpu and "LLVM" not in on_gpu
+
+
 def test_usage_errors(capsys):
     from lenslab.validate.cli import main
 

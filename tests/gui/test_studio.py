@@ -84,8 +84,11 @@ def test_the_worker_tone_maps_each_picture_with_the_viewports_look(qtbot, window
     from lenslab.render.film import to_8bit, tone_map
 
     window.controller.set_target_spp(6)
-    first = wait_for_frame(qtbot, window, min_spp=6)
-    assert first.converged and first.display_settings == (window.viewport.exposure, window.viewport.tone_map)
+    # Frames of the render that began before the new target may come first: wait for the finished one.
+    qtbot.waitUntil(lambda: window.controller.last_frame is not None and window.controller.last_frame.converged,
+                    timeout=20000)
+    first = window.controller.last_frame
+    assert first.samples_per_pixel >= 6 and first.display_settings == (window.viewport.exposure, window.viewport.tone_map)
     # A finished render makes no more frames by itself: a new look must still reach the screen, from the GPU.
     window.exposure_slider.setValue(20)
     window.tone_combo.setCurrentIndex(window.tone_combo.findData("reinhard"))
@@ -101,6 +104,19 @@ def test_the_worker_tone_maps_each_picture_with_the_viewports_look(qtbot, window
     for x, y in ((0, 0), (w // 2, h // 2), (w - 1, h - 1)):
         colour = shown.pixelColor(x, y)
         assert (colour.red(), colour.green(), colour.blue()) == tuple(int(c) for c in frame.display[y, x, :3])
+
+
+def test_a_look_saved_by_hand_or_by_another_version_falls_back_to_the_default(qtbot, make_window, settings,
+                                                                              small_scene):
+    settings.setValue("viewport/exposure", "bright")
+    settings.setValue("viewport/tone_map", "aces")  # not one of ours
+    window = make_window(small_scene)
+    assert (window.viewport.exposure, window.viewport.tone_map) == (0.0, "filmic")
+    assert wait_for_frame(qtbot, window).display_settings == (0.0, "filmic")  # the worker renders on
+    settings.setValue("viewport/exposure", 40.0)  # beyond the slider's six stops
+    assert make_window(small_scene).viewport.exposure == 6.0
+    with pytest.raises(ValueError, match="unknown tone map 'aces'"):
+        window.controller.set_display(0.0, "aces")
 
 
 # -- lens presets ----------------------------------------------------------------------------------------------

@@ -66,3 +66,30 @@ def test_pause_and_target_change_the_worker_state(worker):
     worker.set_paused(True)
     worker._drain(block=False)
     assert worker._target_spp == 16 and worker._paused
+
+
+def test_pausing_or_starting_an_export_republishes_the_picture_with_its_linear_image(worker):
+    # The last picture stays up while paused or exporting: it must come with the radiance behind it, or the
+    # pixel readout answers from an older one.
+    from lenslab.gui.worker import ExportRequest
+
+    republished = []
+    worker._republish = lambda with_linear: republished.append(with_linear)
+    worker.set_paused(True)
+    worker._drain(block=False)
+    assert republished == [True]
+    worker.set_paused(True)  # already paused: nothing new to show
+    worker.set_paused(False)
+    worker._drain(block=False)
+    assert republished == [True]
+
+    started = []
+    worker._start_export = lambda start: started.append(start) or len(started) == 1  # the second one fails
+    request = ExportRequest(scene=Scene(), path="shot.exr", target_spp=4, seconds=None, exposure_stops=0.0,
+                            tone_map="filmic")
+    worker.start_export(1, request)
+    worker._drain(block=False)
+    assert republished == [True, True]
+    worker.start_export(2, request)
+    worker._drain(block=False)
+    assert len(started) == 2 and republished == [True, True]

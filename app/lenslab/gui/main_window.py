@@ -51,6 +51,8 @@ from lenslab.scene.io.meshes import MESH_SUFFIXES, MeshLoadError, load_mesh
 from lenslab.scene.io.native import SCENE_SUFFIX, save_scene
 from lenslab.scene.scene import SceneError
 
+DISPLAY_EXPOSURE_STOPS = 6.0  # the display exposure slider reaches this many stops either way
+
 MAX_RECENT = 10
 APP_NAME = "LensLab"
 
@@ -92,8 +94,7 @@ class MainWindow(QMainWindow):
         self._mesh_loaded.connect(self._on_mesh_loaded, Qt.QueuedConnection)
 
         self.viewport = Viewport()
-        self.viewport.set_display(float(self.settings.value("viewport/exposure", 0.0)),
-                                  str(self.settings.value("viewport/tone_map", "filmic")))
+        self.viewport.set_display(*self._saved_look())
         self.controller.set_display(self.viewport.exposure, self.viewport.tone_map)
         self._create_actions()
         self.setCentralWidget(self._central())
@@ -129,6 +130,19 @@ class MainWindow(QMainWindow):
             action.triggered.connect(slot)
         self.addAction(action)
         return action
+
+    def _saved_look(self) -> tuple[float, str]:
+        """The viewport's exposure and tone map from the last session; a value edited by hand or written by
+        another version falls back to the default rather than stopping the studio."""
+        try:
+            exposure = float(self.settings.value("viewport/exposure", 0.0))
+        except (TypeError, ValueError):
+            exposure = 0.0
+        if not math.isfinite(exposure):
+            exposure = 0.0
+        exposure = min(DISPLAY_EXPOSURE_STOPS, max(-DISPLAY_EXPOSURE_STOPS, exposure))
+        tone_map = str(self.settings.value("viewport/tone_map", "filmic"))
+        return exposure, tone_map if tone_map in TONE_MAPS else "filmic"
 
     def _create_actions(self) -> None:
         a = self._action
@@ -197,7 +211,7 @@ class MainWindow(QMainWindow):
         exposure_label.setToolTip("Display exposure")
         bar.addWidget(exposure_label)
         self.exposure_slider = QSlider(Qt.Horizontal)
-        self.exposure_slider.setRange(-60, 60)
+        self.exposure_slider.setRange(round(-10 * DISPLAY_EXPOSURE_STOPS), round(10 * DISPLAY_EXPOSURE_STOPS))
         self.exposure_slider.setFixedWidth(110)
         self.exposure_slider.setValue(round(self.viewport.exposure * 10))
         self.exposure_slider.setToolTip("Display exposure in stops (display only: the render is not restarted)")

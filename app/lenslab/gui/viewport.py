@@ -103,14 +103,6 @@ class Viewport(QWidget):
         self._fade_timer.timeout.connect(self._fade_tick)
 
     # -- content ---------------------------------------------------------------------------------------------
-    def set_image(self, linear: np.ndarray) -> None:
-        """Show linear radiance, tone-mapped here with the viewport's exposure and tone curve."""
-        size_changed = self.linear is None or self.linear.shape != linear.shape
-        self.linear = linear
-        self._redisplay()
-        if size_changed:
-            self._rebuild_outline()
-
     def set_frame(self, picture: np.ndarray, settings: tuple[float, str], linear: np.ndarray | None) -> None:
         """Show a picture the render worker already tone-mapped (RGBA8, made with ``settings``: exposure and
         tone map). ``linear`` is the radiance behind it for the pixel readout, or None to keep the last one

@@ -11,7 +11,8 @@ tile. Each frame's picture is tone-mapped to 8 bits on the GPU with the viewport
 (``RenderSession.display``), so neither thread does per-pixel work on the CPU; the linear image, for the
 viewport's pixel readout, comes along a few times a second. Once per change of view it casts one ray per pixel through the same kd-tree to find the node and the depth
 under every pixel: the viewport outlines the selection with the first and shows the plane of focus with the
-second. Click-to-focus picks and exports (a second ``RenderSession`` on the same context) run here too.
+second. Click-to-focus picks and exports (a second ``RenderSession`` on the same context, in the headless
+render's longer dispatches) run here too.
 
 Results go back through Qt signals (queued across threads). Frames are coalesced: the worker keeps only the
 newest and signals once until the GUI has taken it, so a busy GUI never builds up a backlog.
@@ -305,6 +306,7 @@ class RenderWorker(QThread):
         camera_edit: CameraEdit | None = None
         settings_edit: SettingsEdit | None = None
         display_edit: DisplayEdit | None = None
+        holding = False  # the viewport is about to stop making frames by itself
         for message in messages:
             if isinstance(message, Stop):
                 self._stop.set()
@@ -320,6 +322,7 @@ class RenderWorker(QThread):
             elif isinstance(message, DisplayEdit):
                 display_edit = message
             elif isinstance(message, Pause):
+                holding = holding or (message.paused and not self._paused)
                 self._paused = message.paused
                 if not self._paused and self._phase == "done":
                     self._phase = "full"  # the target may have been raised meanwhile
@@ -339,9 +342,13 @@ class RenderWorker(QThread):
             if isinstance(message, PickRequest):
                 self._pick(message)
             elif isinstance(message, ExportStart):
-                self._start_export(message)
+                holding = self._start_export(message) or holding
             elif isinstance(message, ExportCancel):
                 self._cancel_export(message.request_id)
+        if holding:
+            # Paused, or the device turns to an export: the last picture stays up for a while, so it comes
+            # with its linear image, or the pixel readout would answer from an older one.
+            self._republish(with_linear=True)
 
     # -- applying edits ------------------------------------------------------------------------------------
     def _apply_scene(self, edit: SceneEdit) -> None:
@@ -393,9 +400,13 @@ class RenderWorker(QThread):
     def _apply_display(self, edit: DisplayEdit) -> None:
         self._display_settings = (edit.exposure, edit.tone_map)
         # Show the picture in the new look now: a finished or paused render makes no more frames by itself.
+        self._republish(with_linear=False)
+
+    def _republish(self, with_linear: bool) -> None:
+        """Publish the full-size picture as it stands again, if there is one."""
         if self._session is not None and self._scene_ok and self._camera_ok and self._phase in ("full", "done") \
                 and self._published_spp >= 0:
-            self._publish_session(converged=self._phase == "done")
+            self._publish_session(converged=self._phase == "done", with_linear=with_linear)
 
     def _resize(self, width: int, height: int) -> None:
         # RenderSession keeps the scene on the GPU; a new size only needs a new accumulation buffer, which
@@ -458,7 +469,7 @@ class RenderWorker(QThread):
             self._preview_display = (self._display_settings, upscale_nearest(rgba, w, h))
         return self._preview_display[1]
 
-    def _publish_session(self, converged: bool) -> None:
+    def _publish_session(self, converged: bool, with_linear: bool = False) -> None:
         from lenslab.render.film import resolve
 
         session = self._session
@@ -471,7 +482,7 @@ class RenderWorker(QThread):
             picture[empty, 3] = 255  # black
         image = None
         now = time.perf_counter()
-        if converged or self._paused or not self._busy() or now - self._last_linear >= LINEAR_INTERVAL:
+        if with_linear or converged or self._paused or not self._busy() or now - self._last_linear >= LINEAR_INTERVAL:
             accumulation = session.accumulation()
             image = resolve(accumulation)
             if has_empty and self._preview_image is not None:
@@ -531,20 +542,25 @@ class RenderWorker(QThread):
                                         tuple(float(c) for c in pick.point), node_index))
 
     # -- export ----------------------------------------------------------------------------------------------
-    def _start_export(self, start: ExportStart) -> None:
+    def _start_export(self, start: ExportStart) -> bool:
+        """Start the export; False if it could not start (the reason goes out by export_failed)."""
         from lenslab.render.job import RenderJob
+        from lenslab.render.tracer import DEFAULT_DISPATCH_SECONDS
 
         if self._export is not None:
             self.export_failed.emit(start.request_id, "another export is still running")
-            return
+            return False
         request = start.request
         try:
+            # An export's dispatches are the headless render's: long enough to keep the device busy, short
+            # enough for a cancel to be felt within a tenth of a second.
             job = RenderJob(self._renderer, request.scene, spp=request.target_spp, time_limit=request.seconds,
-                            dispatch_seconds=self.dispatch_seconds)
+                            dispatch_seconds=max(self.dispatch_seconds, DEFAULT_DISPATCH_SECONDS))
         except Exception as exc:
             self.export_failed.emit(start.request_id, _one_line(exc))
-            return
+            return False
         self._export = _Export(start.request_id, request, job)
+        return True
 
     def _cancel_export(self, request_id: int) -> None:
         export = self._export
@@ -558,7 +574,7 @@ class RenderWorker(QThread):
         export = self._export
         job = export.job
         if not job.finished:
-            progress = job.step(self.dispatch_seconds)
+            progress = job.step(EXPORT_PROGRESS_INTERVAL)
             now = time.perf_counter()
             if now - export.last_report >= EXPORT_PROGRESS_INTERVAL:
                 export.last_report = now

@@ -38,8 +38,13 @@ def cast_rays(renderer, gpu_scene: GpuScene, origins: np.ndarray, directions: np
     packed = np.zeros((n, 2, 4), np.float32)
     packed[:, 0, :3], packed[:, 0, 3] = origins, t_min
     packed[:, 1, :3], packed[:, 1, 3] = directions, np.float32(min(t_max, np.finfo(np.float32).max))
-    rays = ctx.buffer(packed.tobytes())
-    hits = ctx.buffer(reserve=n * 16)
+    # A batch as large as a 4K picture's rays outgrows what one dispatch (65535 groups on some devices) or one
+    # storage block may hold: cast it in chunks that fit both.
+    limits = renderer.limits
+    chunk = min(n, limits.max_work_group_count[0] * LOCAL_SIZE_X, limits.max_storage_block_bytes // packed[0].nbytes)
+    out = np.empty((n, 4), np.float32)
+    rays = ctx.buffer(reserve=chunk * packed[0].nbytes)
+    hits = ctx.buffer(reserve=chunk * 16)
     try:
         gpu_scene.bind()
         rays.bind_to_storage_buffer(RAYS_BINDING)
@@ -49,9 +54,13 @@ def cast_rays(renderer, gpu_scene: GpuScene, origins: np.ndarray, directions: np
         for name, value in gpu_scene.packed.uniforms.items():
             if name in program:
                 program[name].value = value
-        program["ray_count"].value = n
-        program.run((n + LOCAL_SIZE_X - 1) // LOCAL_SIZE_X, 1, 1)
-        out = np.frombuffer(hits.read(), np.float32).reshape(n, 4).copy()
+        for first in range(0, n, chunk):
+            count = min(chunk, n - first)
+            rays.write(packed[first:first + count].tobytes())
+            program["ray_count"].value = count
+            program.run((count + LOCAL_SIZE_X - 1) // LOCAL_SIZE_X, 1, 1)
+            ctx.memory_barrier()
+            out[first:first + count] = np.frombuffer(hits.read(count * 16), np.float32).reshape(count, 4)
     finally:
         rays.release()
         hits.release()

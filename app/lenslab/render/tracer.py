@@ -331,15 +331,26 @@ class RenderSession:
 
     @in_context
     def step(self, seconds: float, target_spp: int | None = None) -> Progress:
-        """Render for about ``seconds`` (at least one dispatch) or until ``target_spp`` is reached."""
+        """Render for at most about ``seconds`` (but at least one dispatch) or until ``target_spp`` is reached.
+
+        A dispatch is not started when the time it is expected to take would run past the deadline: the
+        studio asks for a frame's worth of work and must get its picture within that frame, not one dispatch
+        late."""
         self._bind_trace_buffers()
         self._set_uniforms()
         deadline = time.perf_counter() + seconds
+        first = True
         while target_spp is None or self.samples_per_pixel < target_spp:
-            self._dispatch(*self._plan_dispatch(target_spp))
-            if time.perf_counter() >= deadline:
+            pixels, samples = self._plan_dispatch(target_spp)
+            if not first and time.perf_counter() + self._expected_seconds(pixels, samples) > deadline:
                 break
+            self._dispatch(pixels, samples)
+            first = False
         return self.progress(target_spp)
+
+    def _expected_seconds(self, pixels: int, samples: int) -> float:
+        """How long a dispatch of ``pixels`` x ``samples`` should take, from the cost measured so far."""
+        return pixels * samples * (self._seconds_per_pixel_sample or 0.0)
 
     def _bind_trace_buffers(self) -> None:
         self._gpu_scene.bind()
@@ -400,6 +411,7 @@ class RenderSession:
         self._accumulation.bind_to_storage_buffer(ACCUMULATION_BINDING)
         self._display_pixels.bind_to_storage_buffer(DISPLAY_BINDING)
         program.run((self.width + DISPLAY_GROUP_X - 1) // DISPLAY_GROUP_X, self.height, 1)
+        self.ctx.memory_barrier()  # the shader's writes must be visible to the read that follows
         data = np.frombuffer(self._display_pixels.read(), dtype=np.uint8)
         return data.reshape(self.height, self.width, 4).copy()
 

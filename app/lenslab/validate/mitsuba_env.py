@@ -18,6 +18,16 @@ LLVM19 = Path("/lib/x86_64-linux-gnu/libLLVM.so.19.1")
 MISSING_MITSUBA = "Mitsuba 3 is not installed: pip install 'lenslab[validate]'"
 NO_LLVM = ("Mitsuba 3 found no usable LLVM for its JIT ({detail}): install LLVM 19 (apt-get install libllvm19) "
            "or set DRJIT_LIBLLVM_PATH to a libLLVM.so of version 11 or later")
+NO_CUDA = ("Mitsuba 3's {variant} variant cannot render here ({detail}): it needs an NVIDIA GPU and its driver; "
+           "unset LENSLAB_MITSUBA_VARIANT to compare against llvm_ad_rgb on the CPU")
+
+
+def unavailable_message(detail: str, variant: str | None = None) -> str:
+    """Why Mitsuba's chosen variant cannot render, and what to do about it."""
+    variant = variant or VARIANT
+    if variant.startswith("cuda"):
+        return NO_CUDA.format(variant=variant, detail=detail)
+    return NO_LLVM.format(detail=detail)
 
 
 class MitsubaUnavailable(RuntimeError):
@@ -64,10 +74,10 @@ def load_mitsuba():
         mi.set_variant(VARIANT)
     except Exception as exc:  # ImportError or Dr.Jit's RuntimeError when libLLVM cannot be loaded
         detail = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        raise MitsubaUnavailable(NO_LLVM.format(detail=detail)) from None
+        raise MitsubaUnavailable(unavailable_message(detail)) from None
     problem = _probe_jit()
     if problem:
-        raise MitsubaUnavailable(NO_LLVM.format(detail=problem))
+        raise MitsubaUnavailable(unavailable_message(problem))
     _mitsuba = mi
     return mi
 
