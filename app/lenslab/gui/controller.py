@@ -18,7 +18,7 @@ from PySide6.QtCore import QObject, Signal
 
 from lenslab.gui.document import copy_scene, listen
 from lenslab.gui.worker import VIEWPORT_DISPATCH_SECONDS, ExportRequest, Frame, RenderWorker
-from lenslab.render.film import TONE_MAPS
+from lenslab.render.film import check_tone_map
 
 #: Viewport quality: a fraction of the camera's resolution, or "auto" (at most AUTO_LONG_EDGE pixels wide).
 QUALITIES = {"auto": None, "full": 1.0, "half": 0.5, "quarter": 0.25}
@@ -123,9 +123,7 @@ class RenderController(QObject):
 
     def set_display(self, exposure: float, tone_map: str) -> None:
         """The viewport's look: the worker tone-maps its pictures with it (display only, no restart)."""
-        if tone_map not in TONE_MAPS:
-            raise ValueError(f"unknown tone map '{tone_map}' (choose from {', '.join(TONE_MAPS)})")
-        self.worker.set_display(exposure, tone_map)
+        self.worker.set_display(exposure, check_tone_map(tone_map))
 
     def restart(self) -> None:
         self.send_scene()

@@ -23,6 +23,13 @@ class ExportError(RuntimeError):
     pass
 
 
+def check_tone_map(operator: str) -> str:
+    """``operator`` if it is one of TONE_MAPS; otherwise a ValueError that names it and the choices."""
+    if operator not in TONE_MAPS:
+        raise ValueError(f"unknown tone map '{operator}' (choose from {', '.join(TONE_MAPS)})")
+    return operator
+
+
 def resolve(accumulation: np.ndarray) -> np.ndarray:
     """Radiance per pixel from (weighted sum rgb, weight); pixels with no samples yet are black. The weight is
     the sample count, or with a splatted gaussian filter the expected sum of filter weights (render/tracer.py)."""
@@ -45,13 +52,12 @@ def _filmic(x: np.ndarray) -> np.ndarray:
 
 def tone_map(linear: np.ndarray, exposure_stops: float = 0.0, operator: str = "clamp") -> np.ndarray:
     """Display-referred sRGB in [0, 1] from linear radiance. ``exposure_stops`` scales by 2**stops first."""
+    check_tone_map(operator)
     x = np.maximum(linear, 0.0) * np.float32(2.0**exposure_stops)
     if operator == "reinhard":
         x = x / (1.0 + x)
     elif operator == "filmic":
         x = _filmic(x)
-    elif operator != "clamp":
-        raise ValueError(f"unknown tone map '{operator}' (choose from {', '.join(TONE_MAPS)})")
     return linear_to_srgb(x).astype(np.float32)
 
 

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lenslab.render import gl
+from lenslab.render import film, gl
 from lenslab.render.buffers import GpuScene, pack_scene
 from lenslab.render.features import GENERAL, KernelFeatures, scene_features
 from lenslab.render.gpu_layout import (ACCUMULATION_BINDING, DISPLAY_BINDING, SPLAT_IMAGE_BINDING, TONE_MAP_CLAMP,
@@ -389,17 +389,14 @@ class RenderSession:
 
     def image(self) -> np.ndarray:
         """(H, W, 3) float32 linear radiance: the mean of the samples so far."""
-        from lenslab.render.film import resolve
-
-        return resolve(self.accumulation())
+        return film.resolve(self.accumulation())
 
     @in_context
     def display(self, exposure_stops: float = 0.0, tone_map: str = "clamp") -> np.ndarray:
         """(H, W, 4) uint8 RGBA: the image as a screen shows it, made on the GPU (display.comp: the steps of
         film.resolve, film.tone_map and film.to_8bit); alpha 0 where a pixel has no sample yet. A quarter of
         the bytes of :meth:`accumulation` cross to the CPU, and no per-pixel work is left for it."""
-        if tone_map not in TONE_MAP_CODES:
-            raise ValueError(f"unknown tone map '{tone_map}' (choose from {', '.join(TONE_MAP_CODES)})")
+        film.check_tone_map(tone_map)
         pixels = self.width * self.height
         if self._display_pixels is None or self._display_pixels.size != 4 * pixels:
             self._release_display_pixels()
