@@ -91,10 +91,7 @@ class LensCommand(QUndoCommand):
         self.old = {k: getattr(cam, k) for k in ("focal_length_mm", "f_number", "aperture_blades", "blade_rotation_deg")}
         self.new = dict(self.old)
         if lens is not None:
-            self.new["focal_length_mm"] = lens.clamp_focal_length(cam.focal_length_mm)
-            self.new["f_number"] = lens.clamp_f_number(cam.f_number)
-            self.new["aperture_blades"] = lens.aperture_blades
-            self.new["blade_rotation_deg"] = lens.blade_rotation_deg
+            self.new.update(lens.mount(cam.focal_length_mm, cam.f_number))
 
     def _apply(self, lens, values) -> None:
         for key, value in values.items():

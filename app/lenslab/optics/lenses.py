@@ -16,7 +16,7 @@ from .presetfiles import FieldError, PresetError, build_preset, merge_by_name, p
 from .stops import EXTENDED_THIRD_STOPS, MAX_F_NUMBER, MIN_F_NUMBER, is_valid_f_number
 from .thinlens import FOCAL_LENGTH_RANGE_MM
 
-__all__ = ["LensPreset", "LENSES_DIR", "MAX_APERTURE_BLADES", "load_lens_presets"]
+__all__ = ["LensPreset", "LENSES_DIR", "MAX_APERTURE_BLADES", "find_lens", "load_lens_presets"]
 
 #: Folder of lens files inside a presets folder.
 LENSES_DIR = "lenses"
@@ -163,6 +163,14 @@ class LensPreset:
             inside.append(self.narrowest_f_number)
         return tuple(inside)
 
+    def mount(self, focal_length_mm: float, f_number: float) -> dict[str, object]:
+        """The camera settings this lens gives a camera set to ``focal_length_mm`` and ``f_number``: the focal
+        length and aperture kept within what the lens can do, and the lens's iris (as ThinLensCamera's fields)."""
+        return {"focal_length_mm": self.clamp_focal_length(focal_length_mm),
+                "f_number": self.clamp_f_number(f_number),
+                "aperture_blades": self.aperture_blades,
+                "blade_rotation_deg": self.blade_rotation_deg}
+
 
 _KINDS = {
     "name": "string",
@@ -218,3 +226,18 @@ def load_lens_presets(
             groups.append(_read_lens_dir(lens_dir))
     lenses = merge_by_name(groups)
     return sorted(lenses, key=lambda l: (l.min_focal_length_mm, l.max_focal_length_mm, l.name))
+
+
+def _lens_key(name: str) -> str:
+    """How a lens is named loosely: "85 mm f/1.4", "85mm-f1.4" (its file's name) and "85MM F1.4" are one lens."""
+    return "".join(ch for ch in name.lower() if ch.isalnum() or ch == ".")
+
+
+def find_lens(name: str, lenses: Sequence[LensPreset] | None = None) -> LensPreset:
+    """The lens preset called ``name`` (its name, or its file's name without .json; case, spaces, dashes and
+    slashes do not matter). A ValueError that lists the lenses there are when none is called that."""
+    lenses = load_lens_presets() if lenses is None else lenses
+    for lens in lenses:
+        if _lens_key(lens.name) == _lens_key(name):
+            return lens
+    raise ValueError(f"no lens preset called '{name}' (there are: {', '.join(lens.name for lens in lenses)})")

@@ -49,10 +49,11 @@ class JobProgress:
 
 class RenderJob:
     """Render ``scene`` to ``spp`` samples per pixel, or for ``time_limit`` seconds, or both (whichever comes
-    first). With neither, the scene's own sample count. The image is the scene camera's resolution."""
+    first). With neither, the scene's own sample count. The image is the scene camera's resolution.
+    ``first_sample`` starts the sample indices elsewhere than 0: one part of a render split across workers."""
 
     def __init__(self, renderer: Renderer, scene: Scene, *, spp: int | None = None, time_limit: float | None = None,
-                 dispatch_seconds: float = DEFAULT_DISPATCH_SECONDS):
+                 dispatch_seconds: float = DEFAULT_DISPATCH_SECONDS, first_sample: int = 0):
         if spp is not None and spp < 1:
             raise ValueError(f"a render needs at least 1 sample per pixel, not {spp}")
         if time_limit is not None and not time_limit > 0:
@@ -60,7 +61,7 @@ class RenderJob:
         self.scene = scene
         self.target_spp = spp if spp is not None else (None if time_limit else scene.render.spp)
         self.time_limit = time_limit
-        self.session = RenderSession(renderer, scene, dispatch_seconds=dispatch_seconds)
+        self.session = RenderSession(renderer, scene, dispatch_seconds=dispatch_seconds, first_sample=first_sample)
         self.overran_time_limit = 0.0  # seconds past the time limit spent finishing the first full pass
         self._start = time.perf_counter()  # the time limit counts sampling, not building and compiling
 

@@ -39,6 +39,7 @@ SPLAT_MEMORY_BYTES = 128 << 20
 SPLAT_LAYERS_BYTES = 32 << 20
 SPLAT_MAX_LAYERS = 64  # samples per pixel in one splatted pass
 SPLAT_GATHER_TERMS = 1 << 22  # neighbour terms per splat.comp dispatch, to keep it short on any device
+SAMPLE_INDEX_LIMIT = 1 << 32  # the kernel's sample index is a 32-bit unsigned integer
 
 
 def in_context(method):
@@ -146,8 +147,13 @@ class RenderSession:
 
     def __init__(self, renderer: Renderer, scene: Scene, *, width: int | None = None, height: int | None = None,
                  settings: RenderSettings | None = None, dispatch_seconds: float = DEFAULT_DISPATCH_SECONDS,
-                 environment_importance: bool = True, specialise: bool = True):
+                 environment_importance: bool = True, specialise: bool = True, first_sample: int = 0):
+        if not 0 <= first_sample < SAMPLE_INDEX_LIMIT:
+            raise ValueError(f"first sample index {first_sample} is out of range [0, {SAMPLE_INDEX_LIMIT})")
         self.renderer = renderer
+        # Sample indices start here: renders of disjoint index ranges of one seed add up to one render of them
+        # all (render/job.py; lenslab.batch splits a shot across workers this way).
+        self.first_sample = first_sample
         self.specialise = specialise  # False: the general kernel, whatever the scene uses (for comparisons)
         self.environment_importance = environment_importance
         self.ctx = renderer.ctx
@@ -288,7 +294,7 @@ class RenderSession:
         program = self.program
         program["tile_start"].value = self._pixels_done
         program["tile_pixels"].value = pixels
-        program["sample_start"].value = self.samples_per_pixel
+        program["sample_start"].value = self.first_sample + self.samples_per_pixel
         program["sample_count"].value = samples
         groups = (pixels + LOCAL_SIZE_X - 1) // LOCAL_SIZE_X
         start = time.perf_counter()

@@ -12,6 +12,7 @@ import os
 from dataclasses import dataclass, field
 from typing import Callable
 
+from lenslab.optics.lenses import find_lens
 from lenslab.scene.camera import MAX_IMAGE_SIDE, ThinLensCamera
 from lenslab.scene.fields import declared_choices, declared_range
 from lenslab.scene.scene import RenderSettings, Scene
@@ -33,6 +34,7 @@ class SceneOverrides:
     max_depth: int | None = None
     sampler: str | None = None
     clamp: float | None = None
+    lens: str | None = None  # a lens preset's name: its focal length (a zoom's nearest), aperture range and iris
     defines: dict[str, str] = field(default_factory=dict)  # Mitsuba XML parameters ($name), as mitsuba -D
 
     def __post_init__(self):
@@ -48,6 +50,19 @@ class SceneOverrides:
                                      f"{', '.join(declared_choices(RenderSettings, name))}")
             else:
                 _check_range(name, value, declared_range(RenderSettings, name))
+        if self.lens is not None:
+            self._check_lens()
+
+    def _check_lens(self) -> None:
+        """A focal length or f-number given with a lens must be one the lens has: f/1.2 on an f/1.4 lens is
+        refused, not quietly changed."""
+        lens = find_lens(self.lens)
+        if self.focal_length_mm is not None and lens.clamp_focal_length(self.focal_length_mm) != self.focal_length_mm:
+            raise ValueError(f"focal_length {self.focal_length_mm:g} mm is not on the lens '{lens.name}' "
+                             f"({lens.min_focal_length_mm:g}-{lens.max_focal_length_mm:g} mm)")
+        if self.f_number is not None and lens.clamp_f_number(self.f_number) != self.f_number:
+            raise ValueError(f"f/{self.f_number:g} is not on the lens '{lens.name}' "
+                             f"(f/{lens.widest_f_number:g} to f/{lens.narrowest_f_number:g})")
 
     def open(self, scene_ref: str | os.PathLike, warn: Callable[[str], None] | None = None) -> Scene:
         """Load a scene file (native or Mitsuba XML, with this object's defines) and apply the overrides."""
@@ -58,6 +73,11 @@ class SceneOverrides:
     def apply(self, scene: Scene) -> Scene:
         """A copy of ``scene`` with the overrides set; fields left at None keep the scene's value."""
         camera_changes = {name: getattr(self, name) for name in _CAMERA_FIELDS if getattr(self, name) is not None}
+        if self.lens is not None:  # mounted first: the focal length and f-number given with it are on the lens
+            camera = scene.camera
+            mounted = find_lens(self.lens).mount(camera_changes.get("focal_length_mm", camera.focal_length_mm),
+                                                 camera_changes.get("f_number", camera.f_number))
+            camera_changes = {**mounted, **camera_changes}
         if self.width is not None or self.height is not None:
             camera_changes["resolution"] = self._resolution(scene.camera.resolution)
         render_changes = {name: getattr(self, name) for name in _RENDER_FIELDS if getattr(self, name) is not None}
