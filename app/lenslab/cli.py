@@ -71,6 +71,7 @@ def build_parser() -> argparse.ArgumentParser:
         "  lenslab my_scene.json --headless -o shot.exr --f-stop 1.4 --focus-distance 2.5 --time-limit 60\n"
         "Focal length, f-number and focus distance override the scene's camera for this render only; "
         "brightness does not change with the f-number. Shipped scenes: " + ", ".join(shipped_scene_names()) + ".\n"
+        "Render many shots (brackets, focus stacks, a farm): lenslab batch --help.\n"
         "Compare with Mitsuba 3: lenslab validate --help.\n",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -274,6 +275,10 @@ def main(argv: list[str] | None = None) -> int:
         from lenslab.validate.cli import main as validate_main
 
         return validate_main(args_list[1:])
+    if args_list[:1] == ["batch"]:
+        from lenslab.batch.cli import main as batch_main
+
+        return batch_main(args_list[1:])
     from lenslab.optics.presetfiles import PresetError
     from lenslab.render.buffers import SceneTooLarge
     from lenslab.render.film import ExportError

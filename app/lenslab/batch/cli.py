@@ -1,0 +1,237 @@
+"""``lenslab batch shots.toml``: render every shot of a batch file, on this machine or a Dask cluster.
+
+One progress bar for the batch and one per shot being rendered on a terminal; one line per finished, skipped
+or failed shot otherwise. Exit status 0 when every shot is written (now or by an earlier run), 1 when any
+failed (the others are still rendered), 2 for a usage error, 130 when interrupted (nothing half-written).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+
+from lenslab.batch.spec import Batch, BatchError, read_batch
+
+EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
+MAX_LOCAL_WORKERS = 256
+
+
+class _UsageError(Exception):
+    pass
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str):
+        raise _UsageError(f"{message} (see lenslab batch --help)")
+
+
+def _workers(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, not '{text}'") from None
+    if not 1 <= value <= MAX_LOCAL_WORKERS:
+        raise argparse.ArgumentTypeError(f"{text} is out of range [1, {MAX_LOCAL_WORKERS}]")
+    return value
+
+
+def _devices(text: str) -> tuple[int, ...]:
+    try:
+        devices = tuple(int(part) for part in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected device numbers such as 0,1, not '{text}'") from None
+    if not devices or any(not 0 <= d <= 64 for d in devices):
+        raise argparse.ArgumentTypeError(f"device numbers lie in [0, 64], not '{text}'")
+    return devices
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = _Parser(
+        prog="lenslab batch",
+        description="Render the shots of a batch file (TOML or JSON: docs/batch.md) on worker processes of this "
+                    "machine, or on a Dask cluster. Shots whose output exists are skipped, so a batch that was "
+                    "interrupted resumes where it stopped.",
+        epilog="Examples:\n"
+               "  lenslab batch shots.toml                       # one worker on this machine\n"
+               "  lenslab batch shots.toml --workers 4 --devices 0,1,2,3   # a worker per GPU\n"
+               "  lenslab batch shots.toml --scheduler tcp://farm:8786      # a running Dask cluster\n",
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("batch_file", metavar="BATCH", help="the batch file (.toml or .json)")
+    p.add_argument("--workers", type=_workers, default=None, metavar="N",
+                   help="worker processes on this machine (default: one per --devices entry, else 1)")
+    p.add_argument("--devices", type=_devices, default=(), metavar="0,1",
+                   help="GPUs (EGL device numbers) for this machine's workers, one worker each unless --workers")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="use a running Dask cluster, e.g. tcp://farm:8786; its workers must reach the scene files "
+                        "at the same paths (docs/batch.md)")
+    p.add_argument("--force", action="store_true", help="render every shot, even those whose output exists")
+    p.add_argument("--contact-sheet", metavar="FILE.png", help="also write a contact sheet here (besides any the "
+                   "batch file names)")
+    p.add_argument("--dry-run", action="store_true", help="list the shots and their outputs, render nothing")
+    return p
+
+
+def main(argv: list[str]) -> int:
+    from lenslab.cli import _report_library_warnings
+
+    _report_library_warnings()
+    try:
+        return run(argv)
+    except _UsageError as exc:
+        print(f"lenslab batch: error: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except BatchError as exc:
+        print(f"lenslab batch: error: {exc}", file=sys.stderr)
+        return EXIT_ERROR
+    except KeyboardInterrupt:
+        print("lenslab batch: interrupted; every shot reported done is written, and running the batch again "
+              "renders the rest", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except OSError as exc:  # the scheduler cannot be reached, a worker cannot start
+        print(f"lenslab batch: error: {' '.join(str(exc).split())}", file=sys.stderr)
+        return EXIT_ERROR
+
+
+def run(argv: list[str]) -> int:
+    args = build_parser().parse_args(argv)
+    if args.scheduler and (args.workers or args.devices):
+        raise _UsageError("--scheduler uses the cluster's own workers: leave out --workers and --devices (pin a "
+                          "worker to a GPU with LENSLAB_DEVICE=N in its environment)")
+    batch = read_batch(args.batch_file)
+    contact_sheets = [p for p in (batch.contact_sheet, args.contact_sheet) if p]
+    if args.contact_sheet and not str(args.contact_sheet).lower().endswith(".png"):
+        raise _UsageError(f"--contact-sheet {args.contact_sheet}: a contact sheet is a .png")
+    if args.dry_run:
+        _print_plan(batch, args.force)
+        return EXIT_OK
+    summary = _render(batch, args)
+    for sheet in contact_sheets:
+        _write_contact_sheet(batch, sheet, summary)
+    if summary.failed:
+        print(f"lenslab batch: {len(summary.failed)} of {len(batch.shots)} shots failed:", file=sys.stderr)
+        for shot, message in summary.failed:
+            print(f"  {shot.name}: {message}", file=sys.stderr)
+        return EXIT_ERROR
+    return EXIT_OK
+
+
+def _print_plan(batch: Batch, force: bool) -> None:
+    for shot in batch.shots:
+        state = "exists, skipped" if shot.output.exists() and not force else "to render"
+        parts = f", in {shot.split} parts" if shot.split > 1 else ""
+        print(f"{shot.name}: {shot.output} ({state}{parts})")
+
+
+def _cluster_client(args):
+    from distributed import Client
+
+    from lenslab.batch.farm import local_cluster
+
+    if args.scheduler:
+        return None, Client(args.scheduler, timeout="20s")
+    workers = args.workers or max(1, len(args.devices))
+    cluster = local_cluster(workers)
+    return cluster, Client(cluster)
+
+
+def _render(batch: Batch, args):
+    from lenslab.batch.farm import run_batch
+
+    display = _Display(len(batch.shots))
+    cluster, client = _cluster_client(args)
+    try:
+        with display:
+            summary = run_batch(batch.shots, client, force=args.force, devices=args.devices, on_event=display.show)
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+    display.summary(summary)
+    return summary
+
+
+class _Display:
+    """Rich progress bars on a terminal (the batch, and each shot being rendered); plain lines otherwise."""
+
+    def __init__(self, shots: int):
+        from rich.console import Console
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+        self.console = Console(stderr=True)
+        self.bars = Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.fields[status]}"),
+                             TimeElapsedColumn(), console=self.console, disable=not self.console.is_terminal)
+        self.overall = self.bars.add_task("[bold]batch", total=shots, status="")
+        self._shots: dict[str, int] = {}
+        self._start = time.perf_counter()
+        self._finished = 0
+        self._total = shots
+
+    def __enter__(self):
+        self.bars.__enter__()
+        return self
+
+    def __exit__(self, *exc):
+        return self.bars.__exit__(*exc)
+
+    def _line(self, text: str) -> None:
+        self.console.print(text, highlight=False, markup=False, soft_wrap=True)
+
+    def _finish(self, shot, text: str) -> None:
+        self._finished += 1
+        task = self._shots.pop(str(shot.output), None)
+        if task is not None:
+            self.bars.remove_task(task)
+        self.bars.update(self.overall, completed=self._finished, status=f"{self._finished}/{self._total} shots")
+        self._line(text)
+
+    def show(self, event) -> None:
+        from lenslab.batch.farm import PartRetried, ShotDone, ShotFailed, ShotProgress, ShotSkipped
+
+        shot = event.shot
+        if isinstance(event, ShotSkipped):
+            self._finish(shot, f"skipped {shot.name}: {shot.output} exists (--force renders it again)")
+        elif isinstance(event, ShotDone):
+            for warning in event.warnings:
+                self._line(f"lenslab batch: warning: {shot.name}: {warning}")
+            self._finish(shot, f"wrote {shot.output} ({shot.name}, {event.samples_per_pixel} spp, "
+                               f"{event.seconds:.1f} s of sampling)")
+        elif isinstance(event, ShotFailed):
+            self._finish(shot, f"failed {shot.name}: {event.message}")
+        elif isinstance(event, PartRetried):
+            self._line(f"{shot.name}: a worker was lost; part {event.part + 1} of {shot.split} starts again on "
+                       f"{event.worker}")
+        elif isinstance(event, ShotProgress):
+            key = str(shot.output)
+            if key not in self._shots:
+                self._shots[key] = self.bars.add_task(shot.name, total=1.0, status="")
+            workers = f" on {event.workers} workers" if event.workers > 1 else ""
+            self.bars.update(self._shots[key], completed=event.fraction,
+                             status=f"{event.samples_per_pixel} spp, "
+                                    f"{event.samples_per_second / 1e6:.2f} M samples/s{workers}")
+
+    def summary(self, summary) -> None:
+        minutes = (time.perf_counter() - self._start) / 60
+        self._line(f"{len(summary.done)} rendered, {len(summary.skipped)} skipped, {len(summary.failed)} failed "
+                   f"in {minutes * 60:.1f} s")
+
+
+def _write_contact_sheet(batch: Batch, path, summary) -> None:
+    from pathlib import Path
+
+    from lenslab.batch.contact_sheet import Frame, shot_caption, write_contact_sheet
+    from lenslab.scene.scene import SceneError
+
+    failed = {str(shot.output): message for shot, message in summary.failed}
+    frames = []
+    for shot in batch.shots:
+        try:
+            caption = shot_caption(shot.open_scene().camera, lens_name=shot.overrides.lens)
+        except (SceneError, ValueError, OSError) as exc:
+            caption = " ".join(str(exc).split())
+        if str(shot.output) in failed:
+            caption = f"failed: {failed[str(shot.output)]}"
+        image = shot.output if shot.output.exists() else None
+        frames.append(Frame(image, shot.name, caption, tone_map=shot.tone_map, exposure=shot.exposure))
+    written = write_contact_sheet(Path(path), frames)
+    print(f"wrote contact sheet {written} ({len(frames)} shots)", file=sys.stderr)

@@ -1,0 +1,331 @@
+"""A batch file: the shots to render, with brackets and sweeps written compactly (docs/batch.md).
+
+::
+
+    contact_sheet = "renders/sheet.png"
+
+    [defaults]
+    scene = "dof_chart"
+    width = 480
+    spp = 64
+
+    [[shots]]
+    name = "aperture bracket"
+    output = "renders/chart_f{f_number}.png"
+    f_number = [1.4, 2, 2.8, 4]
+
+A list is a sweep and a ``{from, to, steps}`` table a range; a shot with several of them is rendered for every
+combination. Every problem is reported as one line naming the file, the shot and the key, before anything
+renders: a batch that would fail at its fortieth shot fails at once.
+"""
+
+from __future__ import annotations
+
+import difflib
+import itertools
+import json
+import math
+import re
+import string
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from lenslab.render.film import EXPORT_SUFFIXES, TONE_MAPS
+from lenslab.scene.overrides import SceneOverrides
+
+#: Parts one shot may be split into (one per worker).
+MAX_SPLIT = 256
+
+
+class BatchError(ValueError):
+    """A batch file that cannot be used; the message is one line naming the file (and the shot and key)."""
+
+
+# The keys a shot may have: what each sets, and what kind of value it takes.
+_OVERRIDE_KEYS = {  # batch key: SceneOverrides field
+    "f_number": "f_number", "focal_length": "focal_length_mm", "focus_distance": "focus_distance_m",
+    "width": "width", "height": "height", "spp": "spp", "seed": "seed", "max_depth": "max_depth",
+    "sampler": "sampler", "clamp": "clamp", "lens": "lens",
+}
+_KINDS = {
+    "name": str, "scene": str, "output": str, "lens": str, "sampler": str, "tone_map": str,
+    "f_number": float, "focal_length": float, "focus_distance": float, "clamp": float, "time_limit": float,
+    "exposure": float,
+    "width": int, "height": int, "spp": int, "seed": int, "max_depth": int, "split": int,
+    "defines": dict,
+}
+_NOT_SWEPT = ("name", "output", "defines")  # one value per shot
+_TOP_LEVEL = ("defaults", "shots", "contact_sheet")
+
+
+@dataclass(frozen=True)
+class Shot:
+    """One image to render: a scene, what to change in it, and where the image goes."""
+
+    name: str
+    scene: str  # a scene file (absolute path) or a shipped scene's name
+    output: Path
+    overrides: SceneOverrides = field(default_factory=SceneOverrides)
+    time_limit: float | None = None
+    exposure: float = 0.0  # PNG only, as on the command line
+    tone_map: str = "clamp"
+    split: int = 1  # render in this many sample ranges, on as many workers, and merge
+    where: str = ""  # "shots.toml, shot 2 ('bracket'), f/2.8" for messages
+    number: int = 0  # which [[shots]] entry of the file it came from (1 for the first)
+
+    def open_scene(self, warn=None):
+        """The scene with this shot's overrides applied (a SceneError names the scene's file)."""
+        return self.overrides.open(self.scene, warn=warn)
+
+
+@dataclass(frozen=True)
+class Batch:
+    path: Path
+    shots: tuple[Shot, ...]
+    contact_sheet: Path | None = None
+
+
+def read_batch(path: str | Path) -> Batch:
+    """Read and check a batch file (.toml or .json); BatchError on any problem."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise BatchError(f"{path}: no such batch file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise BatchError(f"{path}: cannot read ({exc})") from None
+    return parse_batch(text, path)
+
+
+def parse_batch(text: str, path: Path) -> Batch:
+    """The batch in ``text``, read as the file ``path`` (its suffix picks TOML or JSON; relative scene and
+    output paths are relative to its folder)."""
+    document = _decode(text, path)
+    unknown = [key for key in document if key not in _TOP_LEVEL]
+    if unknown:
+        raise BatchError(f"{path}: unknown key '{unknown[0]}'{_did_you_mean(unknown[0], _TOP_LEVEL)} "
+                         f"(a batch file has {', '.join(_TOP_LEVEL)})")
+    defaults = document.get("defaults", {})
+    if not isinstance(defaults, dict):
+        raise BatchError(f"{path}: 'defaults' must be a table of shot settings")
+    _check_keys(defaults, f"{path}, defaults")
+    entries = document.get("shots")
+    if not isinstance(entries, list) or not entries or not all(isinstance(e, dict) for e in entries):
+        raise BatchError(f"{path}: no shots: give at least one [[shots]] table (TOML) or a \"shots\" list (JSON)")
+    folder = path.parent.resolve()
+    shots: list[Shot] = []
+    for number, entry in enumerate(entries, start=1):
+        where = f"{path}, shot {number}" + (f" ('{entry['name']}')" if isinstance(entry.get("name"), str) else "")
+        _check_keys(entry, where)
+        shots.extend(_expand(number, {**defaults, **entry}, folder, where))
+    _check_outputs(shots, path)
+    contact_sheet = document.get("contact_sheet")
+    if contact_sheet is not None:
+        if not isinstance(contact_sheet, str) or not contact_sheet.strip():
+            raise BatchError(f"{path}: contact_sheet: expected a file name, not {contact_sheet!r}")
+        contact_sheet = folder / contact_sheet
+        if contact_sheet.suffix.lower() != ".png":
+            raise BatchError(f"{path}: contact_sheet: {contact_sheet.name} must be a .png")
+    return Batch(path, tuple(shots), contact_sheet)
+
+
+def _decode(text: str, path: Path) -> dict:
+    suffix = path.suffix.lower()
+    if suffix == ".json":
+        try:
+            document = json.loads(text)
+        except (json.JSONDecodeError, RecursionError) as exc:
+            raise BatchError(f"{path}: not valid JSON ({exc})") from None
+    elif suffix == ".toml":
+        try:
+            import tomllib
+        except ModuleNotFoundError:  # Python 3.10
+            import tomli as tomllib
+        try:
+            document = tomllib.loads(text)
+        except (tomllib.TOMLDecodeError, RecursionError) as exc:
+            raise BatchError(f"{path}: not valid TOML ({exc})") from None
+    else:
+        raise BatchError(f"{path}: unknown batch file type '{path.suffix}' (use .toml or .json)")
+    if not isinstance(document, dict):
+        raise BatchError(f"{path}: expected a table of settings and shots at the top")
+    return document
+
+
+def _did_you_mean(word: str, choices) -> str:
+    close = difflib.get_close_matches(word, list(choices), n=1)
+    return f" (did you mean '{close[0]}'?)" if close else ""
+
+
+def _check_keys(table: dict, where: str) -> None:
+    for key in table:
+        if key not in _KINDS:
+            raise BatchError(f"{where}: unknown key '{key}'{_did_you_mean(key, _KINDS)}")
+
+
+# -- sweeps --------------------------------------------------------------------------------------------------
+def _values(key: str, raw, where: str) -> list:
+    """The values a key takes: one, a list (a sweep) or a {from, to, steps} range; each checked for kind."""
+    kind = _KINDS[key]
+    if isinstance(raw, list) and kind is not dict:
+        if key in _NOT_SWEPT:
+            raise BatchError(f"{where}: {key}: takes one value, not a list")
+        if not raw:
+            raise BatchError(f"{where}: {key}: an empty list sweeps over nothing")
+        return [_scalar(key, value, where) for value in raw]
+    if isinstance(raw, dict) and kind is not dict:
+        if key in _NOT_SWEPT or kind is str:
+            raise BatchError(f"{where}: {key}: expected {_kind_name(kind)}, not a table")
+        return _range(key, raw, where)
+    return [_scalar(key, raw, where)]
+
+
+def _kind_name(kind) -> str:
+    return {str: "a string", float: "a number", int: "a whole number", dict: "a table"}[kind]
+
+
+def _scalar(key: str, value, where: str):
+    kind = _KINDS[key]
+    ok = (isinstance(value, str) if kind is str else
+          isinstance(value, dict) if kind is dict else
+          isinstance(value, int) and not isinstance(value, bool) if kind is int else
+          isinstance(value, (int, float)) and not isinstance(value, bool))
+    if not ok:
+        raise BatchError(f"{where}: {key}: expected {_kind_name(kind)}, not {_shown(value)}")
+    if kind is float:
+        value = float(value)
+        if not math.isfinite(value):
+            raise BatchError(f"{where}: {key}: {value} is not a finite number")
+    return value
+
+
+def _shown(value) -> str:
+    text = json.dumps(value) if not isinstance(value, str) else repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+_RANGE_KEYS = ("from", "to", "steps", "spacing")
+
+
+def _range(key: str, table: dict, where: str) -> list:
+    """``{from = 1, to = 8, steps = 4}`` -> [1, 3.33, 5.67, 8]; ``spacing = "geometric"`` spaces by equal ratios
+    (a focus stack, or f-numbers a stop apart: {from = 1.4, to = 16, steps = 8, spacing = "geometric"})."""
+    unknown = [k for k in table if k not in _RANGE_KEYS]
+    if unknown:
+        raise BatchError(f"{where}: {key}: a range has from, to, steps and optionally spacing, not '{unknown[0]}'")
+    for name in ("from", "to", "steps"):
+        if name not in table:
+            raise BatchError(f"{where}: {key}: a range needs '{name}'")
+    low, high = (_scalar(key, table[name], f"{where}: {key}.{name}") for name in ("from", "to"))
+    steps = table["steps"]
+    if isinstance(steps, bool) or not isinstance(steps, int) or not 1 <= steps <= 10_000:
+        raise BatchError(f"{where}: {key}.steps: expected a whole number from 1 to 10000, not {_shown(steps)}")
+    spacing = table.get("spacing", "linear")
+    if spacing not in ("linear", "geometric"):
+        raise BatchError(f"{where}: {key}.spacing: '{spacing}' is not linear or geometric")
+    if spacing == "geometric" and not (low > 0 and high > 0):
+        raise BatchError(f"{where}: {key}: a geometric range needs positive ends, not {low:g} to {high:g}")
+    if steps == 1:
+        return [low]
+    fractions = [i / (steps - 1) for i in range(steps)]
+    if spacing == "geometric":
+        values = [low * (high / low) ** t for t in fractions]
+    else:
+        values = [low + (high - low) * t for t in fractions]
+    values[-1] = high  # exactly the end the user wrote
+    return [round(v) for v in values] if _KINDS[key] is int else [round(v, 6) for v in values]
+
+
+def _expand(number: int, settings: dict, folder: Path, where: str) -> list[Shot]:
+    """One Shot per combination of the swept keys' values, in the order the file gives them."""
+    for required in ("scene", "output"):
+        if required not in settings:
+            raise BatchError(f"{where}: no '{required}' (give it in the shot or in [defaults])")
+    choices = {key: _values(key, raw, where) for key, raw in settings.items()}
+    swept = [key for key, values in choices.items() if len(values) > 1]
+    shots = []
+    for index, combination in enumerate(itertools.product(*choices.values()), start=1):
+        values = dict(zip(choices, combination))
+        shot_where = where + (f", {_describe(values, swept)}" if swept else "")
+        shots.append(_shot(number, index, values, swept, folder, shot_where))
+    return shots
+
+
+def _describe(values: dict, keys) -> str:
+    """How a photographer writes the settings that tell the shots of a sweep apart: f/2.8, 50 mm, 1.5 m."""
+    words = []
+    for key in keys:
+        value = values[key]
+        words.append({"f_number": f"f/{value:g}", "focal_length": f"{value:g} mm", "focus_distance": f"{value:g} m"}
+                     .get(key, f"{key} {value:g}" if isinstance(value, (int, float)) else str(value)))
+    return ", ".join(words)
+
+
+def _shot(number: int, index: int, values: dict, swept: list[str], folder: Path, where: str) -> Shot:
+    output = folder / _output_name(values, index, where)
+    if output.suffix.lower() not in EXPORT_SUFFIXES:
+        raise BatchError(f"{where}: output: {output.name} must be an .exr or a .png")
+    base_name = values.get("name") or Path(values["output"]).stem.split("{")[0].rstrip("_-. ") or f"shot {number}"
+    name = base_name + (f" {_describe(values, swept)}" if swept else "")
+    try:
+        overrides = SceneOverrides(**{field_name: values[key] for key, field_name in _OVERRIDE_KEYS.items()
+                                      if key in values},
+                                   defines={str(k): str(v) for k, v in values.get("defines", {}).items()})
+    except ValueError as exc:
+        raise BatchError(f"{where}: {exc}") from None
+    time_limit = values.get("time_limit")
+    if time_limit is not None and not 0 < time_limit <= 1e7:
+        raise BatchError(f"{where}: time_limit: {time_limit:g} s is out of range (0, 1e7]")
+    exposure = values.get("exposure", 0.0)
+    if not -30 <= exposure <= 30:
+        raise BatchError(f"{where}: exposure: {exposure:g} stops is out of range [-30, 30]")
+    tone_map = values.get("tone_map", "clamp")
+    if tone_map not in TONE_MAPS:
+        raise BatchError(f"{where}: tone_map: '{tone_map}' is not one of {', '.join(TONE_MAPS)}")
+    split = values.get("split", 1)
+    if not 1 <= split <= MAX_SPLIT:
+        raise BatchError(f"{where}: split: {split} is out of range [1, {MAX_SPLIT}]")
+    scene = values["scene"]
+    if (folder / scene).exists():  # a file beside the batch file; otherwise a shipped scene's name
+        scene = str((folder / scene).resolve())
+    return Shot(name=name, scene=scene, output=output, overrides=overrides, time_limit=time_limit,
+                exposure=exposure, tone_map=tone_map, split=split, where=where, number=number)
+
+
+class _OutputFormatter(string.Formatter):
+    """str.format for file names: 2.0 is written 2 and 1.4 stays 1.4 unless a format is given; text such as a
+    lens's name "85 mm f/1.4" becomes 85_mm_f_1.4, safe in a file name."""
+
+    def format_field(self, value, format_spec):
+        if isinstance(value, float) and not format_spec:
+            return f"{value:g}"
+        if isinstance(value, str):
+            return re.sub(r"[^A-Za-z0-9.+-]+", "_", value).strip("_")
+        return super().format_field(value, format_spec)
+
+
+def _output_name(values: dict, index: int, where: str) -> str:
+    template = values["output"]
+    fields = {key: value for key, value in values.items() if key not in ("output", "defines")}
+    fields["index"] = index
+    try:
+        return _OutputFormatter().format(template, **fields)
+    except KeyError as exc:
+        name = exc.args[0]
+        problem = (f"this shot sets no {name}" if name in _KINDS else
+                   f"unknown field {{{name}}}{_did_you_mean(str(name), [*_KINDS, 'index'])}")
+        raise BatchError(f"{where}: output: '{template}' names {{{name}}}, but {problem}") from None
+    except (ValueError, IndexError) as exc:
+        raise BatchError(f"{where}: output: '{template}' is not a valid name pattern ({exc})") from None
+
+
+def _check_outputs(shots: list[Shot], path: Path) -> None:
+    """Two shots writing one file would lose a render: say which, and how to tell them apart."""
+    seen: dict[Path, Shot] = {}
+    for shot in shots:
+        first = seen.setdefault(shot.output, shot)
+        if first is not shot:
+            hint = ("put the swept setting in the output's name, e.g. {f_number} or {index}"
+                    if first.number == shot.number else "give each shot its own output")
+            raise BatchError(f"{path}: {first.where.removeprefix(f'{path}, ')} and "
+                             f"{shot.where.removeprefix(f'{path}, ')} both write {shot.output.name}: {hint}")
