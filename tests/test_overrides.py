@@ -38,3 +38,25 @@ def test_nonsense_is_refused_by_name(bad):
     name = next(iter(bad))
     with pytest.raises(ValueError, match=name):
         SceneOverrides(**bad)
+
+
+def test_a_lens_mounts_its_focal_length_aperture_range_and_iris():
+    scene = open_scene("cornell_box")
+    scene.camera.f_number = 1.2
+    mounted = SceneOverrides(lens="85 mm f/1.4").apply(scene).camera
+    assert (mounted.focal_length_mm, mounted.f_number, mounted.aperture_blades) == (85.0, 1.4, 11)  # f/1.2 clamped
+    zoom = SceneOverrides(lens="70-200mm-f2.8", focal_length_mm=135, f_number=4).apply(scene).camera
+    assert (zoom.focal_length_mm, zoom.f_number) == (135.0, 4.0)
+    nearest = SceneOverrides(lens="70-200 mm f/2.8").apply(scene).camera
+    assert nearest.focal_length_mm == 70.0  # the zoom's nearest length to the scene's own 50 mm
+
+
+@pytest.mark.parametrize("bad, message", [
+    ({"lens": "400mm"}, "no lens preset called '400mm' (there are: 14 mm f/2.8, "),
+    ({"lens": "85mm f1.4", "f_number": 1.2}, "f/1.2 is not on the lens '85 mm f/1.4'"),
+    ({"lens": "24-70 mm f/2.8", "focal_length_mm": 85}, "focal_length 85 mm is not on the lens '24-70 mm f/2.8'"),
+])
+def test_a_setting_the_lens_does_not_have_is_refused(bad, message):
+    with pytest.raises(ValueError) as caught:
+        SceneOverrides(**bad)
+    assert message in str(caught.value)

@@ -205,7 +205,7 @@ class _Display:
             key = str(shot.output)
             if key not in self._shots:
                 self._shots[key] = self.bars.add_task(shot.name, total=1.0, status="")
-            workers = f" on {event.workers} workers" if event.workers > 1 else ""
+            workers = f" on {len(event.workers)} workers" if len(event.workers) > 1 else ""
             self.bars.update(self._shots[key], completed=event.fraction,
                              status=f"{event.samples_per_pixel} spp, "
                                     f"{event.samples_per_second / 1e6:.2f} M samples/s{workers}")

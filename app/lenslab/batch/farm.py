@@ -37,7 +37,7 @@ class ShotProgress:
     fraction: float  # 0 to 1 over all its parts
     samples_per_pixel: int  # in the parts so far
     samples_per_second: float  # all its parts together
-    workers: int  # rendering it now
+    workers: tuple[str, ...]  # the addresses of the workers rendering it now
 
 
 @dataclass(frozen=True)
@@ -76,16 +76,17 @@ class BatchSummary:
 
 
 # -- the cluster -----------------------------------------------------------------------------------------------
-def local_cluster(workers: int, *, dashboard_address: str | None = None):
+def local_cluster(workers: int, *, dashboard_address: str = ":0"):
     """A Dask cluster of ``workers`` processes on this machine, one task at a time each (a worker renders on one
-    GL context). llvmpipe is told to share the cores among them, unless LP_NUM_THREADS says otherwise."""
+    GL context). llvmpipe is told to share the cores among them, unless LP_NUM_THREADS says otherwise. Dask's
+    scheduler always serves HTTP; by default on a free port, so that it never takes a dashboard's usual 8787."""
     from distributed import LocalCluster
 
     env = {}
     if "LP_NUM_THREADS" not in os.environ:
         env["LP_NUM_THREADS"] = str(max(1, (os.cpu_count() or 1) // workers))
     return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=dashboard_address,
-                        silence_logs=logging.ERROR, env=env)
+                        silence_logs=logging.CRITICAL, env=env)
 
 
 # -- the run ---------------------------------------------------------------------------------------------------
@@ -191,7 +192,7 @@ def _on_progress(states: dict[str, _ShotState], message: PartProgress, emit) -> 
     running = [p for part, p in state.progress.items() if part not in state.assembly.results]
     emit(ShotProgress(state.shot, state.fraction(),
                       sum(p.progress.samples_per_pixel for p in state.progress.values()),
-                      sum(p.progress.samples_per_second for p in running), len(running)))
+                      sum(p.progress.samples_per_second for p in running), tuple(p.worker for p in running)))
 
 
 def _failure(future) -> str | None:

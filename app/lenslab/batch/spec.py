@@ -256,8 +256,11 @@ def _describe(values: dict, keys) -> str:
     words = []
     for key in keys:
         value = values[key]
-        words.append({"f_number": f"f/{value:g}", "focal_length": f"{value:g} mm", "focus_distance": f"{value:g} m"}
-                     .get(key, f"{key} {value:g}" if isinstance(value, (int, float)) else str(value)))
+        if isinstance(value, str):
+            words.append(value if key in ("lens", "scene") else f"{key} {value}")
+        else:
+            units = {"f_number": "f/{:g}", "focal_length": "{:g} mm", "focus_distance": "{:g} m"}
+            words.append(units.get(key, key + " {:g}").format(value))
     return ", ".join(words)
 
 

@@ -1,0 +1,150 @@
+"""Batch files: sweeps and ranges expand into shots, output names are filled in, and every mistake is one line
+naming the file, the shot and the key, before anything renders."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from lenslab.batch.parts import PART_INDEX_STRIDE, sample_range
+from lenslab.batch.spec import BatchError, parse_batch, read_batch
+
+
+def batch(tmp_path: Path, text: str, name: str = "shots.toml"):
+    path = tmp_path / name
+    path.write_text(text)
+    return read_batch(path)
+
+
+def error(tmp_path: Path, text: str, name: str = "shots.toml") -> str:
+    with pytest.raises(BatchError) as caught:
+        batch(tmp_path, text, name)
+    message = str(caught.value)
+    assert "\n" not in message and message.startswith(str(tmp_path / name))
+    return message
+
+
+def test_a_list_is_a_sweep_and_defaults_apply_to_every_shot(tmp_path):
+    shots = batch(tmp_path, """
+        [defaults]
+        scene = "cornell_box"
+        width = 64
+        spp = 16
+        [[shots]]
+        name = "bracket"
+        output = "out/c_f{f_number}.png"
+        f_number = [1.4, 2, 2.8]
+        [[shots]]
+        output = "out/single.exr"
+        spp = 4
+    """).shots
+    assert [s.name for s in shots] == ["bracket f/1.4", "bracket f/2", "bracket f/2.8", "single"]
+    assert [s.output for s in shots] == [tmp_path / "out/c_f1.4.png", tmp_path / "out/c_f2.png",
+                                         tmp_path / "out/c_f2.8.png", tmp_path / "out/single.exr"]
+    assert [s.overrides.f_number for s in shots] == [1.4, 2.0, 2.8, None]
+    assert [s.overrides.spp for s in shots] == [16, 16, 16, 4]  # a shot's own value wins over the default
+    assert all(s.overrides.width == 64 and s.scene == "cornell_box" for s in shots)
+
+
+def test_ranges_linear_and_geometric_and_the_product_of_two_sweeps(tmp_path):
+    shots = batch(tmp_path, """
+        [[shots]]
+        scene = "dof_chart"
+        output = "stack_{index:02d}_f{f_number}.exr"
+        focus_distance = {from = 1, to = 4, steps = 4}
+        f_number = {from = 2, to = 8, steps = 3, spacing = "geometric"}
+    """).shots
+    pairs = [(s.overrides.focus_distance_m, s.overrides.f_number) for s in shots]
+    assert pairs == [(d, n) for d in (1.0, 2.0, 3.0, 4.0) for n in (2.0, 4.0, 8.0)]
+    assert shots[0].output.name == "stack_01_f2.exr" and shots[-1].output.name == "stack_12_f8.exr"
+    assert shots[4].name == "stack 2 m, f/4"
+
+
+def test_lens_names_become_safe_file_names_and_the_lens_is_mounted(tmp_path):
+    shots = batch(tmp_path, """
+        [[shots]]
+        scene = "cornell_box"
+        output = "lens_{lens}.png"
+        lens = ["35 mm f/1.4", "85mm-f1.4"]
+    """).shots
+    assert [s.output.name for s in shots] == ["lens_35_mm_f_1.4.png", "lens_85mm-f1.4.png"]
+    camera = shots[1].open_scene().camera
+    assert (camera.focal_length_mm, camera.aperture_blades) == (85.0, 11)
+
+
+def test_json_batch_files_and_scene_paths_beside_the_batch_file(tmp_path):
+    (tmp_path / "my_scene.json").write_text("{}")
+    shots = batch(tmp_path, json.dumps({"shots": [{"scene": "my_scene.json", "output": "a_{seed}.exr",
+                                                   "seed": [1, 2], "defines": {"spp": 8}}]}), "shots.json").shots
+    assert [s.scene for s in shots] == [str(tmp_path / "my_scene.json")] * 2
+    assert [s.output.name for s in shots] == ["a_1.exr", "a_2.exr"]
+    assert shots[0].overrides.defines == {"spp": "8"}  # as -D spp=8
+
+
+@pytest.mark.parametrize("text, expected", [
+    ("[[shots]]\nscene='cornell_box'\noutput='a.png'\nf_numbr=2", "shot 1: unknown key 'f_numbr' (did you mean 'f_number'?)"),
+    ("[[shots]]\nscene='cornell_box'\noutput='a.png'\nspp='many'", "shot 1: spp: expected a whole number, not 'many'"),
+    ("[[shots]]\nscene='cornell_box'\noutput='a.png'\nspp=2.5", "shot 1: spp: expected a whole number, not 2.5"),
+    ("[[shots]]\nscene='cornell_box'\noutput='a.png'\nf_number=0.1", "shot 1: f_number 0.1 is out of range"),
+    ("[[shots]]\nscene='cornell_box'\noutput='a.png'\nf_number=[]", "f_number: an empty list sweeps over nothing"),
+    ("[[shots]]\nscene='cornell_box'\noutput='a.png'\nfocus_distance={from=1, to=2}", "focus_distance: a range needs 'steps'"),
+    ("[[shots]]\nscene='cornell_box'\noutput='a.png'\nfocus_distance={from=0, to=2, steps=3, spacing='geometric'}",
+     "a geometric range needs positive ends"),
+    ("[[shots]]\nscene='cornell_box'\noutput='a.png'\nlens='300mm'", "no lens preset called '300mm' (there are: "),
+    ("[[shots]]\nscene='cornell_box'\noutput='a.png'\nlens='85mm f/1.4'\nf_number=1.2",
+     "f/1.2 is not on the lens '85 mm f/1.4' (f/1.4 to f/16)"),
+    ("[[shots]]\nscene='cornell_box'\noutput='a.tif'", "output: a.tif must be an .exr or a .png"),
+    ("[[shots]]\noutput='a.png'", "shot 1: no 'scene' (give it in the shot or in [defaults])"),
+    ("[[shots]]\nscene='cornell_box'\noutput='a_{aperture}.png'", "names {aperture}, but unknown field {aperture}"),
+    ("[[shots]]\nscene='cornell_box'\noutput='a_{seed}.png'", "names {seed}, but this shot sets no seed"),
+    ("[[shots]]\nscene='cornell_box'\noutput='a.png'\nf_number=[2, 4]",
+     "shot 1, f/2 and shot 1, f/4 both write a.png: put the swept setting in the output's name"),
+    ("[[shots]]\nscene='cornell_box'\noutput='a.png'\n[[shots]]\nscene='dof_chart'\noutput='a.png'",
+     "give each shot its own output"),
+    ("[[shots]]\nscene='cornell_box'\noutput='a.png'\nsplit=0", "split: 0 is out of range [1, 256]"),
+    ("[[shots]]\nscene='cornell_box'\noutput='a.png'\ntime_limit=-1", "time_limit: -1 s is out of range"),
+    ("[[shots]]\nscene='cornell_box'\noutput='a.png'\nname=['a', 'b']", "name: takes one value, not a list"),
+    ("[[shots]]\nscene='cornell_box'\noutput='a.png'\ntone_map='aces'", "tone_map: 'aces' is not one of"),
+    ("shots = 3", "no shots: give at least one [[shots]] table"),
+    ("[[shot]]\nscene='cornell_box'", "unknown key 'shot' (did you mean 'shots'?)"),
+    ("[[shots]\nscene=", "not valid TOML ("),
+    ("contact_sheet = 'sheet.jpg'\n[[shots]]\nscene='cornell_box'\noutput='a.png'", "contact_sheet: sheet.jpg must be a .png"),
+])
+def test_every_mistake_is_one_line_naming_file_shot_and_key(tmp_path, text, expected):
+    assert expected in error(tmp_path, text)
+
+
+def test_files_that_are_not_batch_files(tmp_path):
+    assert "no such batch file" in str(pytest.raises(BatchError, read_batch, tmp_path / "none.toml").value)
+    assert "unknown batch file type '.yaml'" in error(tmp_path, "a: 1", "shots.yaml")
+    assert "not valid JSON" in error(tmp_path, "{", "shots.json")
+    assert "not valid JSON" in error(tmp_path, "[" * 100_000, "shots.json")
+    with pytest.raises(BatchError, match="expected a table"):
+        parse_batch("[1, 2]", tmp_path / "shots.json")
+
+
+def test_sample_ranges_cover_the_samples_once():
+    for total, parts in ((256, 4), (10, 3), (3, 8), (1, 1)):
+        ranges = [sample_range(total, part, parts) for part in range(parts)]
+        covered = [index for first, count in ranges for index in range(first, first + count)]
+        assert covered == list(range(total))
+    assert [sample_range(None, part, 3) for part in range(3)] == [(0, None), (PART_INDEX_STRIDE, None),
+                                                                  (2 * PART_INDEX_STRIDE, None)]
+    with pytest.raises(ValueError):
+        sample_range(8, 2, 2)
+
+
+def test_a_worker_takes_its_gpu_from_its_environment_or_its_number(monkeypatch):
+    from lenslab.batch.parts import DEVICE_ENVIRONMENT, PartFailed, _worker_device
+
+    monkeypatch.delenv(DEVICE_ENVIRONMENT, raising=False)
+    assert _worker_device(0, ()) is None  # the default device
+    assert [_worker_device(n, (2, 3)) for n in (0, 1, 2)] == [2, 3, 2]  # a local cluster's workers are numbered
+    assert _worker_device("tcp://farm-node-7:40000", (2, 3)) == 2
+    monkeypatch.setenv(DEVICE_ENVIRONMENT, "1")
+    assert _worker_device(0, (2, 3)) == 1  # pinned where the worker was started
+    monkeypatch.setenv(DEVICE_ENVIRONMENT, "gpu1")
+    with pytest.raises(PartFailed, match="LENSLAB_DEVICE='gpu1'"):
+        _worker_device(0, ())
