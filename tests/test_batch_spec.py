@@ -148,3 +148,12 @@ def test_a_worker_takes_its_gpu_from_its_environment_or_its_number(monkeypatch):
     monkeypatch.setenv(DEVICE_ENVIRONMENT, "gpu1")
     with pytest.raises(PartFailed, match="LENSLAB_DEVICE='gpu1'"):
         _worker_device(0, ())
+
+
+def test_the_documented_batch_files_read(tmp_path):
+    docs = Path(__file__).resolve().parents[1] / "docs"
+    assert len(read_batch(docs / "batch-example.toml").shots) == 12
+    text = (docs / "batch.md").read_text()
+    block = text.split("```toml\n", 1)[1].split("```", 1)[0]  # docs/batch.md's annotated example
+    names = [shot.name for shot in batch(tmp_path, block).shots]
+    assert len(names) == 6 + 8 + 4 and names[0] == "aperture bracket f/1.4" and names[-1] == "lenses 135 mm f/2"

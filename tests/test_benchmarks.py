@@ -35,3 +35,12 @@ def test_vs_mitsuba_renders_every_scene_with_both_samplers(renderer, tmp_path):
 def test_render_throughput_prints_a_figure_per_scene_and_depth(renderer, tmp_path):
     out = run("render_throughput.py", "--seconds", 0.05, "--size", 16, tmp_path=tmp_path)
     assert out.count("cornell_box") == 5 and out.count("dof_chart") == 5
+
+
+@pytest.mark.gl
+def test_batch_scaling_prints_shots_per_minute_with_and_without_the_engine(renderer, tmp_path):
+    out = run("batch_scaling.py", "--shots", 2, "--size", 8, "--spp", 1, tmp_path=tmp_path)
+    for row in ("no engine (this process)", "Dask, 1 worker", "Dask, 2 workers"):
+        line = next(line for line in out.splitlines() if line.startswith(row))
+        assert float(line.split()[-2]) > 0  # shots per minute
+    assert "engine cost per shot" in out and "split across 2 workers" in out

@@ -24,6 +24,7 @@ from typing import Callable
 import numpy as np
 
 from lenslab.batch.spec import MAX_SPLIT, Shot
+from lenslab.render.film import merge
 from lenslab.render.job import JobProgress
 
 #: Where each part of a time-limited shot starts in the sample sequence: room for 2^24 samples per pixel
@@ -191,7 +192,7 @@ class ShotAssembly:
         self.results[result.part] = result
         if result.accumulation is not None:
             # Added as they arrive, so a shot split in 64 holds one image in memory, not 64.
-            self._sum = result.accumulation if self._sum is None else self._sum + result.accumulation
+            self._sum = result.accumulation if self._sum is None else merge(self._sum, result.accumulation)
             result.accumulation = None
 
     @property

@@ -40,7 +40,8 @@ def resolve(accumulation: np.ndarray) -> np.ndarray:
 
 
 def merge(*accumulations: np.ndarray) -> np.ndarray:
-    """Combine partial renders of the same view (different seeds): sums and counts add."""
+    """Combine partial renders of the same view (different seeds, or disjoint sample ranges of one seed: the
+    parts of a shot split across workers, lenslab.batch.parts): sums and counts add."""
     return np.sum(accumulations, axis=0)
 
 
