@@ -180,3 +180,55 @@ def test_the_command_refuses_bad_arguments_in_one_line(tmp_path):
         run = subprocess.run([sys.executable, "-m", "lenslab", "batch", str(tmp_path / "none.toml"), *args],
                              capture_output=True, text=True, timeout=60)
         assert run.returncode == status and expected in run.stderr and len(run.stderr.splitlines()) == 1, run.stderr
+
+
+def test_ctrl_c_keeps_every_finished_shot_and_the_next_run_renders_the_rest(tmp_path, renderer):
+    (tmp_path / "shots.toml").write_text("""
+        [[shots]]
+        scene = "cornell_box"
+        output = "f{f_number}.exr"
+        width = 64
+        spp = 200
+        f_number = [1.4, 2, 2.8, 4]
+    """)
+    command = [sys.executable, "-m", "lenslab", "batch", str(tmp_path / "shots.toml"), "--workers", "1"]
+    # A new session, signalled as a whole: Ctrl-C on a terminal reaches the Dask worker processes too.
+    batch = subprocess.Popen(command, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    first = ""
+    for line in batch.stderr:
+        if line.startswith("wrote "):
+            first = line.split()[1]
+            os.killpg(batch.pid, signal.SIGINT)
+            break
+    rest = batch.stderr.read()
+    assert batch.wait(timeout=120) == 130 and "Traceback" not in rest, rest
+    assert "interrupted; every shot reported done is written" in rest
+    written = sorted(tmp_path.glob("*.exr"))
+    assert str(written[0]) == first and len(written) < 4
+    assert not list(tmp_path.glob(".*"))  # no temporary file left behind
+    image, metadata = read_image(written[0])
+    assert metadata["lenslab:SamplesPerPixel"] == 200 and np.isfinite(image).all()
+
+    again = subprocess.run(command, capture_output=True, text=True, timeout=300)
+    assert again.returncode == 0, again.stderr
+    assert f"skipped {written[0].stem}" in again.stderr and len(list(tmp_path.glob("*.exr"))) == 4
+
+
+def test_the_command_uses_a_running_cluster(tmp_path, client):
+    (tmp_path / "shots.toml").write_text("""
+        [[shots]]
+        scene = "cornell_box"
+        output = "seed{seed}.png"
+        width = 16
+        spp = 1
+        seed = [1, 2, 3]
+    """)
+    run = subprocess.run([sys.executable, "-m", "lenslab", "batch", str(tmp_path / "shots.toml"),
+                          "--scheduler", client.scheduler.address], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert sorted(p.name for p in tmp_path.glob("*.png")) == ["seed1.png", "seed2.png", "seed3.png"]
+    unreachable = subprocess.run([sys.executable, "-m", "lenslab", "batch", str(tmp_path / "shots.toml"), "--force",
+                                  "--scheduler", "tcp://127.0.0.1:9"], capture_output=True, text=True, timeout=120,
+                                 env={**os.environ, "DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT": "2s"})
+    assert unreachable.returncode == 1 and "Traceback" not in unreachable.stderr, unreachable.stderr
+    assert len(unreachable.stderr.strip().splitlines()) == 1 and "cannot reach a Dask scheduler" in unreachable.stderr

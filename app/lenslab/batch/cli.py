@@ -129,7 +129,13 @@ def _cluster_client(args):
     from lenslab.batch.farm import local_cluster
 
     if args.scheduler:
-        return None, Client(args.scheduler, timeout="20s")
+        # How long to try is Dask's own setting (distributed.comm.timeouts.connect, e.g. the environment's
+        # DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT=5s).
+        try:
+            return None, Client(args.scheduler)
+        except OSError as exc:  # includes TimeoutError
+            raise OSError(f"cannot reach a Dask scheduler at {args.scheduler} ({exc}): is `dask scheduler` "
+                          "running there, and is the address its own?") from None
     workers = args.workers or max(1, len(args.devices))
     cluster = local_cluster(workers)
     return cluster, Client(cluster)
@@ -161,7 +167,7 @@ class _Display:
         self.console = Console(stderr=True)
         self.bars = Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.fields[status]}"),
                              TimeElapsedColumn(), console=self.console, disable=not self.console.is_terminal)
-        self.overall = self.bars.add_task("[bold]batch", total=shots, status="")
+        self.overall = self.bars.add_task("[bold]batch", total=shots, status=f"0/{shots} shots")
         self._shots: dict[str, int] = {}
         self._start = time.perf_counter()
         self._finished = 0

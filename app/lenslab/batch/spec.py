@@ -62,7 +62,7 @@ _TOP_LEVEL = ("defaults", "shots", "contact_sheet")
 class Shot:
     """One image to render: a scene, what to change in it, and where the image goes."""
 
-    name: str
+    name: str  # the shot's name and its swept settings ("bracket f/2.8"), or its file's name
     scene: str  # a scene file (absolute path) or a shipped scene's name
     output: Path
     overrides: SceneOverrides = field(default_factory=SceneOverrides)
@@ -268,8 +268,8 @@ def _shot(number: int, index: int, values: dict, swept: list[str], folder: Path,
     output = folder / _output_name(values, index, where)
     if output.suffix.lower() not in EXPORT_SUFFIXES:
         raise BatchError(f"{where}: output: {output.name} must be an .exr or a .png")
-    base_name = values.get("name") or Path(values["output"]).stem.split("{")[0].rstrip("_-. ") or f"shot {number}"
-    name = base_name + (f" {_describe(values, swept)}" if swept else "")
+    # Named by the user (with the swept settings added), or else by its file, which is unique.
+    name = values["name"] + (f" {_describe(values, swept)}" if swept else "") if "name" in values else output.stem
     try:
         overrides = SceneOverrides(**{field_name: values[key] for key, field_name in _OVERRIDE_KEYS.items()
                                       if key in values},
