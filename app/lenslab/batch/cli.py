@@ -94,6 +94,8 @@ def main(argv: list[str]) -> int:
 
 
 def run(argv: list[str]) -> int:
+    from lenslab.render.film import ExportError
+
     args = build_parser().parse_args(argv)
     if args.scheduler and (args.workers or args.devices):
         raise _UsageError("--scheduler uses the cluster's own workers: leave out --workers and --devices (pin a "
@@ -107,7 +109,11 @@ def run(argv: list[str]) -> int:
         return EXIT_OK
     summary = _render(batch, args)
     for sheet in contact_sheets:
-        _write_contact_sheet(batch, sheet, summary)
+        try:
+            _write_contact_sheet(batch, sheet, summary)
+        except (ExportError, OSError) as exc:  # the shots are written: say what is missing, not a traceback
+            print(f"lenslab batch: error: contact sheet {sheet}: {' '.join(str(exc).split())}", file=sys.stderr)
+            return EXIT_ERROR
     if summary.failed:
         print(f"lenslab batch: {len(summary.failed)} of {len(batch.shots)} shots failed:", file=sys.stderr)
         for shot, message in summary.failed:
