@@ -399,3 +399,17 @@ def test_format_focal_length_reads_as_a_lens_barrel():
     from lenslab.optics import format_focal_length
 
     assert [format_focal_length(v) for v in (50, 31.1769, 24.04, 85.0)] == ["50 mm", "31.2 mm", "24 mm", "85 mm"]
+
+
+@pytest.mark.parametrize("metres, text", [(1.5, "1.50 m"), (12.5, "12.5 m"), (120.0, "120 m"), (0.45, "45.0 cm"),
+                                          (math.inf, "∞")])
+def test_format_distance_as_a_focus_scale_reads(metres, text):
+    from lenslab.optics import format_distance
+
+    assert format_distance(metres) == text
+
+
+def test_camera_settings_read_as_the_studio_shows_them():
+    from lenslab.optics import format_camera_settings
+
+    assert format_camera_settings(85.0, 1.4, 0.8) == "85 mm · f/1.4 · focus 80.0 cm"

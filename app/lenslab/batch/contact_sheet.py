@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from lenslab.atomic import atomic_path
+from lenslab.optics import format_camera_settings
 from lenslab.render import film
 
 BACKGROUND = (0.11, 0.11, 0.12)  # display values: a dark neutral that neither glows nor flattens the shots
@@ -33,14 +34,10 @@ class Frame:
     exposure: float = 0.0
 
 
-def shot_caption(camera, lens_name: str | None = None, samples_per_pixel: int | None = None) -> str:
-    """f/2.8 · 50 mm · focus 1.5 m (· the lens · 256 spp): the settings a photographer compares."""
-    words = [f"f/{camera.f_number:g}", f"{camera.focal_length_mm:g} mm", f"focus {camera.focus_distance_m:.3g} m"]
-    if lens_name:
-        words.append(lens_name)
-    if samples_per_pixel:
-        words.append(f"{samples_per_pixel} spp")
-    return " \u00b7 ".join(words)
+def shot_caption(camera, lens_name: str | None = None) -> str:
+    """50 mm · f/2.8 · focus 1.50 m (· the lens): the settings a photographer compares, as the studio shows them."""
+    settings = format_camera_settings(camera.focal_length_mm, camera.f_number, camera.focus_distance_m)
+    return f"{settings} \u00b7 {lens_name}" if lens_name else settings
 
 
 def write_contact_sheet(path: str | Path, frames: list[Frame], *, thumbnail_width: int = 320) -> Path:

@@ -32,6 +32,7 @@ from lenslab.optics import (
     SensorPreset,
     circle_of_confusion_mm,
     depth_of_field,
+    format_distance,
     format_f_number,
     format_focal_length,
     load_lens_presets,
@@ -52,18 +53,6 @@ FOCUS_RANGE = (0.05, 200.0)
 def lens_short_name(lens: LensPreset) -> str:
     focal = (f"{lens.focal_range_mm[0]:g}-{lens.focal_range_mm[1]:g}" if lens.is_zoom else f"{lens.focal_length_mm:g}")
     return f"{focal} f/{lens.widest_f_number:g}"
-
-
-def format_distance(metres: float) -> str:
-    if math.isinf(metres):
-        return "∞"
-    if metres >= 100:
-        return f"{metres:.0f} m"
-    if metres >= 10:
-        return f"{metres:.1f} m"
-    if metres >= 1:
-        return f"{metres:.2f} m"
-    return f"{metres * 100:.1f} cm"
 
 
 class IrisGlyph(QWidget):

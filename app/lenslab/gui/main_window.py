@@ -32,7 +32,7 @@ from PySide6.QtWidgets import (
 
 from lenslab import __version__
 from lenslab.gui import theme
-from lenslab.gui.camera_panel import CameraPanel, format_distance
+from lenslab.gui.camera_panel import CameraPanel
 from lenslab.gui.commands import (AddLightCommand, AddMaterialCommand, AddNodeCommand, RemoveLightsCommand,
                                   RemoveMaterialCommand, RemoveNodesCommand)
 from lenslab.gui.controller import SAMPLE_LIMITS, RenderController, elapsed_text, rate_text, samples_text
@@ -43,7 +43,7 @@ from lenslab.gui.properties import PropertyEditor
 from lenslab.gui.scene_tree import SceneTreeView, node_context_menu
 from lenslab.gui.viewport import Viewport
 from lenslab.gui.worker import VIEWPORT_DISPATCH_SECONDS
-from lenslab.optics import circle_of_confusion_mm, depth_of_field, format_f_number, format_focal_length
+from lenslab.optics import circle_of_confusion_mm, depth_of_field, format_camera_settings, format_distance
 from lenslab.render.film import TONE_MAPS
 from lenslab.scene import editing
 from lenslab.scene.io.loader import open_scene, resolve_scene_path, shipped_scene_names
@@ -453,8 +453,7 @@ class MainWindow(QMainWindow):
 
     def _update_hud(self) -> None:
         cam = self.doc.scene.camera
-        self.viewport.hud_text = (f"{format_focal_length(cam.focal_length_mm)} · {format_f_number(cam.f_number)} · "
-                                  f"focus {format_distance(cam.focus_distance_m)}")
+        self.viewport.hud_text = format_camera_settings(cam.focal_length_mm, cam.f_number, cam.focus_distance_m)
         self.viewport.update()
 
     # -- document events ---------------------------------------------------------------------------------------

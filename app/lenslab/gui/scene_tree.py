@@ -201,10 +201,9 @@ class SceneTreeModel(QAbstractItemModel):
             users = len(self.doc.model.material_users(key[1]))
             return f"<b>{key[1]}</b><br>{obj.type_name} · used by {users} node{'s' * (users != 1)}"
         if kind == "camera":
-            from lenslab.optics import format_f_number, format_focal_length
+            from lenslab.optics import format_camera_settings
 
-            return (f"{format_focal_length(obj.focal_length_mm)} · {format_f_number(obj.f_number)} · "
-                    f"focus {obj.focus_distance_m:.2f} m"
+            return (f"{format_camera_settings(obj.focal_length_mm, obj.f_number, obj.focus_distance_m)}"
                     f" · {obj.resolution[0]}×{obj.resolution[1]}")
         return None
 

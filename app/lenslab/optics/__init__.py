@@ -38,6 +38,8 @@ from .thinlens import (
     blur_diameter_mm,
     field_of_view_x,
     focal_length_for_fov,
+    format_camera_settings,
+    format_distance,
     format_focal_length,
     lens_radius_m,
     textbook_blur_diameter_mm,
@@ -51,6 +53,7 @@ __all__ = [
     "DEFAULT_SENSOR_NAME", "FULL_FRAME", "SensorPreset", "load_sensor_presets",
     "MAX_F_NUMBER", "MIN_F_NUMBER", "THIRD_STOPS", "EXTENDED_THIRD_STOPS", "format_f_number", "is_valid_f_number",
     "nearest_stop", "parse_f_number", "step_stop", "stops_between",
-    "blur_diameter_mm", "field_of_view_x", "focal_length_for_fov", "format_focal_length", "lens_radius_m",
+    "blur_diameter_mm", "field_of_view_x", "focal_length_for_fov", "format_camera_settings", "format_distance",
+    "format_focal_length", "lens_radius_m",
     "textbook_blur_diameter_mm",
 ]

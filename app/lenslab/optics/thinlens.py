@@ -29,6 +29,8 @@ __all__ = [
     "FOCAL_LENGTH_RANGE_MM",
     "FOCUS_DISTANCE_RANGE_M",
     "f_number_for_lens_radius",
+    "format_camera_settings",
+    "format_distance",
     "format_focal_length",
     "field_of_view_x",
     "focal_length_for_fov",
@@ -166,3 +168,25 @@ def textbook_blur_diameter_mm(focal_length_mm, f_number, focus_distance_m, depth
 def format_focal_length(mm: float) -> str:
     """Text as a lens barrel reads: ``"50 mm"``, ``"31.2 mm"`` (one decimal at most, trailing zeros dropped)."""
     return f"{float(mm):.1f}".rstrip("0").rstrip(".") + " mm"
+
+
+def format_distance(metres: float) -> str:
+    """A distance as a focus scale reads: ``"1.50 m"``, ``"12.5 m"``, ``"120 m"``, ``"45.0 cm"``, ``"∞"``."""
+    if math.isinf(metres):
+        return "∞"
+    if metres >= 100:
+        return f"{metres:.0f} m"
+    if metres >= 10:
+        return f"{metres:.1f} m"
+    if metres >= 1:
+        return f"{metres:.2f} m"
+    return f"{metres * 100:.1f} cm"
+
+
+def format_camera_settings(focal_length_mm: float, f_number: float, focus_distance_m: float) -> str:
+    """The settings a photographer reads off a camera, as the studio's viewport shows them and a contact sheet
+    prints them: ``"50 mm · f/2.8 · focus 1.50 m"``."""
+    from .stops import format_f_number
+
+    return (f"{format_focal_length(focal_length_mm)} \u00b7 {format_f_number(f_number)} \u00b7 "
+            f"focus {format_distance(focus_distance_m)}")
