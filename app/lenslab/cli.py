@@ -29,16 +29,19 @@ class CliError(Exception):
         self.status = status
 
 
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str):  # one line, not argparse's usage block
-        raise CliError(f"{message} (see lenslab --help)", EXIT_USAGE)
+class CommandParser(argparse.ArgumentParser):
+    """argparse for every ``lenslab`` command: a usage error is a CliError of one line, not a usage block."""
+
+    def error(self, message: str):
+        raise CliError(f"{message} (see {self.prog} --help)", EXIT_USAGE)
 
 
 def _bound(value: float) -> str:
     return str(int(value)) if float(value).is_integer() else f"{value:g}"
 
 
-def _number(kind, low: float, high: float):
+def number_argument(kind, low: float, high: float):
+    """An argparse type: an int or float in [low, high], refused in one line naming the value."""
     def parse(text: str):
         try:
             value = kind(text)
@@ -54,7 +57,7 @@ def _number(kind, low: float, high: float):
 
 def _declared(kind, cls, field_name: str):
     """An argument checked against the range the scene class declares for the field it sets."""
-    return _number(kind, *declared_range(cls, field_name))
+    return number_argument(kind, *declared_range(cls, field_name))
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -62,7 +65,7 @@ def build_parser() -> argparse.ArgumentParser:
     from lenslab.scene.io.loader import shipped_scene_names
     from lenslab.scene.scene import RenderSettings
 
-    p = _Parser(
+    p = CommandParser(
         prog="lenslab",
         description="LensLab: a photographic studio on a physically based path tracer. Without --headless it "
         "opens the studio window; with --headless it renders SCENE to a file and exits.",
@@ -80,10 +83,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", metavar="FILE", help="where to write the image: .exr (linear, float) or .png (sRGB)")
     p.add_argument("--spp", type=_declared(int, RenderSettings, "spp"), metavar="N",
                    help="samples per pixel (default: the scene's; with --time-limit alone, as many as fit)")
-    p.add_argument("--time-limit", type=_number(float, 0.001, 1e7), metavar="SECONDS",
+    p.add_argument("--time-limit", type=number_argument(float, 0.001, 1e7), metavar="SECONDS",
                    help="stop after this long, keeping what has been rendered (at least one sample in every pixel)")
-    p.add_argument("--width", type=_number(int, 1, MAX_IMAGE_SIDE), metavar="W", help="image width in pixels")
-    p.add_argument("--height", type=_number(int, 1, MAX_IMAGE_SIDE), metavar="H", help="image height in pixels")
+    p.add_argument("--width", type=number_argument(int, 1, MAX_IMAGE_SIDE), metavar="W", help="image width in pixels")
+    p.add_argument("--height", type=number_argument(int, 1, MAX_IMAGE_SIDE), metavar="H", help="image height in pixels")
     p.add_argument("--f-stop", type=_declared(float, ThinLensCamera, "f_number"), metavar="N",
                    help="aperture as an f-number (1.4 is wide open and blurry, 16 is deep focus)")
     p.add_argument("--focal-length", type=_declared(float, ThinLensCamera, "focal_length_mm"), metavar="MM",
@@ -98,14 +101,14 @@ def build_parser() -> argparse.ArgumentParser:
                    help="sample pattern (default: the scene's)")
     p.add_argument("--clamp", type=_declared(float, RenderSettings, "clamp"), metavar="L",
                    help="tame fireflies: cap the radiance one sample may add (biased; 0 = off, the default)")
-    p.add_argument("--exposure", type=_number(float, -30, 30), default=0.0, metavar="STOPS",
+    p.add_argument("--exposure", type=number_argument(float, -30, 30), default=0.0, metavar="STOPS",
                    help="PNG only: brighten (+) or darken (-) by this many stops")
     p.add_argument("--tone-map", choices=("clamp", "reinhard", "filmic"), default="clamp",
                    help="PNG only: how radiance above 1 is brought into the displayable range (default: clamp; the "
                         "studio shows and exports filmic unless told otherwise)")
     p.add_argument("-D", dest="defines", action="append", default=[], metavar="NAME=VALUE",
                    help="Mitsuba XML scenes: set the parameter $NAME, as mitsuba -D does (repeatable)")
-    p.add_argument("--device", type=_number(int, 0, 64), metavar="N", help="which GPU to use (EGL device index)")
+    p.add_argument("--device", type=number_argument(int, 0, 64), metavar="N", help="which GPU to use (EGL device index)")
     p.add_argument("--info", action="store_true", help="print the OpenGL device and the limits in use, then exit")
     p.add_argument("--version", action="version", version=f"lenslab {__version__}")
     return p

@@ -12,28 +12,9 @@ import sys
 import time
 
 from lenslab.batch.spec import Batch, BatchError, read_batch
+from lenslab.cli import EXIT_ERROR, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, CliError, CommandParser, number_argument
 
-EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 MAX_LOCAL_WORKERS = 256
-
-
-class _UsageError(Exception):
-    pass
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str):
-        raise _UsageError(f"{message} (see lenslab batch --help)")
-
-
-def _workers(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number, not '{text}'") from None
-    if not 1 <= value <= MAX_LOCAL_WORKERS:
-        raise argparse.ArgumentTypeError(f"{text} is out of range [1, {MAX_LOCAL_WORKERS}]")
-    return value
 
 
 def _devices(text: str) -> tuple[int, ...]:
@@ -47,7 +28,7 @@ def _devices(text: str) -> tuple[int, ...]:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = _Parser(
+    p = CommandParser(
         prog="lenslab batch",
         description="Render the shots of a batch file (TOML or JSON: docs/batch.md) on worker processes of this "
                     "machine, or on a Dask cluster. Shots whose output exists are skipped, so a batch that was "
@@ -58,7 +39,7 @@ def build_parser() -> argparse.ArgumentParser:
                "  lenslab batch shots.toml --scheduler tcp://farm:8786      # a running Dask cluster\n",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("batch_file", metavar="BATCH", help="the batch file (.toml or .json)")
-    p.add_argument("--workers", type=_workers, default=None, metavar="N",
+    p.add_argument("--workers", type=number_argument(int, 1, MAX_LOCAL_WORKERS), default=None, metavar="N",
                    help="worker processes on this machine (default: one per --devices entry, else 1)")
     p.add_argument("--devices", type=_devices, default=(), metavar="0,1",
                    help="GPUs (EGL device numbers) for this machine's workers, one worker each unless --workers")
@@ -73,14 +54,12 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str]) -> int:
-    from lenslab.cli import _report_library_warnings
-
-    _report_library_warnings()
+    """``lenslab batch ...`` (lenslab.cli.main has set up the warning lines)."""
     try:
         return run(argv)
-    except _UsageError as exc:
+    except CliError as exc:
         print(f"lenslab batch: error: {exc}", file=sys.stderr)
-        return EXIT_USAGE
+        return exc.status
     except BatchError as exc:
         print(f"lenslab batch: error: {exc}", file=sys.stderr)
         return EXIT_ERROR
@@ -98,12 +77,12 @@ def run(argv: list[str]) -> int:
 
     args = build_parser().parse_args(argv)
     if args.scheduler and (args.workers or args.devices):
-        raise _UsageError("--scheduler uses the cluster's own workers: leave out --workers and --devices (pin a "
-                          "worker to a GPU with LENSLAB_DEVICE=N in its environment)")
+        raise CliError("--scheduler uses the cluster's own workers: leave out --workers and --devices (pin a "
+                       "worker to a GPU with LENSLAB_DEVICE=N in its environment)", EXIT_USAGE)
     batch = read_batch(args.batch_file)
     contact_sheets = [p for p in (batch.contact_sheet, args.contact_sheet) if p]
     if args.contact_sheet and not str(args.contact_sheet).lower().endswith(".png"):
-        raise _UsageError(f"--contact-sheet {args.contact_sheet}: a contact sheet is a .png")
+        raise CliError(f"--contact-sheet {args.contact_sheet}: a contact sheet is a .png", EXIT_USAGE)
     if args.dry_run:
         _print_plan(batch, args.force)
         return EXIT_OK
@@ -168,7 +147,7 @@ class _Display:
 
     def __init__(self, shots: int):
         from rich.console import Console
-        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+        from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
         self.console = Console(stderr=True)
         self.bars = Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.fields[status]}"),
@@ -223,9 +202,9 @@ class _Display:
                                     f"{event.samples_per_second / 1e6:.2f} M samples/s{workers}")
 
     def summary(self, summary) -> None:
-        minutes = (time.perf_counter() - self._start) / 60
+        seconds = time.perf_counter() - self._start
         self._line(f"{len(summary.done)} rendered, {len(summary.skipped)} skipped, {len(summary.failed)} failed "
-                   f"in {minutes * 60:.1f} s")
+                   f"in {seconds:.1f} s")
 
 
 def _write_contact_sheet(batch: Batch, path, summary) -> None:

@@ -2,33 +2,14 @@
 
 from __future__ import annotations
 
-import argparse
 import sys
 from pathlib import Path
 
+from lenslab.cli import EXIT_ERROR, EXIT_OK, EXIT_USAGE, CliError, CommandParser, number_argument
 from lenslab.validate.mitsuba_env import MitsubaUnavailable, load_mitsuba
 from lenslab.validate.runner import SCENE_NAMES
 
-EXIT_OK, EXIT_ERROR, EXIT_USAGE = 0, 1, 2
-
-
-class _UsageError(Exception):
-    pass
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str):
-        raise _UsageError(f"{message} (see lenslab validate --help)")
-
-
-def _positive(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number, not '{text}'") from None
-    if not 1 <= value <= 1 << 20:
-        raise argparse.ArgumentTypeError(f"{text} is out of range [1, {1 << 20}]")
-    return value
+_positive = number_argument(int, 1, 1 << 20)  # a sample count or a resolution
 
 
 def default_docs_dir() -> Path:
@@ -38,8 +19,8 @@ def default_docs_dir() -> Path:
     return checkout / "docs" if checkout is not None and (checkout / "docs").is_dir() else Path.cwd() / "docs"
 
 
-def build_parser() -> argparse.ArgumentParser:
-    p = _Parser(prog="lenslab validate",
+def build_parser() -> CommandParser:
+    p = CommandParser(prog="lenslab validate",
                 description="Render the validation scenes with LensLab and with Mitsuba 3 (pip install "
                 "'lenslab[validate]') and print, per scene, the bias of 16x16 block means against a converged "
                 "Mitsuba reference, each renderer's relative MSE at equal samples, and their times.")
@@ -59,9 +40,9 @@ def run(argv: list[str]) -> int:
     names = [n.strip() for n in args.scenes.split(",") if n.strip()]
     unknown = [n for n in names if n not in SCENE_NAMES]
     if unknown or not names:
-        raise _UsageError(f"unknown scene '{','.join(unknown)}' (choose from {', '.join(SCENE_NAMES)})")
+        raise CliError(f"unknown scene '{','.join(unknown)}' (choose from {', '.join(SCENE_NAMES)})", EXIT_USAGE)
     if args.resolution < 16:
-        raise _UsageError("--resolution must be at least 16 (one 16x16 block)")
+        raise CliError("--resolution must be at least 16 (one 16x16 block)", EXIT_USAGE)
     load_mitsuba()  # fail early, with one line, when Mitsuba cannot run here
 
     from lenslab.render.tracer import Renderer
@@ -93,9 +74,9 @@ def main(argv: list[str] | None = None) -> int:
 
     try:
         return run(list(sys.argv[1:] if argv is None else argv))
-    except _UsageError as exc:
+    except CliError as exc:
         print(f"lenslab validate: error: {exc}", file=sys.stderr)
-        return EXIT_USAGE
+        return exc.status
     except MitsubaUnavailable as exc:
         print(f"lenslab validate: {exc}", file=sys.stderr)
         return EXIT_ERROR
