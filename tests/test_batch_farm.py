@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 from lenslab.batch.farm import PartRetried, ShotDone, ShotFailed, ShotProgress, ShotSkipped, local_cluster, run_batch
-from lenslab.batch.spec import read_batch
 from lenslab.render.film import read_image
 from lenslab.scene.overrides import SceneOverrides
+from tests.test_batch_spec import batch as write_batch  # writes shots.toml in a folder and reads it
 
 pytestmark = pytest.mark.gl
 
@@ -26,11 +26,6 @@ def client(renderer):  # the renderer fixture skips where there is no GL at all
 
     with local_cluster(2) as cluster, Client(cluster) as client:
         yield client
-
-
-def write_batch(folder, text: str):
-    (folder / "shots.toml").write_text(text)
-    return read_batch(folder / "shots.toml")
 
 
 def test_shots_are_written_a_failure_is_reported_and_a_rerun_skips_them(tmp_path, client):

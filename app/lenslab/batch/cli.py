@@ -87,12 +87,17 @@ def run(argv: list[str]) -> int:
         _print_plan(batch, args.force)
         return EXIT_OK
     summary = _render(batch, args)
-    for sheet in contact_sheets:
-        try:
-            _write_contact_sheet(batch, sheet, summary)
-        except (ExportError, OSError) as exc:  # the shots are written: say what is missing, not a traceback
-            print(f"lenslab batch: error: contact sheet {sheet}: {' '.join(str(exc).split())}", file=sys.stderr)
-            return EXIT_ERROR
+    if contact_sheets:
+        from lenslab.batch.contact_sheet import write_contact_sheet
+
+        frames = _contact_sheet_frames(batch, summary)
+        for sheet in contact_sheets:
+            try:
+                written = write_contact_sheet(sheet, frames)
+            except (ExportError, OSError) as exc:  # the shots are written: say what is missing, not a traceback
+                print(f"lenslab batch: error: contact sheet {sheet}: {' '.join(str(exc).split())}", file=sys.stderr)
+                return EXIT_ERROR
+            print(f"wrote contact sheet {written} ({len(frames)} shots)", file=sys.stderr)
     if summary.failed:
         print(f"lenslab batch: {len(summary.failed)} of {len(batch.shots)} shots failed:", file=sys.stderr)
         for shot, message in summary.failed:
@@ -207,22 +212,27 @@ class _Display:
                    f"in {seconds:.1f} s")
 
 
-def _write_contact_sheet(batch: Batch, path, summary) -> None:
-    from pathlib import Path
-
-    from lenslab.batch.contact_sheet import Frame, shot_caption, write_contact_sheet
+def _contact_sheet_frames(batch: Batch, summary) -> list:
+    """A frame per shot, captioned with its camera as set (or why it failed). Each scene file is read once,
+    however many shots of a bracket it has."""
+    from lenslab.batch.contact_sheet import Frame, shot_caption
+    from lenslab.scene.io.loader import open_scene
     from lenslab.scene.scene import SceneError
 
     failed = {str(shot.output): message for shot, message in summary.failed}
-    frames = []
-    for shot in batch.shots:
-        try:
-            caption = shot_caption(shot.open_scene().camera, lens_name=shot.overrides.lens)
-        except (SceneError, ValueError, OSError) as exc:
-            caption = " ".join(str(exc).split())
+    scenes: dict[tuple, object] = {}
+
+    def caption(shot) -> str:
         if str(shot.output) in failed:
-            caption = f"failed: {failed[str(shot.output)]}"
-        image = shot.output if shot.output.exists() else None
-        frames.append(Frame(image, shot.name, caption, tone_map=shot.tone_map, exposure=shot.exposure))
-    written = write_contact_sheet(Path(path), frames)
-    print(f"wrote contact sheet {written} ({len(frames)} shots)", file=sys.stderr)
+            return f"failed: {failed[str(shot.output)]}"
+        defines = shot.overrides.defines
+        key = (shot.scene, tuple(sorted(defines.items())))
+        try:
+            if key not in scenes:
+                scenes[key] = open_scene(shot.scene, defines=dict(defines))
+            return shot_caption(shot.overrides.apply(scenes[key]).camera, lens_name=shot.overrides.lens)
+        except (SceneError, ValueError, OSError) as exc:
+            return " ".join(str(exc).split())
+
+    return [Frame(shot.output if shot.output.exists() else None, shot.name, caption(shot), tone_map=shot.tone_map,
+                  exposure=shot.exposure) for shot in batch.shots]

@@ -95,8 +95,7 @@ class _ShotState:
         self.shot = shot
         self.futures = futures
         self.assembly = ShotAssembly(shot)
-        self.progress: dict[int, PartProgress] = {}
-        self.pids: dict[int, int] = {}  # part: the process that reported it last
+        self.progress: dict[int, PartProgress] = {}  # part: what it reported last (and from which process)
         self.failed = False
 
     def fraction(self) -> float:
@@ -184,10 +183,9 @@ def _on_progress(states: dict[str, _ShotState], message: PartProgress, emit) -> 
     state = states.get(message.output)
     if state is None or state.failed or message.part in state.assembly.results:
         return  # another batch's, or late news of a finished part
-    previous_pid = state.pids.get(message.part)
-    if previous_pid is not None and previous_pid != message.pid:
+    previous = state.progress.get(message.part)
+    if previous is not None and previous.pid != message.pid:
         emit(PartRetried(state.shot, message.part, message.worker))  # its worker was lost; it starts again
-    state.pids[message.part] = message.pid
     state.progress[message.part] = message
     running = [p for part, p in state.progress.items() if part not in state.assembly.results]
     emit(ShotProgress(state.shot, state.fraction(),
