@@ -82,8 +82,9 @@ void main() {
     for (int k = 0; k < sample_count; k++) {
         Sampler sampler = sampler_start(pixel, sample_start + uint(k), seed);
         vec4 u = sample4(sampler);  // pixel position and lens position, jointly stratified
-        Ray ray = camera_ray(vec2(pixel) + 0.5 + pixel_offset(u.xy), u.zw);
-        vec3 l = path_radiance(ray, sampler);
+        float lens_weight;  // 0 where the lens barrel blocks the ray (cat's-eye bokeh, optical vignetting)
+        Ray ray = camera_ray(vec2(pixel) + 0.5 + pixel_offset(u.xy), u.zw, lens_weight);
+        vec3 l = lens_weight > 0.0 ? lens_weight * path_radiance(ray, sampler) : vec3(0.0);
         // A NaN or infinity (a degenerate triangle, say) would poison the pixel forever: count it as black.
         if (any(isnan(l)) || any(isinf(l))) l = vec3(0.0);
         if (clamp_max > 0.0 && max_component(l) > clamp_max) l *= clamp_max / max_component(l);

@@ -11,12 +11,15 @@ import pytest
 from lenslab.optics.aperture import sample_concentric_disk, sample_polygon
 from lenslab.render.gl import make_current
 from lenslab.render.gpu_layout import PROBE_IN_BINDING, PROBE_OUT_BINDING
-from lenslab.render.tracer import camera_uniforms
+from lenslab.render.tracer import ApertureTable, camera_uniforms
 from lenslab.scene.camera import ThinLensCamera
 
 PROBE_GROUP_SIZE = 64
 CAMERA = ThinLensCamera(position=(1.0, 2.0, 3.0), look_at=(-0.5, 0.3, -1.0), up=(0.2, 1.0, 0.1),
-                        focal_length_mm=35.0, f_number=1.4, focus_distance_m=2.5, resolution=(300, 200))
+                        focal_length_mm=35.0, f_number=1.4, focus_distance_m=2.5, resolution=(300, 200),
+                        # The geometry of the rays alone: focus from the lens, the sensor one focal length behind
+                        # it, the image across the sensor's width (tests/test_camera_controls.py covers the rest).
+                        focus_from="lens", focus_breathing=False, sensor_fit="horizontal")
 
 
 def camera_axes(camera):
@@ -108,11 +111,14 @@ def test_the_aperture_maps_are_uniform_and_stay_inside_their_shapes():
 
 
 # -- the shader against the Python frame ------------------------------------------------------------------
-def shader_rays(renderer, camera, width, height, items):
+def shader_rays(renderer, camera, width, height, items, *, with_weights=False):
     ctx = renderer.ctx
     make_current(ctx)
     program = renderer.program("camera_probe.comp", LOCAL_SIZE_X=PROBE_GROUP_SIZE)
-    renderer.set_uniforms(program, {**camera_uniforms(camera, width, height), "item_count": len(items)})
+    frame = camera.frame(width, height)
+    renderer.set_uniforms(program, {**camera_uniforms(frame), "item_count": len(items)})
+    table = ApertureTable(ctx)
+    table.bind(frame.aperture)
     source = ctx.buffer(np.asarray(items, np.float32).tobytes())
     result = ctx.buffer(reserve=len(items) * 32)
     source.bind_to_storage_buffer(PROBE_IN_BINDING)
@@ -121,6 +127,9 @@ def shader_rays(renderer, camera, width, height, items):
     out = np.frombuffer(result.read(), np.float32).reshape(-1, 2, 4).copy()
     source.release()
     result.release()
+    table.release()
+    if with_weights:
+        return out[:, 0, :3], out[:, 1, :3], out[:, 0, 3]
     return out[:, 0, :3], out[:, 1, :3]
 
 
@@ -129,7 +138,8 @@ def shader_rays(renderer, camera, width, height, items):
 def test_the_shader_traces_the_rays_the_host_computes(renderer, blades, pinhole, size):
     camera = ThinLensCamera(position=CAMERA.position, look_at=CAMERA.look_at, up=CAMERA.up, focal_length_mm=35.0,
                             f_number=1.4, focus_distance_m=2.5, aperture_blades=blades, blade_rotation_deg=20.0,
-                            resolution=(300, 200), pinhole=pinhole)
+                            resolution=(300, 200), pinhole=pinhole, focus_from="lens", focus_breathing=False,
+                            sensor_fit="horizontal")
     rng = np.random.default_rng(3)
     width, height = size
     items = np.column_stack([rng.random(500) * width, rng.random(500) * height, rng.random((500, 2))])

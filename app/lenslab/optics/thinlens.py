@@ -190,3 +190,50 @@ def format_camera_settings(focal_length_mm: float, f_number: float, focus_distan
 
     return (f"{format_focal_length(focal_length_mm)} \u00b7 {format_f_number(f_number)} \u00b7 "
             f"focus {format_distance(focus_distance_m)}")
+
+
+# -- focusing ----------------------------------------------------------------------------------------------
+# A thin lens of focal length f images a plane at distance s in front of it sharply on a sensor at the image
+# distance v = f s / (s - f) behind it (the Gaussian lens equation 1/s + 1/v = 1/f). A lens's focus scale is
+# marked from the sensor plane, so the distance a photographer sets is D = s + v; solving for s gives
+# s = D/2 (1 + sqrt(1 - 4 f / D)), real only for D >= 4 f: nearer than four focal lengths from the sensor no
+# thin lens can focus (at D = 4 f it images 1:1, s = v = 2 f).
+
+#: What a focus distance may be measured from: the sensor plane (as lens scales are marked) or the lens.
+FOCUS_REFERENCES = ("sensor", "lens")
+
+
+def image_distance_mm(focal_length_mm: float, object_distance_m: float) -> float:
+    """Lens-to-sensor distance (mm) that focuses a plane ``object_distance_m`` in front of the lens:
+    ``v = f s / (s - f)``. 50 mm focused at 1 m: 52.6 mm. Needs ``s > f``."""
+    f = require_positive("focal_length_mm", focal_length_mm)
+    s = require_positive("object_distance_m", object_distance_m) * MM_PER_M
+    if s <= f:
+        raise ValueError(f"a plane {format_distance(s / MM_PER_M)} from the lens is not beyond the focal length "
+                         f"{format_focal_length(f)}: no lens can focus on it")
+    return f * s / (s - f)
+
+
+def object_distance_m(focal_length_mm: float, sensor_distance_m: float) -> float:
+    """Distance (m) from the lens to the plane in focus when the focus scale, measured from the sensor plane,
+    reads ``sensor_distance_m``: ``s = D/2 (1 + sqrt(1 - 4 f / D))``. Needs ``D >= 4 f``."""
+    f = require_positive("focal_length_mm", focal_length_mm) / MM_PER_M
+    d = require_positive("sensor_distance_m", sensor_distance_m)
+    if d < 4.0 * f * (1.0 - 1e-12):
+        raise ValueError(f"focus {format_distance(d)} from the sensor is nearer than a "
+                         f"{format_focal_length(f * MM_PER_M)} lens can focus (four focal lengths, "
+                         f"{format_distance(4.0 * f)})")
+    return 0.5 * d * (1.0 + math.sqrt(max(0.0, 1.0 - 4.0 * f / d)))
+
+
+def sensor_distance_m(focal_length_mm: float, object_distance: float) -> float:
+    """The focus scale's reading (from the sensor plane, m) that puts the plane of focus ``object_distance`` m in
+    front of the lens: ``s + v``. The inverse of :func:`object_distance_m`."""
+    return object_distance + image_distance_mm(focal_length_mm, object_distance) / MM_PER_M
+
+
+def closest_focus_m(focal_length_mm: float, focus_from: str = "sensor") -> float:
+    """The nearest focus distance a thin lens of this focal length can set: four focal lengths from the sensor
+    (1:1), or just beyond one focal length from the lens."""
+    f = require_positive("focal_length_mm", focal_length_mm) / MM_PER_M
+    return 4.0 * f if focus_from == "sensor" else f * (1.0 + 1e-6)

@@ -6,7 +6,10 @@ and gl.load_shader_source hands every one of them to every compute shader as a #
 compile instead of reading the buffers askew.
 """
 
+
 from __future__ import annotations
+
+from lenslab.optics.aperture import APERTURE_KINDS, ROUNDED_BLADE_BINS as _ROUNDED_BLADE_BINS
 
 # -- Materials: MATERIAL_ROWS vec4 rows per material (buffers.pack_material, glsl/bsdf.glsl), its type
 # code in row 0, w.
@@ -73,6 +76,13 @@ RAYS_BINDING = 6
 HITS_BINDING = 7
 PROBE_IN_BINDING = 6
 PROBE_OUT_BINDING = 8
+# glsl/camera.glsl: the aperture's shape (lenslab.optics.aperture), and the texture unit of its tables.
+APERTURE_ROUND = APERTURE_KINDS["round"]
+APERTURE_BLADES = APERTURE_KINDS["blades"]
+APERTURE_ROUNDED_BLADES = APERTURE_KINDS["rounded_blades"]
+APERTURE_IMAGE = APERTURE_KINDS["image"]
+APERTURE_TABLE_UNIT = 0
+ROUNDED_BLADE_BINS = _ROUNDED_BLADE_BINS
 
 
 def glsl_defines() -> dict[str, int]:

@@ -14,18 +14,21 @@ renders can be merged by adding, and the same seed gives the same image however 
 from __future__ import annotations
 
 import functools
+import math
 import time
 from dataclasses import dataclass
 
+import moderngl
 import numpy as np
 
+from lenslab.optics.aperture import APERTURE_KINDS, Aperture
 from lenslab.render import film, gl
 from lenslab.render.buffers import GpuScene, pack_scene
 from lenslab.render.features import GENERAL, KernelFeatures, scene_features
-from lenslab.render.gpu_layout import (ACCUMULATION_BINDING, DISPLAY_BINDING, SPLAT_IMAGE_BINDING, TONE_MAP_CLAMP,
+from lenslab.render.gpu_layout import (ACCUMULATION_BINDING, APERTURE_TABLE_UNIT, DISPLAY_BINDING, SPLAT_IMAGE_BINDING, TONE_MAP_CLAMP,
                                       TONE_MAP_FILMIC, TONE_MAP_REINHARD)
 from lenslab.render.sobol import glsl_array_literal
-from lenslab.scene.camera import ThinLensCamera
+from lenslab.scene.camera import CameraFrame, ThinLensCamera
 from lenslab.scene.scene import RenderSettings, Scene
 
 LOCAL_SIZE_X = 32  # GPU-NOTES: 32x1 work groups traversed the kd-tree fastest on llvmpipe
@@ -111,19 +114,58 @@ class Renderer:
         self.ctx.release()
 
 
-def camera_uniforms(camera: ThinLensCamera, width: int, height: int) -> dict[str, object]:
-    """glsl/camera.glsl's uniforms: the camera's frame for a width x height image, as the host computes it."""
-    frame = camera.frame(width, height)
+def camera_uniforms(frame: CameraFrame) -> dict[str, object]:
+    """glsl/camera.glsl's uniforms: the camera's frame for an image, as the host computes it. The aperture's tables
+    go to the GPU apart (:class:`ApertureTable`)."""
+    aperture = frame.aperture
+    arc_centre, arc_radius, area = aperture._blade_geometry if aperture.blades >= 3 else (0.0, 0.0, math.pi)
+    (gain_x, gain_y), barrel_radius = frame.barrel_opening
+    rows, cols = aperture.image.shape if aperture.image is not None else (0, 0)
     return {
         "cam_position": tuple(float(v) for v in frame.position),
         "cam_to_world": tuple(float(v) for v in frame.to_world.T.reshape(-1)),  # column-major: right, up, back
         "cam_tan_half_fov": tuple(float(t) for t in frame.tan_half_fov),
         "cam_lens_radius": float(frame.lens_radius),
         "cam_focus_distance": float(frame.focus_distance),
-        "cam_blades": int(frame.blades),
-        "cam_blade_rotation": float(frame.blade_rotation),
+        "cam_aperture_kind": APERTURE_KINDS[aperture.kind],
+        "cam_blades": int(aperture.blades),
+        "cam_blade_rotation": float(aperture.rotation_rad),
+        "cam_blade_arc": (float(arc_centre), float(min(arc_radius, 1e30))),
+        "cam_blade_wedge_area": float(area / max(aperture.blades, 1)),
+        "cam_aperture_axes": tuple(float(a) for a in aperture.axes),
+        "cam_barrel_gain": (float(gain_x), float(gain_y)),
+        "cam_barrel_radius": float(barrel_radius) if frame.barrel_clipping > 0.0 else 0.0,
+        "cam_aperture_image_size": (int(cols), int(rows)),
+        "aperture_table": APERTURE_TABLE_UNIT,
         "image_size": (frame.width, frame.height),
     }
+
+
+class ApertureTable:
+    """The aperture's cumulative tables (``Aperture.table``) as a float texture that glsl/camera.glsl reads
+    with texelFetch; uploaded again only when the table changes."""
+
+    def __init__(self, ctx):
+        self.ctx = ctx
+        self._texture = None
+        self._key = None
+
+    def bind(self, aperture: Aperture) -> None:
+        table = aperture.table
+        key = (table.shape, table.tobytes())
+        if key != self._key:
+            self.release()
+            rows, cols = table.shape
+            self._texture = self.ctx.texture((cols, rows), 1, np.ascontiguousarray(table).tobytes(), dtype="f4")
+            self._texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            self._key = key
+        self._texture.use(APERTURE_TABLE_UNIT)
+
+    def release(self) -> None:
+        if self._texture is not None:
+            self._texture.release()
+            self._texture = None
+            self._key = None
 
 
 @dataclass(frozen=True)
@@ -162,6 +204,7 @@ class RenderSession:
         self._accumulation = None
         self._splat_samples = None  # one pass of radiance samples, while a gaussian filter is splatted
         self._display_pixels = None  # display.comp's 8-bit picture
+        self._aperture_table = ApertureTable(self.ctx)
         self.set_scene(scene, width=width, height=height, settings=settings)
 
     # -- scene and camera ---------------------------------------------------------------------------------
@@ -190,6 +233,7 @@ class RenderSession:
     def set_camera(self, camera: ThinLensCamera) -> None:
         """A camera-only edit: no re-upload of geometry, just restart accumulation."""
         camera.validate()
+        self.frame = camera.frame(self.width, self.height, base_dir=self.scene.base_dir())
         self.camera = camera
         self.reset()
 
@@ -256,7 +300,7 @@ class RenderSession:
         """The uniforms the trace kernel is given by name before each step: the scene's, the camera's and the
         settings' (each dispatch then sets its own tile and samples). The general kernel reads every one."""
         values = dict(self._gpu_scene.packed.uniforms)
-        values.update(camera_uniforms(self.camera, self.width, self.height))
+        values.update(camera_uniforms(self.frame))
         splat_pixels = self.width * self.height if self._splat_samples is not None else 0
         values.update(max_depth=self.settings.max_depth, rr_depth=self.settings.rr_depth, seed=self.settings.seed,
                       clamp_max=self.settings.clamp, splat_pixels=splat_pixels,
@@ -360,6 +404,7 @@ class RenderSession:
 
     def _bind_trace_buffers(self) -> None:
         self._gpu_scene.bind()
+        self._aperture_table.bind(self.frame.aperture)
         target = self._splat_samples if self._splat_samples is not None else self._accumulation
         target.bind_to_storage_buffer(ACCUMULATION_BINDING)
 
@@ -376,7 +421,7 @@ class RenderSession:
         """The surface seen through the lens centre at image position (x, y) in pixels, (0, 0) top left."""
         from lenslab.render.raycast import cast_rays
 
-        frame = self.camera.frame(self.width, self.height)
+        frame = self.frame
         origins, directions = frame.rays([(x, y)])
         hits = cast_rays(self.renderer, self._gpu_scene, origins, directions)
         prim = int(hits.prim[0])
@@ -430,6 +475,7 @@ class RenderSession:
 
     @in_context
     def release(self) -> None:
+        self._aperture_table.release()
         self._release_splat_samples()
         self._release_display_pixels()
         if self._gpu_scene is not None:

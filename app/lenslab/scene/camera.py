@@ -17,19 +17,30 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
-from lenslab.optics.aperture import sample_aperture
+from lenslab.optics.aperture import Aperture
+from lenslab.optics.dof import COC_DIAGONAL_DIVISOR, DepthOfField
+from lenslab.optics.exposure import EXPOSURE_MODES, ISO_RANGE, SHUTTER_RANGE_S, exposure_scale
+from lenslab.optics.framing import SENSOR_FITS, imaged_area_mm
 from lenslab.optics.lenses import MAX_APERTURE_BLADES
 from lenslab.optics.sensors import SENSOR_SIDE_RANGE_MM
 from lenslab.optics.stops import F_NUMBER_RANGE
-from lenslab.optics.thinlens import FOCAL_LENGTH_RANGE_MM, FOCUS_DISTANCE_RANGE_M, field_of_view_x, lens_radius_m
+from lenslab.optics.thinlens import (FOCAL_LENGTH_RANGE_MM, FOCUS_DISTANCE_RANGE_M, FOCUS_REFERENCES, MM_PER_M,
+                                     closest_focus_m, format_distance, image_distance_mm, lens_radius_m,
+                                     object_distance_m, sensor_distance_m)
 
 Vec3 = tuple[float, float, float]
 
 #: The widest and tallest image LensLab renders, pixels.
 MAX_IMAGE_SIDE = 16384
+#: Anamorphic squeeze (bokeh height over width) LensLab accepts: 1 is a spherical lens; 1.33, 1.5, 1.8 and 2 are
+#: the usual anamorphics; below 1 the oval lies on its side.
+SQUEEZE_RANGE = (0.25, 4.0)
+#: Circles of confusion LensLab accepts, mm: 0.5 um (a microscope) to 1 mm (a billboard seen from its foot).
+COC_RANGE_MM = (0.0005, 1.0)
 
 
 @dataclass
@@ -41,21 +52,132 @@ class ThinLensCamera:
     f_number: float = field(default=2.8, metadata={"range": F_NUMBER_RANGE, "doc": "N; aperture diameter is f/N"})
     focus_distance_m: float = field(default=5.0, metadata={"range": FOCUS_DISTANCE_RANGE_M,
                                                                   "doc": "distance to the plane of focus"})
+    focus_from: str = field(default="sensor", metadata={"choices": FOCUS_REFERENCES,
+                                                        "doc": "what focus_distance_m is measured from"})
+    focus_breathing: bool = field(default=True, metadata={
+        "doc": "the sensor sits at the image distance, so framing changes with focus; false: one focal length"})
     sensor_mm: tuple[float, float] = field(default=(36.0, 24.0), metadata={"range": SENSOR_SIDE_RANGE_MM})
+    sensor_fit: str = field(default="auto", metadata={"choices": SENSOR_FITS,
+                                                      "doc": "which of the sensor's sides the image spans"})
+    circle_of_confusion_mm: float | None = field(default=None, metadata={
+        "range": COC_RANGE_MM, "doc": "sharpness criterion; null: the imaged area's diagonal / 1500"})
     aperture_blades: int = field(default=0, metadata={"range": (0, MAX_APERTURE_BLADES),
                                                           "doc": "0 = round; otherwise >= 3"})
     blade_rotation_deg: float = field(default=0.0, metadata={"range": (-360.0, 360.0)})
+    blade_curvature: float = field(default=0.0, metadata={"range": (0.0, 1.0),
+                                                          "doc": "0: straight blades .. 1: a round stop"})
+    anamorphic_squeeze: float = field(default=1.0, metadata={"range": SQUEEZE_RANGE,
+                                                             "doc": "bokeh height over width"})
+    barrel_clipping: float = field(default=0.0, metadata={
+        "range": (0.0, 1.0), "doc": "cat's-eye bokeh: how far the barrel cuts into the stop at the frame's corner"})
+    aperture_image: str = field(default="", metadata={"doc": "a grayscale image of the stop; relative to the scene"})
+    exposure_mode: str = field(default="compensated", metadata={"choices": EXPOSURE_MODES})
+    iso: float = field(default=100.0, metadata={"range": ISO_RANGE})
+    shutter_s: float = field(default=1.0 / 125.0, metadata={"range": SHUTTER_RANGE_S, "doc": "seconds"})
     resolution: tuple[int, int] = field(default=(640, 480), metadata={"range": (1, MAX_IMAGE_SIDE)})
     pinhole: bool = field(default=False, metadata={"doc": "an ideal pinhole: everything sharp, the f-number ignored"})
 
     # -- derived quantities -------------------------------------------------------------------------------
     @property
     def fov_x(self) -> float:
-        return field_of_view_x(self.focal_length_mm, self.sensor_mm[0])
+        """Horizontal field of view of an image of the camera's own resolution, radians."""
+        return self.frame().fov_x
 
     @property
     def lens_radius(self) -> float:
         return 0.0 if self.pinhole else lens_radius_m(self.focal_length_mm, self.f_number)
+
+    @property
+    def plane_of_focus_m(self) -> float:
+        """Distance from the lens to the plane in focus, metres (what the renderer needs)."""
+        if self.focus_from == "lens":
+            return float(self.focus_distance_m)
+        return object_distance_m(self.focal_length_mm, self.focus_distance_m)
+
+    @property
+    def image_distance_mm(self) -> float:
+        """Distance from the lens to the sensor, mm: the image distance of the plane of focus (focus breathing), or
+        one focal length (framing held, as pbrt and Mitsuba)."""
+        if not self.focus_breathing or self.pinhole:
+            return float(self.focal_length_mm)
+        return image_distance_mm(self.focal_length_mm, self.plane_of_focus_m)
+
+    @property
+    def closest_focus_m(self) -> float:
+        """The nearest focus distance this camera's lens can set, in its own reference (thin-lens limit)."""
+        if self.focus_from == "lens" and not self.focus_breathing:
+            return FOCUS_DISTANCE_RANGE_M[0]
+        return closest_focus_m(self.focal_length_mm, self.focus_from)
+
+    def focus_setting_for(self, depth_m: float) -> float:
+        """The focus distance (in this camera's reference) that makes a point ``depth_m`` ahead of the lens, along
+        the view axis, sharp: the value click-to-focus sets."""
+        if self.focus_from == "lens":
+            return float(depth_m)
+        return sensor_distance_m(self.focal_length_mm, depth_m)
+
+    def distance_from_reference(self, depth_m):
+        """A depth ahead of the lens as this camera's focus scale would read it (adds the lens-to-sensor distance
+        when focus is measured from the sensor)."""
+        return depth_m + (self.image_distance_mm / MM_PER_M if self.focus_from == "sensor" else 0.0)
+
+    def imaged_area_mm(self, width: int | None = None, height: int | None = None) -> tuple[float, float]:
+        """The part of the sensor (mm) an image of ``width`` x ``height`` shows (default: the camera's own)."""
+        width, height = int(width or self.resolution[0]), int(height or self.resolution[1])
+        return imaged_area_mm(*self.sensor_mm, width, height, self.sensor_fit)
+
+    def coc_mm(self, width: int | None = None, height: int | None = None) -> float:
+        """The circle of confusion the depth-of-field readout uses: the camera's own, or the diagonal of the area
+        the image shows / 1500."""
+        if self.circle_of_confusion_mm is not None:
+            return float(self.circle_of_confusion_mm)
+        return math.hypot(*self.imaged_area_mm(width, height)) / COC_DIAGONAL_DIVISOR
+
+    def aperture(self, base_dir: Path | None = None) -> Aperture:
+        """The stop's shape; an aperture image is read relative to ``base_dir`` (the scene's folder)."""
+        image = None
+        if self.aperture_image:
+            from lenslab.scene.aperture_images import read_aperture_image
+
+            image = read_aperture_image(self.aperture_image, base_dir)
+        return Aperture(blades=self.aperture_blades, rotation_rad=math.radians(self.blade_rotation_deg),
+                        curvature=self.blade_curvature, squeeze=self.anamorphic_squeeze, image=image)
+
+    def exposure_scale(self, light_fraction: float = 1.0) -> float:
+        """What the image's radiance is multiplied by: 1 in the compensated mode; in the physical mode
+        t S / (120 N^2) times the light the aperture passes (lenslab.optics.exposure)."""
+        if self.exposure_mode != "physical":
+            return 1.0
+        return exposure_scale(self.f_number, self.shutter_s, self.iso, light_fraction)
+
+    def depth_of_field(self, width: int | None = None, height: int | None = None,
+                       light_fraction: float = 1.0) -> DepthOfField:
+        """Near and far limits of acceptable sharpness and the hyperfocal distance, in the camera's focus
+        reference, for exactly the picture the renderer draws.
+
+        A point at depth d ahead of the lens makes a blur disk of diameter ``c = A |d - s| / d * v / s`` on the
+        sensor (A the aperture's diameter, s the plane of focus, v the lens-to-sensor distance); the limits are
+        the depths where c equals the circle of confusion. An aperture that passes less light than the round f/N
+        stop counts with the diameter of a disk of its area."""
+        f = self.focal_length_mm
+        s = self.plane_of_focus_m * MM_PER_M
+        v = self.image_distance_mm
+        aperture = f / self.f_number * math.sqrt(light_fraction)
+        c = self.coc_mm(width, height)
+        blur_at_infinity = aperture * v / s  # c of a point at d = infinity: A v / s
+        near = s / (1.0 + c / blur_at_infinity)
+        far = s / (1.0 - c / blur_at_infinity) if c < blur_at_infinity else math.inf
+        # The hyperfocal distance: the focus whose blur at infinity is c. With v = f s / (s - f) that is
+        # s = f + A f / c (the textbook H = f^2 / (N c) + f); with v = f it is A f / c.
+        hyperfocal = aperture * f / c + (f if self.focus_breathing else 0.0)
+        reference_shift = v if self.focus_from == "sensor" else 0.0
+        near_m, far_m = (near + reference_shift) / MM_PER_M, (far + reference_shift) / MM_PER_M
+        if self.focus_from == "sensor":
+            hyperfocal_m = (sensor_distance_m(f, hyperfocal / MM_PER_M) if self.focus_breathing
+                            else (hyperfocal + f) / MM_PER_M)
+        else:
+            hyperfocal_m = hyperfocal / MM_PER_M
+        return DepthOfField(near_m=near_m, far_m=far_m, hyperfocal_m=hyperfocal_m, total_m=far_m - near_m)
 
     def basis(self) -> np.ndarray:
         """Rows: right, up, back (+Z of the camera frame; the camera looks down -Z) in world space."""
@@ -74,23 +196,33 @@ class ThinLensCamera:
     def validate(self) -> None:
         if self.aperture_blades in (1, 2):
             raise ValueError("aperture_blades must be 0 (round) or at least 3")
+        if self.focus_distance_m < self.closest_focus_m:
+            reference = "the sensor" if self.focus_from == "sensor" else "the lens"
+            raise ValueError(f"focus_distance_m {format_distance(self.focus_distance_m)} from {reference} is nearer "
+                             f"than a {self.focal_length_mm:g} mm lens can focus: at least "
+                             f"{format_distance(self.closest_focus_m)}")
         self.basis()
 
-    def frame(self, width: int | None = None, height: int | None = None) -> "CameraFrame":
+    def frame(self, width: int | None = None, height: int | None = None, *,
+              base_dir: Path | None = None) -> "CameraFrame":
         """The camera as it makes an image of ``width`` x ``height`` pixels (default: its own resolution).
 
-        The image spans the sensor's width; its height follows the image's shape, so a viewport of another
-        aspect ratio than the scene's shows more or less above and below, never a stretched picture."""
+        The image shows the part of the sensor its sensor fit gives (lenslab.optics.framing): a viewport of
+        another aspect ratio than the scene's shows more or less of the sensor, never a stretched picture. The
+        field of view is that area seen from the lens-to-sensor distance. ``base_dir`` is where a relative
+        aperture image is read from (the scene's folder)."""
         width = int(width or self.resolution[0])
         height = int(height or self.resolution[1])
         if width < 1 or height < 1:
             raise ValueError(f"an image needs at least one pixel each way, not {width} x {height}")
         right, up, back = self.basis()
-        tan_x = math.tan(self.fov_x / 2.0)
+        film_w, film_h = self.imaged_area_mm(width, height)
+        v = self.image_distance_mm
         return CameraFrame(position=np.asarray(self.position, dtype=float), right=right, up=up, back=back,
-                           tan_half_fov=(tan_x, tan_x * height / width), lens_radius=self.lens_radius,
-                           focus_distance=float(self.focus_distance_m), blades=int(self.aperture_blades),
-                           blade_rotation=math.radians(self.blade_rotation_deg), width=width, height=height)
+                           tan_half_fov=(film_w / (2.0 * v), film_h / (2.0 * v)), lens_radius=self.lens_radius,
+                           focus_distance=self.plane_of_focus_m, aperture=self.aperture(base_dir),
+                           barrel_clipping=float(self.barrel_clipping), film_mm=(film_w, film_h),
+                           image_distance_mm=v, width=width, height=height)
 
 
 @dataclass(frozen=True, eq=False)
@@ -101,8 +233,10 @@ class CameraFrame:
     bottom-right; pixel (i, j)'s centre is (i + 0.5, j + 0.5). A pinhole ray through an image point has, in
     the camera's frame, the direction (x tan(fov_x / 2), y tan(fov_y / 2), -1) with x, y in [-1, 1] (+y up);
     it meets the plane of focus at that direction times ``focus_distance``. A thin-lens ray leaves a point of
-    the aperture (a disk of radius ``lens_radius``, or a polygon of ``blades`` corners) and passes through
-    that same point of focus, so everything on the plane of focus is sharp.
+    the aperture (``aperture``, in units of ``lens_radius``) and passes through that same point of focus, so
+    everything on the plane of focus is sharp. With ``barrel_clipping``, the lens barrel's opening, seen from
+    an image point off the axis, is shifted across the stop (by that fraction of the stop's radius at the
+    frame's corner): rays outside it are blocked, giving cat's-eye bokeh and optical vignetting.
     """
 
     position: np.ndarray  # centre of the lens, world space
@@ -110,10 +244,12 @@ class CameraFrame:
     up: np.ndarray
     back: np.ndarray
     tan_half_fov: tuple[float, float]  # tan(fov_x / 2), tan(fov_y / 2)
-    lens_radius: float  # metres; 0 for a pinhole
-    focus_distance: float  # metres along the view axis to the plane of focus
-    blades: int  # 0: a round aperture
-    blade_rotation: float  # radians
+    lens_radius: float  # metres: the round f/N stop's radius; 0 for a pinhole
+    focus_distance: float  # metres along the view axis from the lens to the plane of focus
+    aperture: Aperture  # the stop's shape, in units of lens_radius
+    barrel_clipping: float  # 0: none; 1: the barrel's opening shifted by the stop's radius at the corner
+    film_mm: tuple[float, float]  # width and height of the sensor area the image shows
+    image_distance_mm: float  # lens to sensor
     width: int
     height: int
 
@@ -128,9 +264,26 @@ class CameraFrame:
         return np.stack([self.right, self.up, self.back], axis=1)
 
     @property
+    def fov_x(self) -> float:
+        """Horizontal field of view of this image, radians."""
+        return 2.0 * math.atan(self.tan_half_fov[0])
+
+    @property
     def fov_y(self) -> float:
         """Vertical field of view of this image, radians."""
         return 2.0 * math.atan(self.tan_half_fov[1])
+
+    @property
+    def barrel_opening(self) -> tuple[tuple[float, float], float]:
+        """The barrel's opening in aperture units: (its shift per unit of image coordinate x and y in [-1, 1], its
+        radius). The opening is the circle around the stop; at the frame's corner it is shifted by
+        ``barrel_clipping`` times its radius, and in between in proportion to the distance from the centre on the
+        film (so in proportion to the tangent of the field angle, as the projection of an opening in front of the
+        stop would be)."""
+        radius = max(self.aperture.axes)
+        half_w, half_h = self.film_mm[0] / 2.0, self.film_mm[1] / 2.0
+        gain = self.barrel_clipping * radius / math.hypot(half_w, half_h)
+        return (gain * half_w, gain * half_h), radius
 
     def view_size_at(self, distance: float) -> tuple[float, float]:
         """Width and height in metres of what the image shows on a plane ``distance`` ahead of the lens."""
@@ -141,7 +294,7 @@ class CameraFrame:
         return self.position + self.focus_distance * self.forward
 
     def depth_of(self, points) -> np.ndarray | float:
-        """Distance along the view axis to world ``points`` (..., 3): the focus distance that makes each sharp."""
+        """Distance along the view axis from the lens to world ``points`` (..., 3)."""
         depth = (np.asarray(points, dtype=float) - self.position) @ self.forward
         return float(depth) if np.ndim(depth) == 0 else depth
 
@@ -158,25 +311,33 @@ class CameraFrame:
         directions = local @ self.to_world.T
         return directions / np.linalg.norm(directions, axis=-1, keepdims=True)
 
-    def rays(self, pixels, lens_samples=None) -> tuple[np.ndarray, np.ndarray]:
+    def rays(self, pixels, lens_samples=None, *, with_weights: bool = False):
         """World origins and unit directions (each (N, 3)) of the camera rays through image points ``pixels``
         (N, 2). ``lens_samples`` (N, 2) in [0, 1) choose each ray's point on the aperture, as the renderer's
-        sampler does; without them every ray leaves the lens centre (the pinhole rays)."""
+        sampler does; without them every ray leaves the lens centre (the pinhole rays). ``with_weights`` adds
+        each ray's weight (N,): 0 where the barrel blocks it, else the aperture sample's weight."""
         pixels = np.asarray(pixels, dtype=float).reshape(-1, 2)
         focus = self._pinhole_local(pixels) * self.focus_distance
         lens = np.zeros_like(focus)
+        weights = np.ones(len(pixels))
         if lens_samples is not None:
-            aperture = sample_aperture(np.asarray(lens_samples, dtype=float).reshape(-1, 2), self.blades,
-                                       self.blade_rotation)
-            lens[:, :2] = self.lens_radius * aperture
+            points, weights = self.aperture.sample(np.asarray(lens_samples, dtype=float).reshape(-1, 2))
+            if self.barrel_clipping > 0.0:
+                (gain_x, gain_y), radius = self.barrel_opening
+                ndc = self._ndc(pixels)
+                shift = ndc * np.array([gain_x, gain_y])
+                weights = np.where(np.linalg.norm(points - shift, axis=-1) <= radius, weights, 0.0)
+            lens[:, :2] = self.lens_radius * points
         directions = (focus - lens) @ self.to_world.T
         directions /= np.linalg.norm(directions, axis=-1, keepdims=True)
         origins = self.position + lens @ self.to_world.T
-        return origins, directions
+        return (origins, directions, weights) if with_weights else (origins, directions)
+
+    def _ndc(self, pixels: np.ndarray) -> np.ndarray:
+        """Image coordinates in [-1, 1], +y up."""
+        return np.stack([2.0 * pixels[:, 0] / self.width - 1.0, 1.0 - 2.0 * pixels[:, 1] / self.height], axis=-1)
 
     def _pinhole_local(self, pixels) -> np.ndarray:
-        pixels = np.asarray(pixels, dtype=float).reshape(-1, 2)
-        ndc_x = 2.0 * pixels[:, 0] / self.width - 1.0
-        ndc_y = 1.0 - 2.0 * pixels[:, 1] / self.height
+        ndc = self._ndc(np.asarray(pixels, dtype=float).reshape(-1, 2))
         tan_x, tan_y = self.tan_half_fov
-        return np.stack([ndc_x * tan_x, ndc_y * tan_y, -np.ones_like(ndc_x)], axis=-1)
+        return np.stack([ndc[:, 0] * tan_x, ndc[:, 1] * tan_y, -np.ones(len(ndc))], axis=-1)

@@ -242,6 +242,8 @@ def file_fields(model: EditableScene) -> Iterator[FileField]:
                 yield ("material", name), (field.name, "file")
     if isinstance(model.scene.environment, EnvironmentMap):
         yield ("environment",), ("file",)
+    if model.scene.camera.aperture_image:
+        yield ("camera",), ("aperture_image",)
 
 
 def rebased_file_paths(model: EditableScene, new_folder: Path) -> dict[FileField, str]:

@@ -1002,6 +1002,11 @@ class _Importer:
             sensor_mm=(SENSOR_WIDTH_MM, SENSOR_WIDTH_MM * height / width),
             resolution=(width, height),
             pinhole=pinhole,
+            # Mitsuba's thin lens exactly: focus measured from the lens, the sensor one focal length behind it
+            # at every focus, the field of view across the image's width.
+            focus_from="lens",
+            focus_breathing=False,
+            sensor_fit="horizontal",
         )
 
     def _bounds_corners(self) -> np.ndarray:

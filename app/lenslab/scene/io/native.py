@@ -28,7 +28,11 @@ from lenslab.scene.textures import TEXTURE_TYPES, ImageTexture, Texture
 from lenslab.scene.lights import LIGHT_TYPES, Light
 
 FORMAT_KEY = "lenslab_scene"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
+#: Version 1 files measured the focus distance from the lens, kept the sensor one focal length behind it and
+#: spanned the image across the sensor's width; version 2's defaults are the photographer's (docs/scene-format.md,
+#: "Versions"). A version 1 file is read with its old meaning, so it renders exactly as it always did.
+_VERSION_1_CAMERA = {"focus_from": "lens", "focus_breathing": False, "sensor_fit": "horizontal"}
 SCENE_SUFFIX = ".json"
 
 # Polymorphic fields: the JSON object's "type" key picks the dataclass.
@@ -152,6 +156,11 @@ def _check_references(scene: Scene) -> None:
         scene.camera.validate()
     except ValueError as exc:
         raise _Invalid("camera", str(exc)) from None
+    if scene.camera.aperture_image:
+        try:  # read now, so that a missing or black image is named while the scene opens
+            scene.camera.aperture(scene.base_dir())
+        except ValueError as exc:
+            raise _Invalid("camera.aperture_image", str(exc)) from None
 
     def visit(nodes: list[Node], path: str) -> None:
         for i, node in enumerate(nodes):
@@ -176,9 +185,18 @@ def scene_from_dict(data: Any, source_path: Path | None = None) -> Scene:
     version = data.get(FORMAT_KEY)
     if version is None:
         raise _Invalid(FORMAT_KEY, "missing: this is not a LensLab scene")
-    if version != FORMAT_VERSION:
-        raise _Invalid(FORMAT_KEY, f"version {_describe(version)} is not supported (this LensLab reads {FORMAT_VERSION})")
-    scene = _read_dataclass({k: v for k, v in data.items() if k != FORMAT_KEY}, Scene, "")
+    if version not in (1, FORMAT_VERSION) or isinstance(version, bool):
+        raise _Invalid(FORMAT_KEY, f"version {_describe(version)} is not supported (this LensLab reads 1 and "
+                                   f"{FORMAT_VERSION})")
+    data = {k: v for k, v in data.items() if k != FORMAT_KEY}
+    if version == 1:
+        camera = data.get("camera", {})
+        if isinstance(camera, dict):
+            for key in camera.keys() & _VERSION_1_CAMERA.keys():
+                raise _Invalid(_join("camera", key), f"unknown key in a version 1 scene (write "
+                                                     f'"{FORMAT_KEY}": {FORMAT_VERSION} to use it)')
+            data["camera"] = {**_VERSION_1_CAMERA, **camera}
+    scene = _read_dataclass(data, Scene, "")
     scene.source_path = source_path
     _check_references(scene)
     return scene
