@@ -20,8 +20,14 @@ def point_light_scene(depth_m: float, radius_m: float, camera: ThinLensCamera) -
     )
 
 
+#: The thin lens of pbrt and Mitsuba: focus measured from the lens, the sensor one focal length behind it at every
+#: focus, the image across the sensor's width. Tests that check the renderer against those formulas
+#: (lenslab.optics.thinlens.blur_diameter_mm, fields of view) set it; tests/test_camera_controls.py covers the rest.
+FIXED_SENSOR = dict(focus_from="lens", focus_breathing=False, sensor_fit="horizontal")
+
+
 def axis_camera(**kwargs) -> ThinLensCamera:
-    defaults = dict(position=(0.0, 0.0, 0.0), look_at=(0.0, 0.0, -1.0), up=(0.0, 1.0, 0.0))
+    defaults = dict(position=(0.0, 0.0, 0.0), look_at=(0.0, 0.0, -1.0), up=(0.0, 1.0, 0.0), **FIXED_SENSOR)
     return ThinLensCamera(**(defaults | kwargs))
 
 

@@ -14,6 +14,8 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from tests.scenes import FIXED_SENSOR
+
 from lenslab.scene import editing
 from lenslab.scene.camera import ThinLensCamera
 from lenslab.scene.editable import EditableScene, unique_name
@@ -31,7 +33,7 @@ FOCUS_POINT = (0.0, 1.0, 2.5)
 
 def camera(**changes) -> ThinLensCamera:
     settings = dict(position=(0.0, 1.0, 5.0), look_at=(0.0, 1.0, 0.0), focal_length_mm=50.0,
-                    focus_distance_m=2.5, sensor_mm=(36.0, 24.0), resolution=(640, 480))
+                    focus_distance_m=2.5, sensor_mm=(36.0, 24.0), resolution=(640, 480), **FIXED_SENSOR)
     settings.update(changes)
     return ThinLensCamera(**settings)
 

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+
+from tests.scenes import FIXED_SENSOR
 import trimesh
 
 from lenslab.render.tracer import RenderSession
@@ -19,7 +21,7 @@ def million_triangle_scene(tmp_path_factory):
     ball = trimesh.creation.icosphere(subdivisions=8, radius=1.0)  # 1,310,720 triangles
     ball.export(folder / "ball.ply")
     return Scene(
-        camera=ThinLensCamera(position=(0, 0, 4), look_at=(0, 0, 0), focal_length_mm=50, f_number=4,
+        camera=ThinLensCamera(**FIXED_SENSOR, position=(0, 0, 4), look_at=(0, 0, 0), focal_length_mm=50, f_number=4,
                               focus_distance_m=3, resolution=(48, 32)),
         environment=ConstantEnvironment((1.0, 1.0, 1.0)),
         render=RenderSettings(max_depth=2),

@@ -8,6 +8,8 @@ import math
 import numpy as np
 import pytest
 
+from tests.scenes import FIXED_SENSOR
+
 from lenslab.render.film import write_image
 from lenslab.render.tracer import RenderSession
 from lenslab.scene.camera import ThinLensCamera
@@ -24,7 +26,7 @@ ALBEDO = 0.6
 def looking_down_at_floor(**scene_args) -> Scene:
     """A camera 2 m above a large diffuse floor, looking straight down at its centre."""
     defaults = dict(
-        camera=ThinLensCamera(position=(0, 2, 0), look_at=(0, 0, 0), up=(0, 0, -1), focal_length_mm=200,
+        camera=ThinLensCamera(**FIXED_SENSOR, position=(0, 2, 0), look_at=(0, 0, 0), up=(0, 0, -1), focal_length_mm=200,
                               f_number=16, focus_distance_m=2, resolution=(16, 16)),
         render=RenderSettings(max_depth=2),
         materials={"floor": Diffuse((ALBEDO, ALBEDO, ALBEDO))},
@@ -63,7 +65,7 @@ def test_sun_irradiance_gives_lambertian_radiance(renderer, diameter):
 def test_the_sun_disk_is_seen_by_rays_that_escape(renderer):
     # A camera looking straight at a 5-degree sun sees its radiance inside the disk and black sky outside.
     sun = SunLight("sun", direction=(0, 0, 1), irradiance=(1.0, 1.0, 1.0), angular_diameter_deg=5.0)
-    scene = Scene(camera=ThinLensCamera(position=(0, 0, 0), look_at=(0, 0, 1), focal_length_mm=200, f_number=16,
+    scene = Scene(camera=ThinLensCamera(**FIXED_SENSOR, position=(0, 0, 0), look_at=(0, 0, 1), focal_length_mm=200, f_number=16,
                                         focus_distance_m=100, resolution=(32, 32)),
                   render=RenderSettings(max_depth=1), lights=[sun])
     image, _ = render(renderer, scene, 4)
@@ -85,7 +87,7 @@ def write_sky(path, sun_pixels=True):
 
 def sphere_under_sky(path, **env):
     return Scene(
-        camera=ThinLensCamera(position=(0, 0, 4), look_at=(0, 0, 0), focal_length_mm=70, f_number=8,
+        camera=ThinLensCamera(**FIXED_SENSOR, position=(0, 0, 4), look_at=(0, 0, 0), focal_length_mm=70, f_number=8,
                               focus_distance_m=4, resolution=(24, 24)),
         environment=EnvironmentMap(file=str(path), **env),
         render=RenderSettings(max_depth=2),
@@ -141,7 +143,7 @@ def test_environment_rotation_turns_the_lighting(renderer, tmp_path):
 def textured_card(texture) -> Scene:
     """A card filling the view, lit evenly by a white sky: its radiance equals its albedo."""
     return Scene(
-        camera=ThinLensCamera(position=(0, 0, 2), look_at=(0, 0, 0), focal_length_mm=72, f_number=16,
+        camera=ThinLensCamera(**FIXED_SENSOR, position=(0, 0, 2), look_at=(0, 0, 0), focal_length_mm=72, f_number=16,
                               focus_distance_m=2, sensor_mm=(36, 36), resolution=(32, 32)),
         environment=ConstantEnvironment((1.0, 1.0, 1.0)),
         render=RenderSettings(max_depth=2),
@@ -208,7 +210,7 @@ def test_area_light_straight_above_a_floor_matches_the_form_factor(renderer):
               + y / math.sqrt(1 + y * y) * math.atan(x / math.sqrt(1 + y * y))) / (2 * math.pi)
     expected = ALBEDO * radiance * 4 * corner
     scene = Scene(
-        camera=ThinLensCamera(position=(0, 0.5, 2), look_at=(0, 0, 0), focal_length_mm=400, f_number=16,
+        camera=ThinLensCamera(**FIXED_SENSOR, position=(0, 0.5, 2), look_at=(0, 0, 0), focal_length_mm=400, f_number=16,
                               focus_distance_m=2, resolution=(16, 16)),
         render=RenderSettings(max_depth=2),
         materials={"floor": Diffuse((ALBEDO,) * 3), "lamp": Emissive((radiance,) * 3)},
@@ -231,7 +233,7 @@ def test_environment_map_rows_meet_the_sphere_as_their_layout_says(renderer, tmp
     for theta_deg, up in ((0.0, (0, 0, -1)), (45.0, (0, 1, 0)), (180.0, (0, 0, -1))):
         theta = math.radians(theta_deg)
         look = (0.0, math.cos(theta), -math.sin(theta))
-        camera = ThinLensCamera(position=(0, 0, 0), look_at=look, up=up, focal_length_mm=2000.0, pinhole=True,
+        camera = ThinLensCamera(**FIXED_SENSOR, position=(0, 0, 0), look_at=look, up=up, focal_length_mm=2000.0, pinhole=True,
                                 resolution=(1, 1))
         scene = Scene(camera=camera, environment=EnvironmentMap(file=str(tmp_path / "rows.exr"), rows=rows),
                       render=RenderSettings(max_depth=1))
@@ -286,7 +288,7 @@ def test_lights_chosen_by_what_reaches_the_point_agree_with_lights_chosen_by_pow
     from lenslab.scene.materials import Emissive
 
     scene = looking_down_at_floor(
-        camera=ThinLensCamera(position=(0, 1.5, 1.5), look_at=(0, 0, 0), focal_length_mm=35, f_number=16,
+        camera=ThinLensCamera(**FIXED_SENSOR, position=(0, 1.5, 1.5), look_at=(0, 0, 0), focal_length_mm=35, f_number=16,
                               focus_distance_m=2, resolution=(24, 24)),
         render=RenderSettings(max_depth=3),
         environment=ConstantEnvironment((0.05, 0.05, 0.07)),

@@ -70,7 +70,7 @@ def test_the_written_file_carries_the_camera_and_the_samples(renderer, tmp_path)
         job.release()
     pixels, meta = read_image(path)
     assert pixels.shape == (24, 32, 3)
-    assert meta["Exif:FNumber"] == pytest.approx(4.0) and meta["lenslab:SamplesPerPixel"] == 2
+    assert meta["FNumber"] == pytest.approx(4.0) and meta["lenslab:SamplesPerPixel"] == 2
     assert meta["lenslab:Seed"] == 9
     # 35 mm equivalent focal length: the full-frame sensor's own.
     assert meta["Exif:FocalLengthIn35mmFilm"] == round(scene.camera.focal_length_mm)

@@ -22,7 +22,7 @@ def test_shipped_scenes_round_trip_losslessly(tmp_path, name):
     again = load_scene(tmp_path / "copy.json")
     assert again == scene
     assert scene_to_dict(again) == scene_to_dict(scene)
-    assert json.loads((tmp_path / "copy.json").read_text())["lenslab_scene"] == 1
+    assert json.loads((tmp_path / "copy.json").read_text())["lenslab_scene"] == 2
 
 
 def test_shipped_scenes_are_listed():
@@ -35,8 +35,9 @@ def test_dof_chart_has_an_object_exactly_at_the_focus_distance():
     forward = np.subtract(scene.camera.look_at, scene.camera.position)
     forward = forward / np.linalg.norm(forward)
     depths = (flat.triangles.reshape(-1, 3) - scene.camera.position) @ forward
-    assert np.isclose(depths, scene.camera.focus_distance_m, atol=1e-6).any()
-    assert depths.min() < scene.camera.focus_distance_m / 2 and depths.max() > 2 * scene.camera.focus_distance_m
+    plane = scene.camera.plane_of_focus_m  # the chart's focus reading is from the sensor: 3.087 m puts it at 3 m
+    assert np.isclose(depths, plane, atol=2e-4).any()
+    assert depths.min() < plane / 2 and depths.max() > 2 * plane
 
 
 def test_round_trip_with_a_mesh_file(tmp_path):

@@ -313,7 +313,7 @@ def test_export_writes_a_valid_file_and_cancelling_writes_none(qtbot, window, tm
     pixels, metadata = read_image(out)
     assert pixels.shape == (24, 32, 3)
     assert metadata["lenslab:SamplesPerPixel"] == 4
-    assert metadata["Exif:FNumber"] == pytest.approx(1.8)
+    assert metadata["FNumber"] == pytest.approx(1.8)
     assert pixels.max() > 0
     assert window.export_progress_dialog is None
 

@@ -223,6 +223,8 @@ class ShotAssembly:
         from lenslab.render.film import resolve, write_image
 
         self.shot.output.parent.mkdir(parents=True, exist_ok=True)
-        return write_image(self.shot.output, resolve(self.accumulation()), self.metadata(),
+        metadata = self.metadata()
+        return write_image(self.shot.output, resolve(self.accumulation()), metadata,
+                           sensor_exposure=float(metadata.get("lenslab:ExposureScale", 1.0)),
                            exposure_stops=self.shot.exposure, tone_map_operator=self.shot.tone_map)
 

@@ -66,9 +66,20 @@ def to_8bit(display: np.ndarray) -> np.ndarray:
     return np.clip(np.round(display * 255.0), 0, 255).astype(np.uint8)
 
 
+#: The primaries and white point of LensLab's linear RGB (Rec. 709 / sRGB, D65), as OpenEXR's chromaticities.
+REC709_CHROMATICITIES = (0.64, 0.33, 0.30, 0.60, 0.15, 0.06, 0.3127, 0.3290)
+#: Metadata that OpenImageIO must be told is a 4 x 4 matrix (OpenEXR's worldToCamera and worldToNDC).
+MATRIX_ATTRIBUTES = ("worldtocamera", "worldtoNDC")
+
+
 def write_image(path: str | os.PathLike, linear: np.ndarray, metadata: dict[str, object] | None = None,
-                *, exposure_stops: float = 0.0, tone_map_operator: str = "clamp") -> Path:
-    """Write ``linear`` (H, W, 3) to an .exr (linear float) or .png (sRGB, tone mapped), atomically."""
+                *, sensor_exposure: float = 1.0, exposure_stops: float = 0.0, tone_map_operator: str = "clamp") -> Path:
+    """Write ``linear`` (H, W, 3) to an .exr (linear float) or .png (sRGB, tone mapped), atomically.
+
+    ``sensor_exposure`` multiplies the radiance first, in both: the camera's physical exposure, part of the
+    capture. ``exposure_stops`` and the tone map are the PNG's display look. An EXR carries Rec. 709
+    chromaticities and the camera matrices; a PNG carries Exif (its eXIf chunk: f-number, exposure time, ISO,
+    focal length) and LensLab's own values as text chunks."""
     import OpenImageIO as oiio  # imported here: only exporting needs it
 
     path = Path(path)
@@ -78,16 +89,26 @@ def write_image(path: str | os.PathLike, linear: np.ndarray, metadata: dict[str,
     if not path.parent.is_dir():
         raise ExportError(f"{path}: folder {path.parent} does not exist")
     height, width = linear.shape[:2]
+    linear = linear[..., :3] * np.float32(sensor_exposure) if sensor_exposure != 1.0 else linear[..., :3]
+    metadata = dict(metadata or {})
     if suffix == ".exr":
-        pixels = np.ascontiguousarray(linear[..., :3], dtype=np.float32)
+        pixels = np.ascontiguousarray(linear, dtype=np.float32)
         spec = oiio.ImageSpec(width, height, 3, oiio.FLOAT)
         spec.attribute("compression", "zip")
+        spec.attribute("chromaticities", oiio.TypeDesc("float[8]"), REC709_CHROMATICITIES)
     else:
         pixels = to_8bit(tone_map(linear, exposure_stops, tone_map_operator))
         spec = oiio.ImageSpec(width, height, 3, oiio.UINT8)
         spec.attribute("oiio:ColorSpace", "sRGB")
-    for key, value in (metadata or {}).items():
-        spec.attribute(key, value if not isinstance(value, bool) else int(value))
+        metadata.update({"lenslab:DisplayExposureStops": float(exposure_stops), "lenslab:ToneMap": tone_map_operator})
+        # PNG keeps Exif's own tags in its eXIf chunk and only text besides: LensLab's values become text.
+        metadata = {key: (_as_text(value) if key.startswith("lenslab:") else value) for key, value in metadata.items()
+                    if key not in MATRIX_ATTRIBUTES}
+    for key, value in metadata.items():
+        if key in MATRIX_ATTRIBUTES:
+            spec.attribute(key, oiio.TypeDesc("matrix"), tuple(float(v) for v in np.asarray(value).reshape(-1)))
+        else:
+            spec.attribute(key, value if not isinstance(value, bool) else int(value))
 
     with atomic_path(path) as tmp:
         out = oiio.ImageOutput.create(str(tmp))
@@ -99,6 +120,10 @@ def write_image(path: str | os.PathLike, linear: np.ndarray, metadata: dict[str,
         if not ok:
             raise ExportError(f"{path}: write failed ({error})")
     return path
+
+
+def _as_text(value: object) -> str:
+    return f"{value:.9g}" if isinstance(value, float) else str(value)
 
 
 def read_image(path: str | os.PathLike) -> tuple[np.ndarray, dict[str, object]]:

@@ -20,8 +20,11 @@ from pathlib import Path
 import numpy as np
 
 from lenslab import __version__
+from lenslab.optics.exposure import ev100
 from lenslab.optics.sensors import crop_factor
+from lenslab.optics.stops import format_f_number
 from lenslab.render.tracer import DEFAULT_DISPATCH_SECONDS, Renderer, RenderSession
+from lenslab.scene.camera import CameraFrame
 from lenslab.scene.scene import Scene
 
 #: :meth:`RenderJob.run` renders for about this long between progress reports.
@@ -119,27 +122,34 @@ class RenderJob:
         return self.session.image()
 
     def metadata(self) -> dict[str, object]:
-        return image_metadata(self.scene, self.session.samples_per_pixel, self.session.width, self.session.height)
+        return image_metadata(self.scene, self.session.samples_per_pixel, self.session.frame)
 
     def write(self, path: str | os.PathLike, *, exposure_stops: float = 0.0, tone_map: str = "clamp") -> Path:
-        """Write the finished image with its metadata (.exr linear, .png tone mapped), whole or not at all."""
+        """Write the finished image with its metadata (.exr linear, .png tone mapped), whole or not at all. A
+        camera in the physical exposure mode exposes both (docs/architecture.md, "Exposure")."""
         from lenslab.render.film import write_image
 
-        return write_image(path, self.image(), self.metadata(), exposure_stops=exposure_stops,
-                           tone_map_operator=tone_map)
+        metadata = self.metadata()
+        return write_image(path, self.image(), metadata, sensor_exposure=metadata["lenslab:ExposureScale"],
+                           exposure_stops=exposure_stops, tone_map_operator=tone_map)
 
     def release(self) -> None:
         self.session.release()
 
 
-def image_metadata(scene: Scene, spp: int, width: int, height: int) -> dict[str, object]:
-    """Camera settings under Exif's names where it has one, LensLab's own otherwise."""
+def image_metadata(scene: Scene, spp: int, frame: CameraFrame) -> dict[str, object]:
+    """What a photograph's file says about how it was made: Exif's names (as OpenImageIO spells them) where Exif
+    has one, the OpenEXR standard camera matrices, and LensLab's own names for the rest.
+
+    ``frame`` is the camera as it made this image (its size, the part of the sensor it shows, its aperture)."""
     cam = scene.camera
+    film_w, film_h = frame.film_mm
     sensor_w, sensor_h = cam.sensor_mm
-    pixels_per_cm = float(width / (sensor_w / 10.0))  # the picture spans the sensor's width (square pixels)
-    return {
+    pixels_per_cm = float(frame.width / (film_w / 10.0))  # the picture spans film_w of the focal plane
+    light_fraction = frame.aperture.light_fraction
+    metadata: dict[str, object] = {
         "Software": f"LensLab {__version__}",
-        "Exif:FNumber": float(cam.f_number),
+        "FNumber": float(cam.f_number),
         "Exif:FocalLength": float(cam.focal_length_mm),
         "Exif:FocalLengthIn35mmFilm": int(round(cam.focal_length_mm * crop_factor(sensor_w, sensor_h))),
         "Exif:SubjectDistance": float(cam.focus_distance_m),
@@ -147,15 +157,58 @@ def image_metadata(scene: Scene, spp: int, width: int, height: int) -> dict[str,
         "Exif:FocalPlaneXResolution": pixels_per_cm,
         "Exif:FocalPlaneYResolution": pixels_per_cm,
         "Exif:FocalPlaneResolutionUnit": 3,
+        "Exif:ExposureMode": 1 if cam.exposure_mode == "physical" else 0,  # manual, or auto
+        "lenslab:Aperture": format_f_number(cam.f_number),  # the marked stop ("f/11" for 11.31)
         "lenslab:SensorWidthMM": float(sensor_w),
         "lenslab:SensorHeightMM": float(sensor_h),
-        # The picture spans the sensor's width; its height follows the image's shape.
-        "lenslab:ImageHeightMM": float(sensor_w * height / width),
+        "lenslab:SensorFit": cam.sensor_fit,
+        "lenslab:ImageWidthMM": float(film_w),
+        "lenslab:ImageHeightMM": float(film_h),
         "lenslab:FocusDistanceM": float(cam.focus_distance_m),
+        "lenslab:FocusFrom": cam.focus_from,
+        "lenslab:FocusBreathing": int(cam.focus_breathing),
+        "lenslab:PlaneOfFocusM": float(frame.focus_distance),
+        "lenslab:ImageDistanceMM": float(frame.image_distance_mm),
+        "lenslab:CircleOfConfusionMM": float(cam.coc_mm(frame.width, frame.height)),
         "lenslab:ApertureBlades": int(cam.aperture_blades),
+        "lenslab:BladeCurvature": float(cam.blade_curvature),
+        "lenslab:AnamorphicSqueeze": float(cam.anamorphic_squeeze),
+        "lenslab:BarrelClipping": float(cam.barrel_clipping),
+        "lenslab:ApertureLightFraction": float(light_fraction),
+        "lenslab:ExposureMode": cam.exposure_mode,
+        "lenslab:ExposureScale": float(cam.exposure_scale(light_fraction)),
         "lenslab:SamplesPerPixel": int(spp),
         "lenslab:Seed": int(scene.render.seed),
         "lenslab:MaxDepth": int(scene.render.max_depth),
         "lenslab:Sampler": scene.render.sampler,
         "lenslab:Clamp": float(scene.render.clamp),
+        "worldtocamera": world_to_camera(frame),
+        "worldtoNDC": world_to_ndc(frame),
     }
+    if cam.aperture_image:
+        metadata["lenslab:ApertureImage"] = cam.aperture_image
+    if cam.exposure_mode == "physical":
+        metadata.update({"ExposureTime": float(cam.shutter_s), "Exif:PhotographicSensitivity": int(round(cam.iso)),
+                         "lenslab:EV100": ev100(cam.f_number, cam.shutter_s, cam.iso)})
+    return metadata
+
+
+def world_to_camera(frame: CameraFrame) -> np.ndarray:
+    """OpenEXR's ``worldToCamera``: a 4 x 4 matrix for row vectors (p_camera = p_world M), to a left-handed camera
+    space with x right, y up and z the viewing direction."""
+    rotation = np.stack([frame.right, frame.up, frame.forward])  # rows: the camera's axes in the world
+    matrix = np.eye(4)
+    matrix[:3, :3] = rotation.T
+    matrix[3, :3] = -frame.position @ rotation.T
+    return matrix
+
+
+def world_to_ndc(frame: CameraFrame) -> np.ndarray:
+    """OpenEXR's ``worldToNDC``: world points to the image, (0, 0) its top-left corner and (1, 1) its bottom-right,
+    after division by w (row vectors). The pinhole projection through the lens centre; z / w is 1 / depth."""
+    tan_x, tan_y = frame.tan_half_fov
+    projection = np.array([[0.5 / tan_x, 0.0, 0.0, 0.0],
+                           [0.0, -0.5 / tan_y, 0.0, 0.0],
+                           [0.5, 0.5, 0.0, 1.0],
+                           [0.0, 0.0, 1.0, 0.0]])
+    return world_to_camera(frame) @ projection

@@ -90,7 +90,7 @@ class ThinLensCamera:
     @property
     def plane_of_focus_m(self) -> float:
         """Distance from the lens to the plane in focus, metres (what the renderer needs)."""
-        if self.focus_from == "lens":
+        if self.focus_from == "lens" or self.pinhole:  # a pinhole has everything sharp: no plane to work out
             return float(self.focus_distance_m)
         return object_distance_m(self.focal_length_mm, self.focus_distance_m)
 
@@ -105,7 +105,7 @@ class ThinLensCamera:
     @property
     def closest_focus_m(self) -> float:
         """The nearest focus distance this camera's lens can set, in its own reference (thin-lens limit)."""
-        if self.focus_from == "lens" and not self.focus_breathing:
+        if self.pinhole or (self.focus_from == "lens" and not self.focus_breathing):
             return FOCUS_DISTANCE_RANGE_M[0]
         return closest_focus_m(self.focal_length_mm, self.focus_from)
 
