@@ -332,3 +332,12 @@ def test_exported_files_carry_the_camera(renderer, tmp_path):
     assert meta["ExposureTime"] == pytest.approx(0.5) and meta["Exif:PhotographicSensitivity"] == 200
     assert meta["lenslab:SamplesPerPixel"] == "1" and meta["lenslab:Seed"] == str(scene.render.seed)
     assert meta["lenslab:ExposureMode"] == "physical"
+
+
+def test_every_shipped_lens_can_focus_as_close_as_it_is_marked():
+    """A lens's marked minimum focus (from the sensor) is within reach of a thin lens: four focal lengths."""
+    from lenslab.optics.lenses import load_lens_presets
+
+    for lens in load_lens_presets(include_user=False):
+        if lens.min_focus_distance_m is not None:
+            assert lens.min_focus_distance_m >= 4 * lens.max_focal_length_mm / 1000, lens.name
