@@ -43,7 +43,7 @@ def test_a_list_is_a_sweep_and_defaults_apply_to_every_shot(tmp_path):
     assert [s.name for s in shots] == ["bracket f/1.4", "bracket f/2", "bracket f/2.8", "single"]
     assert [s.output for s in shots] == [tmp_path / "out/c_f1.4.png", tmp_path / "out/c_f2.png",
                                          tmp_path / "out/c_f2.8.png", tmp_path / "out/single.exr"]
-    assert [s.overrides.f_number for s in shots] == [1.4, 2.0, 2.8, None]
+    assert [s.overrides.f_number for s in shots] == [2 ** 0.5, 2.0, 2 ** 1.5, None]  # marked stops, exact
     assert [s.overrides.spp for s in shots] == [16, 16, 16, 4]  # a shot's own value wins over the default
     assert all(s.overrides.width == 64 and s.scene == "cornell_box" for s in shots)
 

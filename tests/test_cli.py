@@ -31,7 +31,7 @@ def test_headless_exr_is_linear_float_with_camera_metadata(renderer, tmp_path, c
     pixels, meta = read_image(out)
     assert pixels.shape == (24, 32, 3) and pixels.dtype == np.float32
     assert pixels.max() > 1.0  # linear radiance: the light is brighter than display white
-    assert meta["FNumber"] == pytest.approx(2.8)
+    assert meta["FNumber"] == pytest.approx(2 ** 1.5)  # --f-stop 2.8: the exact stop
     assert meta["Exif:FocalLength"] == pytest.approx(35.0)
     assert meta["Exif:SubjectDistance"] == pytest.approx(1.5)
     assert meta["lenslab:SensorWidthMM"] == pytest.approx(36.0) and meta["lenslab:SensorHeightMM"] == pytest.approx(24.0)

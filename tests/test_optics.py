@@ -17,6 +17,9 @@ from lenslab.optics import dof, stops, thinlens
 from lenslab.optics.dof import circle_of_confusion_mm, depth_of_field, hyperfocal_distance_m
 from lenslab.optics.stops import (
     EXTENDED_THIRD_STOPS,
+    STOP_SCALES,
+    exact_f_number,
+    marked_f_number,
     THIRD_STOPS,
     format_f_number,
     nearest_stop,
@@ -329,22 +332,44 @@ def test_step_stop_on_a_custom_scale():
 
 
 @pytest.mark.parametrize(
-    "n,text", [(2.8, "f/2.8"), (2, "f/2"), (2.0, "f/2"), (22, "f/22"), (0.95, "f/0.95"), (5.657, "f/5.7"), (128, "f/128")]
+    "n,text", [(2.8, "f/2.8"), (2, "f/2"), (2.0, "f/2"), (22, "f/22"), (0.95, "f/0.95"), (5.657, "f/5.6"), (5.65, "f/5.7"), (128, "f/128")]
 )
 def test_format_f_number(n, text):
     assert format_f_number(n) == text
 
 
-@pytest.mark.parametrize("n", EXTENDED_THIRD_STOPS)
-def test_format_parse_round_trip(n):
-    assert parse_f_number(format_f_number(n)) == n
+@pytest.mark.parametrize("scale", ["full", "half", "third"])
+def test_a_mark_reads_as_its_exact_stop_and_shows_as_its_mark(scale):
+    stops = STOP_SCALES[scale]
+    assert len(stops.marks) == len(stops.exact)
+    for mark, exact in zip(stops.marks, stops.exact):
+        assert mark == pytest.approx(exact, rel=0.05)  # the conventional rounding, never further
+        assert parse_f_number(f"f/{mark:g}", scale) == exact
+        assert exact_f_number(mark, scale) == exact
+        assert marked_f_number(exact, scale) == mark
+        assert format_f_number(exact) == f"f/{mark:g}"
+
+
+@pytest.mark.parametrize("scale, fraction", [("full", 1.0), ("half", 0.5), ("third", 1 / 3)])
+def test_one_step_is_exactly_one_mark_of_the_scale(scale, fraction):
+    n = exact_f_number(2.8, scale)
+    for _ in range(6):
+        after = step_stop(n, 1, scale)
+        assert 2 * math.log2(after / n) == pytest.approx(fraction)  # stops of light
+        n = after
+
+
+def test_a_mark_two_scales_share_is_read_on_the_scale_given():
+    assert exact_f_number(13, "third") == pytest.approx(2 ** (11 / 3))  # 12.70
+    assert exact_f_number(13, "half") == pytest.approx(2 ** 3.75)  # 13.45
+    assert exact_f_number(5.65) == 5.65  # not a mark: as written
 
 
 @pytest.mark.parametrize(
     "text,n", [("f/2.8", 2.8), ("2.8", 2.8), ("F/4", 4), ("f2.8", 2.8), (" f / 11 ", 11), ("1:1.4", 1.4), ("2,8", 2.8), ("ƒ/8", 8), (".95", 0.95)]
 )
 def test_parse_f_number(text, n):
-    assert parse_f_number(text) == n
+    assert parse_f_number(text) == pytest.approx(exact_f_number(n))  # marks read as their exact stop
 
 
 @pytest.mark.parametrize("text", ["", "f/", "f/abc", "2.8.1", "f/-2", "nan", "inf", "f/2.8 mm", "1/2.8x"])

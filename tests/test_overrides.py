@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 
 from lenslab.scene.io.loader import open_scene
+from lenslab.optics.stops import exact_f_number
 from lenslab.scene.overrides import SceneOverrides
 from lenslab.validate.runner import scene_path
 
@@ -13,7 +14,7 @@ def test_only_the_given_settings_change_and_the_scene_itself_does_not():
     scene = open_scene("cornell_box")
     before = (scene.camera.f_number, scene.camera.focal_length_mm, scene.render.spp, scene.render.clamp)
     changed = SceneOverrides(f_number=1.4, focus_distance_m=2.5, spp=7, clamp=5.0, sampler="independent").apply(scene)
-    assert (changed.camera.f_number, changed.camera.focus_distance_m) == (1.4, 2.5)
+    assert (changed.camera.f_number, changed.camera.focus_distance_m) == (exact_f_number(1.4), 2.5)  # f/1.4 as typed is the exact stop
     assert (changed.render.spp, changed.render.clamp, changed.render.sampler) == (7, 5.0, "independent")
     assert changed.camera.focal_length_mm == scene.camera.focal_length_mm
     assert (scene.camera.f_number, scene.camera.focal_length_mm, scene.render.spp, scene.render.clamp) == before
@@ -44,7 +45,7 @@ def test_a_lens_mounts_its_focal_length_aperture_range_and_iris():
     scene = open_scene("cornell_box")
     scene.camera.f_number = 1.2
     mounted = SceneOverrides(lens="85 mm f/1.4").apply(scene).camera
-    assert (mounted.focal_length_mm, mounted.f_number, mounted.aperture_blades) == (85.0, 1.4, 11)  # f/1.2 clamped
+    assert (mounted.focal_length_mm, mounted.f_number, mounted.aperture_blades) == (85.0, exact_f_number(1.4), 11)  # f/1.2 clamped
     zoom = SceneOverrides(lens="70-200mm-f2.8", focal_length_mm=135, f_number=4).apply(scene).camera
     assert (zoom.focal_length_mm, zoom.f_number) == (135.0, 4.0)
     nearest = SceneOverrides(lens="70-200 mm f/2.8").apply(scene).camera

@@ -9,7 +9,7 @@ from lenslab.optics import presetfiles
 from lenslab.optics.lenses import LensPreset, load_lens_presets, read_lens_file
 from lenslab.optics.presetfiles import PresetError, shipped_presets_dir, user_presets_dir
 from lenslab.optics.sensors import FULL_FRAME, SensorPreset, load_sensor_presets
-from lenslab.optics.stops import THIRD_STOPS, step_stop
+from lenslab.optics.stops import THIRD_STOPS, exact_f_number, step_stop
 
 REPO = Path(__file__).resolve().parents[1]
 SHIPPED_LENS_FILES = sorted((REPO / "presets" / "lenses").glob("*.json"))
@@ -65,7 +65,8 @@ def test_shipped_lenses_are_the_promised_set():
     assert set(expected) <= set(lenses)
     for name, (short, long_, n) in expected.items():
         lens = lenses[name]
-        assert (lens.min_focal_length_mm, lens.max_focal_length_mm, lens.widest_f_number) == (short, long_, n)
+        assert (lens.min_focal_length_mm, lens.max_focal_length_mm, lens.widest_f_number) == (short, long_,
+                                                                                              exact_f_number(n))
         assert lens.is_zoom == (short != long_)
 
 
@@ -104,7 +105,8 @@ def test_sensor_properties():
 def test_prime_clamps():
     lens = LensPreset("50", focal_length_mm=50, widest_f_number=1.2, narrowest_f_number=16)
     assert lens.clamp_focal_length(24) == 50 and lens.clamp_focal_length(85) == 50
-    assert lens.clamp_f_number(0.95) == 1.2
+    # A lens's marks are its exact stops: f/1.2 opens to 2^(2/3), f/16 closes to 16.
+    assert lens.clamp_f_number(0.95) == exact_f_number(1.2) == pytest.approx(1.26, abs=0.001)
     assert lens.clamp_f_number(22) == 16
     assert lens.clamp_f_number(5.6) == 5.6
     assert not lens.is_zoom
@@ -115,16 +117,18 @@ def test_zoom_clamps():
     assert lens.clamp_focal_length(10) == 24
     assert lens.clamp_focal_length(35) == 35
     assert lens.clamp_focal_length(200) == 70
-    assert lens.clamp_f_number(1.4) == 2.8
-    assert lens.clamp_f_number(32) == 22  # narrowest defaults to f/22
+    assert lens.clamp_f_number(1.4) == exact_f_number(2.8)
+    assert lens.clamp_f_number(32) == exact_f_number(22)  # narrowest defaults to f/22
     assert lens.is_zoom
 
 
 def test_available_stops_include_the_lens_ends():
     fast = LensPreset("50", focal_length_mm=50, widest_f_number=1.2, narrowest_f_number=16)
-    stops = fast.available_stops()
-    assert stops[:3] == (1.2, 1.4, 1.6) and stops[-1] == 16
-    assert step_stop(1.4, -1, stops) == 1.2
+    stops = fast.available_stops()  # exact third stops
+    assert stops[:3] == pytest.approx((2 ** (2 / 6), 2 ** (3 / 6), 2 ** (4 / 6))) and stops[-1] == 16
+    assert step_stop(2 ** 0.5, -1, stops) == stops[0]
+    assert fast.available_stops("full") == pytest.approx((2 ** (1 / 3), 2 ** 0.5, 2, 2 ** 1.5, 4, 2 ** 2.5, 8,
+                                                          2 ** 3.5, 16))
     odd = LensPreset("odd", focal_length_mm=40, widest_f_number=1.7, narrowest_f_number=21)
     stops = odd.available_stops(THIRD_STOPS)
     assert stops[0] == 1.7 and stops[1] == 1.8 and stops[-2:] == (20, 21)

@@ -13,7 +13,7 @@ from dataclasses import KW_ONLY, dataclass, field
 from typing import Iterable, Sequence
 
 from .presetfiles import FieldError, PresetError, build_preset, merge_by_name, preset_dirs, read_json
-from .stops import EXTENDED_THIRD_STOPS, MAX_F_NUMBER, MIN_F_NUMBER, is_valid_f_number
+from .stops import MAX_F_NUMBER, MIN_F_NUMBER, Scale, exact_f_number, is_valid_f_number
 from .thinlens import FOCAL_LENGTH_RANGE_MM
 
 __all__ = ["LensPreset", "LENSES_DIR", "MAX_APERTURE_BLADES", "find_lens", "load_lens_presets"]
@@ -67,7 +67,8 @@ class LensPreset:
                 raise FieldError(
                     key, f"f-number must lie in [{MIN_F_NUMBER:g}, {MAX_F_NUMBER:g}], got {value!r}"
                 )
-            object.__setattr__(self, key, float(value))
+            # A lens's marks stand for exact stops: an f/1.4 lens opens to 2^0.5, and stops down to 2^4.5 at f/22.
+            object.__setattr__(self, key, exact_f_number(float(value)))
         if self.narrowest_f_number < self.widest_f_number:
             raise FieldError(
                 "narrowest_f_number",
@@ -144,14 +145,18 @@ class LensPreset:
             raise ValueError("f-number is NaN")
         return min(max(n, self.widest_f_number), self.narrowest_f_number)
 
-    def available_stops(self, scale: Sequence[float] = EXTENDED_THIRD_STOPS) -> tuple[float, ...]:
-        """The marks of ``scale`` this lens can set, plus its own end stops.
+    def available_stops(self, scale: Scale = "third") -> tuple[float, ...]:
+        """The stops of ``scale`` (a name from stops.STOP_SCALES: exact values; or a sequence of f-numbers) this
+        lens can set, plus its own end stops.
 
-        f/1.2 .. f/16 gives (1.2, 1.4, 1.6, ..., 16).  The lens's own widest
+        f/1.2 .. f/16 in thirds gives the exact (1.26, 1.41, 1.59, ..., 16).  The lens's own widest
         and narrowest f-numbers are always included, even when they are not
         marks (an f/1.8 lens on a full-stop scale starts at 1.8).  Pass the result as ``scale`` to
         ``stops.step_stop`` to step within the lens.
         """
+        from .stops import _scale_values
+
+        scale = _scale_values(scale)
         rel = 1e-3  # same tolerance as stops.py: 5.6 and 5.600001 are one mark
         inside = [
             float(s) for s in scale
@@ -169,7 +174,8 @@ class LensPreset:
         return {"focal_length_mm": self.clamp_focal_length(focal_length_mm),
                 "f_number": self.clamp_f_number(f_number),
                 "aperture_blades": self.aperture_blades,
-                "blade_rotation_deg": self.blade_rotation_deg}
+                "blade_rotation_deg": self.blade_rotation_deg,
+                "blade_curvature": self.blade_roundness}
 
 
 _KINDS = {

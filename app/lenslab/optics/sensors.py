@@ -22,6 +22,7 @@ __all__ = [
     "crop_factor",
     "DEFAULT_SENSOR_NAME",
     "SENSORS_FILE",
+    "find_sensor",
     "load_sensor_presets",
 ]
 
@@ -50,6 +51,8 @@ class SensorPreset:
     width_mm: float
     height_mm: float
     description: str = field(default="", compare=False)
+    #: This format's own circle of confusion, mm (a cinema or a print standard); None: the diagonal / 1500.
+    circle_of_confusion_mm: float | None = None
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name.strip():
@@ -60,6 +63,11 @@ class SensorPreset:
             if not (low <= value <= high):
                 raise FieldError(key, f"must lie in [{low:g}, {high:g}] mm, got {value:g}")
             object.__setattr__(self, key, value)  # store ints from JSON as floats
+        coc = self.circle_of_confusion_mm
+        if coc is not None:
+            if isinstance(coc, bool) or not (0.0005 <= float(coc) <= 1.0):
+                raise FieldError("circle_of_confusion_mm", f"must lie in [0.0005, 1] mm, got {coc!r}")
+            object.__setattr__(self, "circle_of_confusion_mm", float(coc))
 
     @property
     def diagonal_mm(self) -> float:
@@ -77,7 +85,9 @@ class SensorPreset:
 
     @property
     def coc_mm(self) -> float:
-        """Acceptable circle of confusion, diagonal / 1500 (see ``dof``)."""
+        """Acceptable circle of confusion: the format's own, or its diagonal / 1500 (see ``dof``)."""
+        if self.circle_of_confusion_mm is not None:
+            return self.circle_of_confusion_mm
         return circle_of_confusion_mm(self.width_mm, self.height_mm)
 
 
@@ -87,7 +97,8 @@ DEFAULT_SENSOR_NAME = "Full frame"
 #: The default sensor, available without reading any file.
 FULL_FRAME = SensorPreset(DEFAULT_SENSOR_NAME, 36.0, 24.0, "35 mm still format")
 
-_KINDS = {"name": "string", "width_mm": "number", "height_mm": "number", "description": "string"}
+_KINDS = {"name": "string", "width_mm": "number", "height_mm": "number", "description": "string",
+          "circle_of_confusion_mm": "number or null"}
 
 
 def _read_sensors_file(path) -> list[SensorPreset]:
@@ -129,3 +140,17 @@ def load_sensor_presets(
         if path.exists():
             groups.append(_read_sensors_file(path))
     return merge_by_name(groups)
+
+
+def find_sensor(name: str, sensors: Iterable[SensorPreset] | None = None) -> SensorPreset:
+    """The sensor preset called ``name`` (case, spaces and dashes do not matter: "aps-c", "Full Frame"). A
+    ValueError listing the sensors there are when none is called that."""
+    sensors = list(load_sensor_presets() if sensors is None else sensors)
+
+    def key(text: str) -> str:
+        return "".join(ch for ch in text.lower() if ch.isalnum() or ch in "./()")
+
+    for sensor in sensors:
+        if key(sensor.name) == key(name):
+            return sensor
+    raise ValueError(f"no sensor preset called '{name}' (there are: {', '.join(s.name for s in sensors)})")

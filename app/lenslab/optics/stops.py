@@ -1,10 +1,14 @@
 """Aperture stops: the marked f-number scale, snapping and stepping along it, text in and out.
 
 An f-number ``N`` is focal length over entrance-pupil diameter; each *stop*
-halves the light, i.e. multiplies ``N`` by ``sqrt(2)``, and a third stop by
-``2 ** (1/6)``.  Lenses and cameras mark the rounded values in
-:data:`THIRD_STOPS` (5.6 rather than 5.657, 11 rather than 11.31); distances
-along the scale are therefore measured in stops (``log2 N^2``), not in N.
+halves the light, i.e. multiplies ``N`` by ``sqrt(2)``, a half stop by ``2 ** (1/4)`` and a third stop by
+``2 ** (1/6)``.  Lenses and cameras *mark* rounded values (5.6 rather than 5.657, 11 rather than 11.31),
+but an iris is calibrated to the exact ones: that is what makes each mark the same step of light. So
+LensLab shows marks and renders exact values. Three scales (:data:`STOP_SCALES`): full, half and third
+stops, each with its marks and the exact ``2 ** (k / 2)``, ``2 ** (k / 4)``, ``2 ** (k / 6)`` beside them.
+Text a user types ("f/11", "11") means the marked stop's exact value (:func:`parse_f_number`); a number
+read from a scene file is taken as written. Distances along a scale are measured in stops
+(``log2 N^2``), not in N.
 """
 
 from __future__ import annotations
@@ -12,9 +16,15 @@ from __future__ import annotations
 import bisect
 import math
 import re
-from typing import Sequence
+from dataclasses import dataclass
+from typing import Sequence, Union
 
 __all__ = [
+    "DEFAULT_STOP_SCALE",
+    "STOP_SCALES",
+    "StopScale",
+    "exact_f_number",
+    "marked_f_number",
     "THIRD_STOPS",
     "EXTENDED_THIRD_STOPS",
     "MIN_F_NUMBER",
@@ -43,6 +53,70 @@ EXTENDED_THIRD_STOPS: tuple[float, ...] = (
     + THIRD_STOPS
     + (25, 29, 32, 36, 40, 45, 51, 57, 64, 72, 81, 90, 102, 114, 128)
 )
+
+#: Full stops as marked, f/0.7 to f/128 (exact: 2 ** (k / 2)).
+FULL_STOPS: tuple[float, ...] = (0.7, 1, 1.4, 2, 2.8, 4, 5.6, 8, 11, 16, 22, 32, 45, 64, 90, 128)
+#: Half stops as marked, f/0.7 to f/128 (exact: 2 ** (k / 4)): 1.7 for 1.68, 9.5 for 9.51, 13 for 13.45.
+HALF_STOPS: tuple[float, ...] = (0.7, 0.8, 1, 1.2, 1.4, 1.7, 2, 2.4, 2.8, 3.3, 4, 4.8, 5.6, 6.7, 8, 9.5, 11, 13,
+                                 16, 19, 22, 27, 32, 38, 45, 54, 64, 76, 90, 108, 128)
+
+
+@dataclass(frozen=True)
+class StopScale:
+    """A scale of apertures: ``marks`` as printed on lenses, ``exact`` the f-numbers they stand for,
+    ``2 ** (k / (2 * steps_per_stop))`` from f/1 (k = 0)."""
+
+    name: str
+    steps_per_stop: int
+    marks: tuple[float, ...]
+
+    @property
+    def exact(self) -> tuple[float, ...]:
+        first = -self.marks.index(1)  # the mark f/1 is k = 0
+        return tuple(2.0 ** ((first + i) / (2 * self.steps_per_stop)) for i in range(len(self.marks)))
+
+
+#: The scales a camera steps its aperture along, by name.
+STOP_SCALES: dict[str, StopScale] = {
+    "full": StopScale("full", 1, FULL_STOPS),
+    "half": StopScale("half", 2, HALF_STOPS),
+    "third": StopScale("third", 3, EXTENDED_THIRD_STOPS),
+}
+DEFAULT_STOP_SCALE = "third"
+
+#: What functions taking a scale accept: a scale's name, a StopScale (its exact values), or the f-numbers
+#: themselves, ascending.
+Scale = Union[str, StopScale, Sequence[float]]
+
+
+def _scale_values(scale: Scale) -> Sequence[float]:
+    if isinstance(scale, str):
+        if scale not in STOP_SCALES:
+            raise ValueError(f"unknown stop scale '{scale}' (choose from {', '.join(STOP_SCALES)})")
+        scale = STOP_SCALES[scale]
+    return scale.exact if isinstance(scale, StopScale) else scale
+
+
+def exact_f_number(n: float, scale: str = DEFAULT_STOP_SCALE) -> float:
+    """The exact f-number of a marked stop of ``scale`` (11 -> 11.3137 on the third-stop scale, 13 -> 12.70 on
+    thirds but 13.45 on halves); any other number as it is."""
+    stops = STOP_SCALES[scale]
+    for mark, exact in zip(stops.marks, stops.exact):
+        if math.isclose(n, mark, rel_tol=_SAME_STOP_REL_TOL):
+            return exact
+    return float(n)
+
+
+def marked_f_number(n: float, scale: str | None = None) -> float:
+    """The mark a lens prints for an exact stop (11.3137 -> 11); any other number as it is. Without ``scale``,
+    the third-stop marks are tried, then the half-stop ones."""
+    for name in ((scale,) if scale else ("third", "half")):
+        stops = STOP_SCALES[name]
+        for mark, exact in zip(stops.marks, stops.exact):
+            if math.isclose(n, exact, rel_tol=_SAME_STOP_REL_TOL):
+                return mark
+    return float(n)
+
 
 #: Valid f-numbers lie in [MIN_F_NUMBER, MAX_F_NUMBER], the one range every
 #: part of LensLab accepts (scene files, the command line, the studio, lens
@@ -82,14 +156,14 @@ def stops_between(n1: float, n2: float) -> float:
     return 2.0 * math.log2(_checked(n2) / _checked(n1))
 
 
-def nearest_stop(n: float, scale: Sequence[float] = THIRD_STOPS) -> float:
+def nearest_stop(n: float, scale: Scale = THIRD_STOPS) -> float:
     """The value on ``scale`` closest to ``n`` in stops (log scale).
 
     Values outside the scale snap to its end.  ``scale`` must be ascending;
     pass ``lens.available_stops()`` to snap within what a lens can do.
     """
     n = _checked(n)
-    return min(scale, key=lambda stop: abs(math.log(stop / n)))
+    return min(_scale_values(scale), key=lambda stop: abs(math.log(stop / n)))
 
 
 def _index_on_scale(n: float, scale: Sequence[float]) -> int | None:
@@ -99,7 +173,7 @@ def _index_on_scale(n: float, scale: Sequence[float]) -> int | None:
     return None
 
 
-def step_stop(n: float, steps: int, scale: Sequence[float] = THIRD_STOPS) -> float:
+def step_stop(n: float, steps: int, scale: Scale = THIRD_STOPS) -> float:
     """Move ``steps`` marks along ``scale`` from ``n`` (positive = smaller aperture).
 
     From a value on the scale, one step is one mark.  From a value between
@@ -111,6 +185,7 @@ def step_stop(n: float, steps: int, scale: Sequence[float] = THIRD_STOPS) -> flo
     """
     n = _checked(n)
     steps = int(steps)
+    scale = _scale_values(scale)
     if steps == 0:
         return nearest_stop(n, scale)
     last = len(scale) - 1
@@ -134,9 +209,10 @@ def step_stop(n: float, steps: int, scale: Sequence[float] = THIRD_STOPS) -> flo
 def format_f_number(n: float) -> str:
     """Text as photographers write it: ``"f/2.8"``, ``"f/2"``, ``"f/0.95"``, ``"f/22"``.
 
-    One decimal (two below f/1, where 0.95 vs 0.9 matters), trailing zeros dropped.
+    An exact stop shows its mark (``"f/11"`` for 11.31). Otherwise one decimal (two below f/1, where 0.95
+    vs 0.9 matters), trailing zeros dropped.
     """
-    n = _checked(n)
+    n = marked_f_number(_checked(n))
     text = f"{n:.2f}" if n < 1.0 else f"{n:.1f}"
     return "f/" + text.rstrip("0").rstrip(".")
 
@@ -147,8 +223,9 @@ _F_NUMBER_RE = re.compile(
 )
 
 
-def parse_f_number(text: str) -> float:
-    """Parse ``"f/2.8"``, ``"2.8"``, ``"F2.8"``, ``"1:2.8"`` (and ``"2,8"``) to ``2.8``.
+def parse_f_number(text: str, scale: str = DEFAULT_STOP_SCALE) -> float:
+    """Parse ``"f/2.8"``, ``"2.8"``, ``"F2.8"``, ``"1:2.8"`` (and ``"2,8"``): a marked stop of ``scale`` gives
+    its exact value (2.8 -> 2.8284), any other number itself.
 
     Raises ValueError naming the text when it is not an f-number or is
     outside [0.5, 128].
@@ -161,4 +238,4 @@ def parse_f_number(text: str) -> float:
         raise ValueError(
             f"f-number out of range [{MIN_F_NUMBER:g}, {MAX_F_NUMBER:g}]: {text!r}"
         )
-    return n
+    return exact_f_number(n, scale)

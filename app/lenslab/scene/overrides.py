@@ -9,16 +9,22 @@ from __future__ import annotations
 
 import dataclasses
 import os
+from pathlib import Path
 from dataclasses import dataclass, field
 from typing import Callable
 
 from lenslab.optics.lenses import find_lens
+from lenslab.optics.sensors import find_sensor
+from lenslab.optics.thinlens import format_distance
+from lenslab.optics.stops import exact_f_number, format_f_number
 from lenslab.scene.camera import MAX_IMAGE_SIDE, ThinLensCamera
 from lenslab.scene.fields import declared_choices, declared_range
 from lenslab.scene.scene import RenderSettings, Scene
 
 # The overrides named as the camera's and the render settings' fields they set.
-_CAMERA_FIELDS = ("f_number", "focal_length_mm", "focus_distance_m")
+_CAMERA_FIELDS = ("f_number", "focal_length_mm", "focus_distance_m", "focus_from", "focus_breathing", "sensor_fit",
+                  "circle_of_confusion_mm", "aperture_blades", "blade_curvature", "anamorphic_squeeze",
+                  "barrel_clipping", "aperture_image", "exposure_mode", "iso", "shutter_s")
 _RENDER_FIELDS = ("spp", "seed", "max_depth", "sampler", "clamp")
 
 
@@ -35,11 +41,42 @@ class SceneOverrides:
     sampler: str | None = None
     clamp: float | None = None
     lens: str | None = None  # a lens preset's name: its focal length (a zoom's nearest), aperture range and iris
+    sensor: str | None = None  # a sensor preset's name: its size and, if it has one, its circle of confusion
+    focus_from: str | None = None
+    focus_breathing: bool | None = None
+    sensor_fit: str | None = None
+    circle_of_confusion_mm: float | None = None
+    aperture_blades: int | None = None
+    blade_curvature: float | None = None
+    anamorphic_squeeze: float | None = None
+    barrel_clipping: float | None = None
+    aperture_image: str | None = None  # absolute, or relative to the working folder (made absolute here)
+    exposure_mode: str | None = None  # given ISO or shutter alone, the physical mode
+    iso: float | None = None
+    shutter_s: float | None = None
     defines: dict[str, str] = field(default_factory=dict)  # Mitsuba XML parameters ($name), as mitsuba -D
 
     def __post_init__(self):
         for name in _CAMERA_FIELDS:
-            _check_range(name, getattr(self, name), declared_range(ThinLensCamera, name))
+            value = getattr(self, name)
+            if value is None or isinstance(value, bool):
+                continue
+            if isinstance(value, str):
+                choices = _declared_choices_or_none(ThinLensCamera, name)
+                if choices is not None and value not in choices:
+                    raise ValueError(f"{name} '{value}' is not one of {', '.join(choices)}")
+            else:
+                _check_range(name, value, declared_range(ThinLensCamera, name))
+        if self.aperture_blades in (1, 2):
+            raise ValueError("aperture_blades must be 0 (round) or at least 3")
+        if self.f_number is not None:  # a marked stop as typed means its exact value (f/11 is 11.31)
+            object.__setattr__(self, "f_number", exact_f_number(self.f_number))
+        if self.aperture_image:
+            object.__setattr__(self, "aperture_image", str(Path(self.aperture_image).expanduser().resolve()))
+        if self.exposure_mode is None and (self.iso is not None or self.shutter_s is not None):
+            object.__setattr__(self, "exposure_mode", "physical")
+        if self.sensor is not None:
+            find_sensor(self.sensor)
         for name in ("width", "height"):
             _check_range(name, getattr(self, name), (1, MAX_IMAGE_SIDE))
         for name in _RENDER_FIELDS:
@@ -61,8 +98,8 @@ class SceneOverrides:
             raise ValueError(f"focal_length {self.focal_length_mm:g} mm is not on the lens '{lens.name}' "
                              f"({lens.min_focal_length_mm:g}-{lens.max_focal_length_mm:g} mm)")
         if self.f_number is not None and lens.clamp_f_number(self.f_number) != self.f_number:
-            raise ValueError(f"f/{self.f_number:g} is not on the lens '{lens.name}' "
-                             f"(f/{lens.widest_f_number:g} to f/{lens.narrowest_f_number:g})")
+            raise ValueError(f"{format_f_number(self.f_number)} is not on the lens '{lens.name}' "
+                             f"({format_f_number(lens.widest_f_number)} to {format_f_number(lens.narrowest_f_number)})")
 
     def open(self, scene_ref: str | os.PathLike, warn: Callable[[str], None] | None = None) -> Scene:
         """Load a scene file (native or Mitsuba XML, with this object's defines) and apply the overrides."""
@@ -73,6 +110,10 @@ class SceneOverrides:
     def apply(self, scene: Scene) -> Scene:
         """A copy of ``scene`` with the overrides set; fields left at None keep the scene's value."""
         camera_changes = {name: getattr(self, name) for name in _CAMERA_FIELDS if getattr(self, name) is not None}
+        if self.sensor is not None:
+            sensor = find_sensor(self.sensor)
+            camera_changes = {"sensor_mm": (sensor.width_mm, sensor.height_mm),
+                              "circle_of_confusion_mm": sensor.circle_of_confusion_mm, **camera_changes}
         if self.lens is not None:  # mounted first: the focal length and f-number given with it are on the lens
             camera = scene.camera
             mounted = find_lens(self.lens).mount(camera_changes.get("focal_length_mm", camera.focal_length_mm),
@@ -81,8 +122,11 @@ class SceneOverrides:
         if self.width is not None or self.height is not None:
             camera_changes["resolution"] = self._resolution(scene.camera.resolution)
         render_changes = {name: getattr(self, name) for name in _RENDER_FIELDS if getattr(self, name) is not None}
-        return dataclasses.replace(scene, camera=dataclasses.replace(scene.camera, **camera_changes),
-                                   render=dataclasses.replace(scene.render, **render_changes))
+        camera = dataclasses.replace(scene.camera, **camera_changes)
+        if self.lens is not None:
+            _check_minimum_focus(camera, find_lens(self.lens))
+        camera.validate()  # nothing nearer than the thin lens can focus, whatever the lens
+        return dataclasses.replace(scene, camera=camera, render=dataclasses.replace(scene.render, **render_changes))
 
     def _resolution(self, scene_resolution: tuple[int, int]) -> tuple[int, int]:
         width, height = scene_resolution
@@ -91,6 +135,23 @@ class SceneOverrides:
         if self.height is not None and self.width is None:
             return min(MAX_IMAGE_SIDE, max(1, round(self.height * width / height))), self.height
         return self.width, self.height
+
+
+def _check_minimum_focus(camera: ThinLensCamera, lens) -> None:
+    """A lens focuses no nearer than its marked minimum, which is measured from the sensor plane."""
+    if lens.min_focus_distance_m is None:
+        return
+    from_sensor = camera.plane_of_focus_m + camera.image_distance_mm / 1000
+    if from_sensor < lens.min_focus_distance_m * (1 - 1e-9):
+        raise ValueError(f"focus {format_distance(from_sensor)} from the sensor is nearer than the lens "
+                         f"'{lens.name}' focuses (minimum {format_distance(lens.min_focus_distance_m)})")
+
+
+def _declared_choices_or_none(cls: type, name: str):
+    try:
+        return declared_choices(cls, name)
+    except KeyError:
+        return None
 
 
 def _check_range(name: str, value, bounds: tuple) -> None:
