@@ -10,6 +10,7 @@ import pytest
 
 from lenslab.batch.parts import PART_INDEX_STRIDE, sample_range
 from lenslab.batch.spec import BatchError, parse_batch, read_batch
+from lenslab.scene.io.loader import open_scene
 
 
 def batch(tmp_path: Path, text: str, name: str = "shots.toml"):
@@ -157,3 +158,40 @@ def test_the_documented_batch_files_read(tmp_path):
     block = text.split("```toml\n", 1)[1].split("```", 1)[0]  # docs/batch.md's annotated example
     names = [shot.name for shot in batch(tmp_path, block).shots]
     assert len(names) == 6 + 8 + 4 and names[0] == "aperture bracket f/1.4" and names[-1] == "lenses 135 mm f/2"
+
+
+def test_a_shutter_bracket_and_the_camera_controls_of_a_shot(tmp_path):
+    shots = batch(tmp_path, """
+        [[shots]]
+        name = "bracket"
+        scene = "cornell_box"
+        output = "b_{index}.exr"
+        shutter = ["1/250", "1/125", 0.5]
+        iso = 400
+        sensor = "aps-c"
+        blades = 7
+        blade_curvature = 0.4
+        anamorphic = 1.5
+        """).shots
+    assert [s.overrides.shutter_s for s in shots] == pytest.approx([1 / 250, 1 / 125, 0.5])
+    assert [s.name for s in shots] == ["bracket 1/250 s", "bracket 1/125 s", "bracket 0.5 s"]
+    overrides = shots[0].overrides
+    assert overrides.exposure_mode == "physical" and overrides.iso == 400 and overrides.sensor == "aps-c"
+    assert (overrides.aperture_blades, overrides.blade_curvature, overrides.anamorphic_squeeze) == (7, 0.4, 1.5)
+    camera = overrides.apply(open_scene("cornell_box")).camera
+    assert camera.sensor_mm == (23.5, 15.6) and camera.exposure_mode == "physical"
+
+
+@pytest.mark.parametrize("entry, message", [
+    ('shutter = "forever"', "shutter: not a shutter time: 'forever'"),
+    ("blades = 2", "aperture_blades must be 0 (round) or at least 3"),
+    ("anamorphic = 9.0", "anamorphic_squeeze 9.0 is out of range [0.25, 4]"),
+    ('sensor = "super 8"', "no sensor preset called 'super 8'"),
+])
+def test_bad_camera_controls_in_a_batch_name_the_shot(tmp_path, entry, message):
+    assert message in error(tmp_path, f"""
+        [[shots]]
+        scene = "cornell_box"
+        output = "a.png"
+        {entry}
+        """)

@@ -83,7 +83,7 @@ def test_a_time_limit_shorter_than_one_pass_still_samples_every_pixel(renderer, 
 @pytest.mark.parametrize(
     "argv, message",
     [
-        (["cornell_box", "--headless", "-o", "x.png", "--f-stop", "0"], r"argument --f-stop: 0 is out of range \[0\.5, 128\]"),
+        (["cornell_box", "--headless", "-o", "x.png", "--f-stop", "0"], r"argument --f-stop: f-number out of range \[0\.5, 128\]: .0."),
         (["cornell_box", "--headless", "-o", "x.png", "--spp", "many"], r"--spp: expected a whole number, not 'many'"),
         (["cornell_box", "--headless", "-o", "x.png", "--spp", "-1"], r"--spp: -1 is out of range \[1, 16777216\]"),
         (["cornell_box", "--headless", "-o", "x.png", "--focus-distance", "-2"], r"--focus-distance: -2 is out of range"),
@@ -280,3 +280,69 @@ def test_a_missing_texture_is_one_warning_and_the_render_goes_on(tmp_path, capsy
     lines = [line for line in err.splitlines() if "nosuch.png" in line]
     assert lines == [f"lenslab: warning: {tmp_path / 'nosuch.png'}: texture file not found; "
                      "showing a magenta checkerboard instead"]
+
+
+# -- the camera's own language (issue 13) -------------------------------------------------------------------
+def test_every_camera_flag_reaches_the_rendered_camera(renderer, tmp_path, capsys):
+    out = tmp_path / "shot.exr"
+    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", out, *SMALL, "--sensor", "aps-c",
+                             "--sensor-fit", "fill", "--blades", "6", "--blade-curvature", "0.5", "--anamorphic",
+                             "1.5", "--barrel-clipping", "0.3", "--coc", "0.02", "--iso", "800", "--shutter",
+                             "1/30", "--f-stop", "f/4", "--focus-from", "lens", "--no-focus-breathing")
+    assert status == 0, err
+    _, meta = read_image(out)
+    assert (meta["lenslab:SensorWidthMM"], meta["lenslab:SensorHeightMM"]) == pytest.approx((23.5, 15.6))
+    assert meta["lenslab:SensorFit"] == "fill" and meta["lenslab:ImageHeightMM"] == pytest.approx(15.6)
+    assert meta["lenslab:ApertureBlades"] == 6 and meta["lenslab:BladeCurvature"] == pytest.approx(0.5)
+    assert meta["lenslab:AnamorphicSqueeze"] == pytest.approx(1.5)
+    assert meta["lenslab:BarrelClipping"] == pytest.approx(0.3)
+    assert meta["lenslab:CircleOfConfusionMM"] == pytest.approx(0.02)
+    assert meta["lenslab:ExposureMode"] == "physical"  # --iso and --shutter imply it
+    assert meta["ExposureTime"] == pytest.approx(1 / 30) and meta["Exif:PhotographicSensitivity"] == 800
+    assert meta["FNumber"] == pytest.approx(4.0)
+    assert meta["lenslab:FocusFrom"] == "lens" and meta["lenslab:FocusBreathing"] == 0
+    assert meta["lenslab:PlaneOfFocusM"] == pytest.approx(meta["lenslab:FocusDistanceM"])
+
+
+def test_a_lens_mounts_and_focus_nearer_than_it_can_is_refused(renderer, tmp_path, capsys):
+    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "a.png", *SMALL,
+                             "--lens", "85mm f/1.4", "--focus-distance", "0.5")
+    assert status == 1
+    assert err == ("lenslab: error: focus 50.0 cm from the sensor is nearer than the lens '85 mm f/1.4' focuses "
+                   "(minimum 80.0 cm)\n")
+    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "b.exr", *SMALL,
+                             "--lens", "85mm f/1.4")
+    assert status == 0, err
+    _, meta = read_image(tmp_path / "b.exr")
+    assert meta["Exif:FocalLength"] == 85.0 and meta["lenslab:ApertureBlades"] == 11
+    assert meta["lenslab:BladeCurvature"] == pytest.approx(0.8)  # the preset's blade roundness
+    # No lens at all: nothing nearer than four focal lengths from the sensor.
+    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "c.png", *SMALL,
+                             "--focal-length", "200", "--focus-distance", "0.5")
+    assert status == 1 and "nearer than a 200 mm lens can focus: at least 80.0 cm" in err and err.count("\n") == 1
+
+
+@pytest.mark.parametrize("flag, value, message", [
+    ("--blades", "2", "a stop has 0 blades (round) or at least 3"),
+    ("--blade-curvature", "1.5", "out of range [0, 1]"),
+    ("--anamorphic", "9", "out of range [0.25, 4]"),
+    ("--shutter", "fast", "not a shutter time: 'fast'"),
+    ("--iso", "-3", "out of range"),
+    ("--sensor-fit", "stretch", "invalid choice: 'stretch'"),
+    ("--f-stop", "f/0.2", "f-number out of range"),
+])
+def test_nonsense_camera_values_are_one_usage_line(capsys, flag, value, message):
+    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", "x.png", flag, value)
+    assert status == 2 and message in err and err.count("\n") == 1 and flag in err
+
+
+def test_an_unknown_sensor_names_the_ones_there_are(capsys, tmp_path):
+    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.png", "--sensor", "super 8")
+    assert status == 1 and "no sensor preset called 'super 8' (there are: " in err and "APS-C" in err
+
+
+def test_the_presets_are_listed(capsys):
+    status, out, _ = run_cli(capsys, "--list-lenses")
+    assert status == 0 and "85 mm f/1.4" in out and "f/1.4 to f/16" in out and "80.0 cm" in out
+    status, out, _ = run_cli(capsys, "--list-sensors")
+    assert status == 0 and "APS-C" in out and "23.5 x 15.6 mm" in out and "1.53x" in out and "29 µm" in out

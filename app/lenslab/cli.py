@@ -60,6 +60,34 @@ def _declared(kind, cls, field_name: str):
     return number_argument(kind, *declared_range(cls, field_name))
 
 
+def _f_number_argument(text: str) -> float:
+    """An f-number as a photographer writes it ("2.8", "f/2.8"): a marked stop is its exact value."""
+    from lenslab.optics.stops import parse_f_number
+
+    try:
+        return parse_f_number(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def _shutter_argument(text: str) -> float:
+    from lenslab.optics.exposure import parse_shutter
+
+    try:
+        return parse_shutter(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def _blades_argument(text: str) -> int:
+    from lenslab.optics.lenses import MAX_APERTURE_BLADES
+
+    blades = number_argument(int, 0, MAX_APERTURE_BLADES)(text)
+    if blades in (1, 2):
+        raise argparse.ArgumentTypeError(f"{text}: a stop has 0 blades (round) or at least 3")
+    return blades
+
+
 def build_parser() -> argparse.ArgumentParser:
     from lenslab.scene.camera import MAX_IMAGE_SIDE, ThinLensCamera
     from lenslab.scene.io.loader import shipped_scene_names
@@ -72,8 +100,11 @@ def build_parser() -> argparse.ArgumentParser:
         epilog="Examples:\n"
         "  lenslab cornell_box --headless -o cornell.png --spp 64\n"
         "  lenslab my_scene.json --headless -o shot.exr --f-stop 1.4 --focus-distance 2.5 --time-limit 60\n"
-        "Focal length, f-number and focus distance override the scene's camera for this render only; "
-        "brightness does not change with the f-number. Shipped scenes: " + ", ".join(shipped_scene_names()) + ".\n"
+        "  lenslab product_shot --headless -o p.exr --lens '85mm f/1.4' --f-stop 2 --iso 400 --shutter 1/60\n"
+        "The camera settings override the scene's camera for this render only. A marked stop (--f-stop 11) is the "
+        "exact stop (2^3.5); focus is measured from the sensor plane unless the scene says otherwise. In the "
+        "default compensated exposure brightness does not change with the f-number; with --iso or --shutter "
+        "each stop is a stop of light. Lenses and sensors: --list-lenses, --list-sensors. Shipped scenes: " + ", ".join(shipped_scene_names()) + ".\n"
         "Render many shots (brackets, focus stacks, a farm): lenslab batch --help.\n"
         "Compare with Mitsuba 3: lenslab validate --help.\n",
         formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -87,12 +118,41 @@ def build_parser() -> argparse.ArgumentParser:
                    help="stop after this long, keeping what has been rendered (at least one sample in every pixel)")
     p.add_argument("--width", type=number_argument(int, 1, MAX_IMAGE_SIDE), metavar="W", help="image width in pixels")
     p.add_argument("--height", type=number_argument(int, 1, MAX_IMAGE_SIDE), metavar="H", help="image height in pixels")
-    p.add_argument("--f-stop", type=_declared(float, ThinLensCamera, "f_number"), metavar="N",
-                   help="aperture as an f-number (1.4 is wide open and blurry, 16 is deep focus)")
+    p.add_argument("--f-stop", type=_f_number_argument, metavar="N",
+                   help="aperture as an f-number, e.g. 2.8 or f/2.8 (1.4 is wide open and blurry, 16 is deep focus)")
     p.add_argument("--focal-length", type=_declared(float, ThinLensCamera, "focal_length_mm"), metavar="MM",
                    help="lens focal length in millimetres (sets the field of view with the sensor width)")
     p.add_argument("--focus-distance", type=_declared(float, ThinLensCamera, "focus_distance_m"), metavar="M",
                    help="distance to the plane of focus, in metres")
+    camera = p.add_argument_group("camera and lens")
+    camera.add_argument("--lens", metavar="NAME", help="mount a lens preset: its focal lengths, stops, iris and "
+                        "minimum focus (see --list-lenses)")
+    camera.add_argument("--sensor", metavar="NAME", help="a sensor preset: its size and circle of confusion "
+                        "(see --list-sensors)")
+    camera.add_argument("--sensor-fit", choices=declared_choices(ThinLensCamera, "sensor_fit"),
+                        help="which part of the sensor the image shows (auto: the long sides together)")
+    camera.add_argument("--focus-from", choices=declared_choices(ThinLensCamera, "focus_from"),
+                        help="what --focus-distance is measured from (default: the scene's; new scenes: sensor)")
+    camera.add_argument("--no-focus-breathing", dest="focus_breathing", action="store_const", const=False,
+                        help="hold the framing: the sensor one focal length behind the lens at every focus")
+    camera.add_argument("--coc", type=_declared(float, ThinLensCamera, "circle_of_confusion_mm"), metavar="MM",
+                        help="circle of confusion for the depth-of-field readout and metadata")
+    camera.add_argument("--blades", type=_blades_argument, metavar="N", help="aperture blades: 0 round, or 3 to 32")
+    camera.add_argument("--blade-curvature", type=_declared(float, ThinLensCamera, "blade_curvature"), metavar="C",
+                        help="0 straight blades (polygonal bokeh) to 1 round")
+    camera.add_argument("--anamorphic", type=_declared(float, ThinLensCamera, "anamorphic_squeeze"),
+                        metavar="SQUEEZE", help="anamorphic squeeze: bokeh height over width (e.g. 1.33, 2)")
+    camera.add_argument("--barrel-clipping", type=_declared(float, ThinLensCamera, "barrel_clipping"), metavar="C",
+                        help="cat's-eye bokeh toward the frame's corners, 0 to 1")
+    camera.add_argument("--aperture-image", metavar="FILE", help="a grayscale image of the stop (custom bokeh)")
+    camera.add_argument("--exposure-mode", choices=declared_choices(ThinLensCamera, "exposure_mode"),
+                        help="compensated (brightness kept) or physical (each stop a stop of light)")
+    camera.add_argument("--iso", type=_declared(float, ThinLensCamera, "iso"), metavar="S",
+                        help="sensor speed; implies --exposure-mode physical")
+    camera.add_argument("--shutter", type=_shutter_argument, metavar="T",
+                        help="exposure time, e.g. 1/125 or 2s; implies --exposure-mode physical")
+    camera.add_argument("--list-lenses", action="store_true", help="print the lens presets and exit")
+    camera.add_argument("--list-sensors", action="store_true", help="print the sensor presets and exit")
     p.add_argument("--seed", type=_declared(int, RenderSettings, "seed"), metavar="S",
                    help="random seed: the same seed gives the same image")
     p.add_argument("--max-depth", type=_declared(int, RenderSettings, "max_depth"), metavar="D",
@@ -167,7 +227,12 @@ def scene_overrides(args):
     return SceneOverrides(f_number=args.f_stop, focal_length_mm=args.focal_length,
                           focus_distance_m=args.focus_distance, width=args.width, height=args.height, spp=args.spp,
                           seed=args.seed, max_depth=args.max_depth, sampler=args.sampler, clamp=args.clamp,
-                          defines=parse_defines(args.defines))
+                          lens=args.lens, sensor=args.sensor, sensor_fit=args.sensor_fit, focus_from=args.focus_from,
+                          focus_breathing=args.focus_breathing, circle_of_confusion_mm=args.coc,
+                          aperture_blades=args.blades, blade_curvature=args.blade_curvature,
+                          anamorphic_squeeze=args.anamorphic, barrel_clipping=args.barrel_clipping,
+                          aperture_image=args.aperture_image, exposure_mode=args.exposure_mode, iso=args.iso,
+                          shutter_s=args.shutter, defines=parse_defines(args.defines))
 
 
 def _progress_display():
@@ -243,8 +308,35 @@ def render_headless(args) -> int:
     return EXIT_OK
 
 
+def _print_presets(kind: str) -> int:
+    """--list-lenses / --list-sensors: the presets as a table, shipped and the user's own."""
+    from lenslab.optics import format_f_number, format_focal_length, load_lens_presets, load_sensor_presets
+    from lenslab.optics.thinlens import format_distance
+
+    if kind == "lenses":
+        header = ("lens", "focal length", "stops", "blades", "closest focus")
+        rows = [(lens.name,
+                 format_focal_length(lens.min_focal_length_mm) if not lens.is_zoom else
+                 f"{lens.min_focal_length_mm:g}-{format_focal_length(lens.max_focal_length_mm)}",
+                 f"{format_f_number(lens.widest_f_number)} to {format_f_number(lens.narrowest_f_number)}",
+                 "round" if not lens.aperture_blades else
+                 f"{lens.aperture_blades}" + (f", curvature {lens.blade_roundness:g}" if lens.blade_roundness else ""),
+                 format_distance(lens.min_focus_distance_m) if lens.min_focus_distance_m else "")
+                for lens in load_lens_presets()]
+    else:
+        header = ("sensor", "size", "crop", "circle of confusion")
+        rows = [(sensor.name, f"{sensor.width_mm:g} x {sensor.height_mm:g} mm", f"{sensor.crop_factor:.2f}x",
+                 f"{sensor.coc_mm * 1000:.0f} µm") for sensor in load_sensor_presets()]
+    widths = [max(len(str(row[i])) for row in [header, *rows]) for i in range(len(header))]
+    for row in [header, *rows]:
+        print("  ".join(str(cell).ljust(width) for cell, width in zip(row, widths)).rstrip())
+    return EXIT_OK
+
+
 def run(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
+    if args.list_lenses or args.list_sensors:
+        return _print_presets("lenses" if args.list_lenses else "sensors")
     if args.info:
         return _print_info(args.device)
     if args.headless:

@@ -46,11 +46,19 @@ _OVERRIDE_KEYS = {  # batch key: SceneOverrides field
     "f_number": "f_number", "focal_length": "focal_length_mm", "focus_distance": "focus_distance_m",
     "width": "width", "height": "height", "spp": "spp", "seed": "seed", "max_depth": "max_depth",
     "sampler": "sampler", "clamp": "clamp", "lens": "lens",
+    "sensor": "sensor", "sensor_fit": "sensor_fit", "focus_from": "focus_from", "coc": "circle_of_confusion_mm",
+    "blades": "aperture_blades", "blade_curvature": "blade_curvature", "anamorphic": "anamorphic_squeeze",
+    "barrel_clipping": "barrel_clipping", "aperture_image": "aperture_image", "exposure_mode": "exposure_mode",
+    "iso": "iso", "shutter": "shutter_s",
 }
 _KINDS = {
     "name": str, "scene": str, "output": str, "lens": str, "sampler": str, "tone_map": str,
     "f_number": float, "focal_length": float, "focus_distance": float, "clamp": float, "time_limit": float,
     "exposure": float,
+    "sensor": str, "sensor_fit": str, "focus_from": str, "aperture_image": str, "exposure_mode": str,
+    "coc": float, "blade_curvature": float, "anamorphic": float, "barrel_clipping": float, "iso": float,
+    "shutter": float,  # seconds, or text as a camera shows it: "1/125"
+    "blades": int,
     "width": int, "height": int, "spp": int, "seed": int, "max_depth": int, "split": int,
     "defines": dict,
 }
@@ -186,6 +194,13 @@ def _kind_name(kind) -> str:
 
 def _scalar(key: str, value, where: str):
     kind = _KINDS[key]
+    if key == "shutter" and isinstance(value, str):
+        from lenslab.optics.exposure import parse_shutter
+
+        try:
+            return parse_shutter(value)
+        except ValueError as exc:
+            raise BatchError(f"{where}: shutter: {exc}") from None
     ok = (isinstance(value, str) if kind is str else
           isinstance(value, dict) if kind is dict else
           isinstance(value, int) and not isinstance(value, bool) if kind is int else
@@ -257,9 +272,13 @@ def _describe(values: dict, keys) -> str:
     for key in keys:
         value = values[key]
         if isinstance(value, str):
-            words.append(value if key in ("lens", "scene") else f"{key} {value}")
+            words.append(value if key in ("lens", "scene", "sensor") else f"{key} {value}")
+        elif key == "shutter":
+            from lenslab.optics.exposure import format_shutter
+
+            words.append(format_shutter(value))
         else:
-            units = {"f_number": "f/{:g}", "focal_length": "{:g} mm", "focus_distance": "{:g} m"}
+            units = {"f_number": "f/{:g}", "focal_length": "{:g} mm", "focus_distance": "{:g} m", "iso": "ISO {:g}"}
             words.append(units.get(key, key + " {:g}").format(value))
     return ", ".join(words)
 
@@ -270,6 +289,8 @@ def _shot(number: int, index: int, values: dict, swept: list[str], folder: Path,
         raise BatchError(f"{where}: output: {output.name} must be an .exr or a .png")
     # Named by the user (with the swept settings added), or else by its file, which is unique.
     name = values["name"] + (f" {_describe(values, swept)}" if swept else "") if "name" in values else output.stem
+    if "aperture_image" in values:  # relative to the batch file, as the outputs are
+        values = {**values, "aperture_image": str(folder / Path(values["aperture_image"]).expanduser())}
     try:
         overrides = SceneOverrides(**{field_name: values[key] for key, field_name in _OVERRIDE_KEYS.items()
                                       if key in values},
