@@ -60,7 +60,7 @@ def test_choosing_f28_sets_the_f_number_and_restarts_accumulation(qtbot, window)
     combo = window.camera_panel.aperture_combo
     with qtbot.waitSignal(window.controller.restarted, timeout=5000) as restart:
         combo.setCurrentIndex(combo.findText("f/2.8"))
-    assert window.doc.scene.camera.f_number == 2.8
+    assert window.doc.scene.camera.f_number == 2 ** 1.5  # the mark f/2.8 is the exact stop
     generation = restart.args[0]
     assert generation > before.generation
     # The first picture of the new generation starts again from a few samples.
@@ -72,9 +72,9 @@ def test_choosing_f28_sets_the_f_number_and_restarts_accumulation(qtbot, window)
     combo.lineEdit().setText("f/3")
     combo.lineEdit().editingFinished.emit()
     assert window.doc.scene.camera.f_number == 3.0
-    # Stepping goes along the third-stop scale from there.
+    # Stepping goes along the third-stop scale from there: to the exact f/3.2.
     window.camera_panel.step_aperture(+1)
-    assert window.doc.scene.camera.f_number == 3.2
+    assert window.doc.scene.camera.f_number == pytest.approx(2 ** (10 / 6))
 
 
 # -- the look on screen ----------------------------------------------------------------------------------------
@@ -127,7 +127,7 @@ def test_a_lens_preset_sets_the_focal_length_and_clamps_the_aperture(qtbot, wind
     qtbot.mouseClick(lens_button(window, lens), Qt.LeftButton)
     cam = window.doc.scene.camera
     assert cam.focal_length_mm == 135.0
-    assert cam.f_number == 2.0  # f/1.8 is wider than the lens opens
+    assert cam.f_number == 2.0  # f/1.8 is wider than the lens opens (f/2 is exact)
     assert cam.aperture_blades == lens.aperture_blades
     assert window.doc.lens == lens
     # The aperture scale now stops at the lens's widest: asking for f/1.4 gives f/2.
@@ -140,14 +140,14 @@ def test_a_lens_preset_sets_the_focal_length_and_clamps_the_aperture(qtbot, wind
     zoom = lens_named(window, "24-70 mm f/2.8")
     window.lens_actions[window.camera_panel.lenses.index(zoom)].trigger()  # the menu entry (Alt+N)
     cam = window.doc.scene.camera
-    assert cam.focal_length_mm == 70.0 and cam.f_number == 2.8
+    assert cam.focal_length_mm == 70.0 and cam.f_number == 2 ** 1.5
     window.camera_panel.set_focal_length(200.0, False)
     assert window.doc.scene.camera.focal_length_mm == 70.0
     # Free: no limits again, and one undo puts the previous lens back.
     qtbot.mouseClick(window.camera_panel.lens_buttons[0], Qt.LeftButton)
     assert window.doc.lens is None
     window.camera_panel.set_f_number(1.4)
-    assert window.doc.scene.camera.f_number == 1.4
+    assert window.doc.scene.camera.f_number == 1.4  # a number set as it is (typed text reads marks as exact)
     window.doc.undo_stack.undo()
     window.doc.undo_stack.undo()
     assert window.doc.lens == zoom
@@ -165,13 +165,14 @@ def test_clicking_an_object_focuses_at_its_depth(qtbot, window):
     changes = []
     window.doc.model.events.changed.connect(changes.append)  # the scene's own events, no Qt signal
     for x, y, name in ((24.5, 28.5, "tall box"), (40.5, 40.5, "short box"), (36.5, 12.5, "back wall")):
-        before = window.doc.scene.camera.focus_distance_m
+        before = window.doc.scene.camera.plane_of_focus_m
         seen = len(changes)
         click_image(qtbot, window, x, y)
         qtbot.waitUntil(lambda: any(c.field == ("focus_distance_m",) for c in changes[seen:]), timeout=10000)
         u, v = clicks[-1]
         truth, node_index = cpu_depth(scene, u, v)
-        focus = window.doc.scene.camera.focus_distance_m
+        # The reading is from the sensor; the plane it puts in focus is at the clicked depth from the lens.
+        focus = window.doc.scene.camera.plane_of_focus_m
         assert math.isfinite(truth) and names[node_index] == name
         assert abs(focus - truth) <= 0.01 * truth, (name, focus, truth)
         assert abs(focus - before) > 0.01 * truth

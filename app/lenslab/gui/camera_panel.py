@@ -1,15 +1,18 @@
-"""The camera panel: the lens, aperture, focal length, focus, sensor and iris in photographers' terms, with a
-depth-of-field readout and diagram. Everything here edits ``scene.camera`` through undo commands (a slider drag
+"""The camera panel: the lens, aperture, focal length, focus, sensor, iris and exposure in photographers' terms,
+with a depth-of-field readout and diagram. Everything here edits ``scene.camera`` through undo commands (a slider drag
 is one undo step) and follows the document when something else changes it (undo, click-to-focus)."""
 
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 from PySide6.QtCore import QPointF, QRectF, QSize, Qt, Signal
 from PySide6.QtGui import QAction, QColor, QFont, QPainter, QPainterPath, QPen, QPolygonF
 from PySide6.QtWidgets import (
+    QCheckBox,
     QComboBox,
+    QFileDialog,
     QGridLayout,
     QHBoxLayout,
     QLabel,
@@ -30,8 +33,6 @@ from lenslab.optics import (
     LensPreset,
     PresetError,
     SensorPreset,
-    circle_of_confusion_mm,
-    depth_of_field,
     format_distance,
     format_f_number,
     format_focal_length,
@@ -40,11 +41,22 @@ from lenslab.optics import (
     parse_f_number,
     step_stop,
 )
+from lenslab.optics.exposure import ev100, format_shutter, parse_shutter
 from lenslab.optics.sensors import crop_factor
+from lenslab.optics.stops import DEFAULT_STOP_SCALE, STOP_SCALES, marked_f_number
 from lenslab.scene.camera import ThinLensCamera
-from lenslab.scene.fields import declared_range
+from lenslab.scene.editing import camera_changes_keeping_focus, closest_focus
+from lenslab.scene.fields import declared_choices, declared_range
 
-FULL_STOPS = (1.4, 2, 2.8, 4, 5.6, 8, 11, 16, 22)
+FULL_STOPS = STOP_SCALES["full"].exact  # labelled under the aperture slider
+STOP_SCALE_NAMES = {"third": "Third stops", "half": "Half stops", "full": "Full stops"}
+STEP_WORDS = {"third": "a third of a stop", "half": "half a stop", "full": "a stop"}
+SENSOR_FIT_NAMES = {"auto": "Auto (long sides together)", "horizontal": "Horizontal", "vertical": "Vertical",
+                    "fill": "Fill (crop the sensor)", "overscan": "Overscan (whole sensor)"}
+ISO_SPEEDS = (50, 100, 200, 400, 800, 1600, 3200, 6400, 12800, 25600)
+#: The full-stop shutter scale a camera dial shows, seconds.
+SHUTTER_SPEEDS = (30, 15, 8, 4, 2, 1, 1 / 2, 1 / 4, 1 / 8, 1 / 15, 1 / 30, 1 / 60, 1 / 125, 1 / 250, 1 / 500,
+                  1 / 1000, 1 / 2000, 1 / 4000, 1 / 8000)
 COMMON_FOCAL_LENGTHS = (14, 24, 35, 50, 85, 135, 200)
 FOCAL_RANGE = (8.0, 800.0)
 FOCUS_RANGE = (0.05, 200.0)
@@ -222,16 +234,19 @@ class StopSlider(QWidget):
         for i, stop in enumerate(self.scale):
             if any(math.isclose(stop, s, rel_tol=1e-3) for s in FULL_STOPS) or i in (0, n - 1):
                 x = handle / 2 + (span * i / max(1, n - 1))
-                p.drawText(QRectF(x - 14, 0, 28, 14), Qt.AlignCenter, f"{stop:g}")
+                p.drawText(QRectF(x - 14, 0, 28, 14), Qt.AlignCenter, f"{marked_f_number(stop):g}")
         p.end()
 
 
 class CameraPanel(QWidget):
     status_message = Signal(str)
 
-    def __init__(self, doc, focus_action: QAction | None = None, parent=None):
+    def __init__(self, doc, focus_action: QAction | None = None, parent=None, settings=None):
         super().__init__(parent)
         self.doc = doc
+        self.settings = settings  # QSettings: the stop scale chosen last time
+        saved = settings.value("camera/stop_scale", DEFAULT_STOP_SCALE) if settings is not None else DEFAULT_STOP_SCALE
+        self.scale_name = saved if saved in STOP_SCALES else DEFAULT_STOP_SCALE
         try:
             self.lenses = load_lens_presets()
         except PresetError as exc:
@@ -250,6 +265,7 @@ class CameraPanel(QWidget):
         layout.addWidget(self._focal_section())
         layout.addWidget(self._focus_section(focus_action))
         layout.addWidget(self._dof_section())
+        layout.addWidget(self._exposure_section())
         layout.addWidget(self._sensor_section())
         layout.addStretch(1)
         listen(doc.model.events.changed, self, self._on_change)
@@ -328,8 +344,48 @@ class CameraPanel(QWidget):
         grid.addWidget(self.blades, 0, 1)
         grid.addWidget(QLabel("Rotation"), 0, 2)
         grid.addWidget(self.rotation, 0, 3)
+        self.curvature = self._camera_number("blade_curvature", "Blade curvature", 2, 0.05,
+                                             "Blade edges: 0 straight (polygonal bokeh) to 1 round")
+        self.squeeze = self._camera_number("anamorphic_squeeze", "Anamorphic squeeze", 2, 0.05,
+                                           "Bokeh height over width: 1 spherical, 1.33, 1.5, 1.8 or 2 anamorphic")
+        self.barrel = self._camera_number("barrel_clipping", "Barrel clipping", 2, 0.05,
+                                          "Cat's-eye bokeh and vignetting toward the corners: how far the barrel "
+                                          "cuts into the stop at the frame's corner")
+        for row, (label, widget) in enumerate((("Curvature", self.curvature), ("Squeeze", self.squeeze)), start=1):
+            grid.addWidget(QLabel(label), row, 0)
+            grid.addWidget(widget, row, 1)
+        grid.addWidget(QLabel("Cat's eye"), 1, 2)
+        grid.addWidget(self.barrel, 1, 3)
+        self.stop_scale_combo = QComboBox()
+        for name, text in STOP_SCALE_NAMES.items():
+            self.stop_scale_combo.addItem(text, name)
+        self.stop_scale_combo.setToolTip("What one step of [ and ] moves: the scale shows marked stops, the "
+                                         "camera takes the exact ones (f/11 is 11.31)")
+        self.stop_scale_combo.currentIndexChanged.connect(self._stop_scale_chosen)
+        grid.addWidget(QLabel("Steps"), 2, 2)
+        grid.addWidget(self.stop_scale_combo, 2, 3)
         section.add(grid)
+        image_row = QHBoxLayout()
+        self.aperture_image_button = QPushButton("Aperture image…")
+        self.aperture_image_button.setToolTip("A grayscale image of the stop for custom bokeh (a star, a heart)")
+        self.aperture_image_button.clicked.connect(self._choose_aperture_image)
+        self.aperture_image_clear = QToolButton()
+        self.aperture_image_clear.setText("×")
+        self.aperture_image_clear.setToolTip("Back to the blades")
+        self.aperture_image_clear.clicked.connect(lambda: self.set_aperture_image(""))
+        self.aperture_image_label = hint("")
+        image_row.addWidget(self.aperture_image_button)
+        image_row.addWidget(self.aperture_image_clear)
+        image_row.addWidget(self.aperture_image_label, 1)
+        section.add(image_row)
         return section
+
+    def _camera_number(self, field: str, undo_text: str, decimals: int, step: float, tip: str) -> NumberEdit:
+        """A number field that edits one of the camera's fields, within the range the field declares."""
+        edit = NumberEdit(*declared_range(ThinLensCamera, field), decimals=decimals, step=step)
+        edit.setToolTip(tip)
+        edit.edited.connect(lambda v, merge: self.doc.set_camera(undo_text, merge, **{field: float(v)}))
+        return edit
 
     def _focal_section(self) -> Section:
         section = Section("Focal length")
@@ -370,10 +426,29 @@ class CameraPanel(QWidget):
         self.focus = NumberEdit(*declared_range(ThinLensCamera, "focus_distance_m"), decimals=3, step=0.01, suffix=" m")
         self.focus.setObjectName("focusDistance")
         self.focus.setFixedWidth(86)
-        self.focus.edited.connect(lambda v, merge: self.doc.set_camera("Focus distance", merge, focus_distance_m=v))
+        self.focus.edited.connect(lambda v, merge: self.set_focus(v, merge))
         row.addWidget(self.focus_slider, 1)
         row.addWidget(self.focus)
         section.add(row)
+        options = QHBoxLayout()
+        self.focus_from = QComboBox()
+        self.focus_from.addItem("from the sensor", "sensor")
+        self.focus_from.addItem("from the lens", "lens")
+        self.focus_from.setToolTip("What the focus distance is measured from: the sensor plane, as a lens's focus "
+                                   "scale is marked, or the lens (pbrt's and Mitsuba's meaning). The plane of "
+                                   "focus stays where it is.")
+        self.focus_from.currentIndexChanged.connect(self._focus_from_chosen)
+        self.breathing = QCheckBox("Focus breathing")
+        self.breathing.setToolTip("The sensor moves to the image distance as a real lens focuses, so the framing "
+                                  "tightens at close focus. Off: the framing is held (pbrt, Mitsuba).")
+        self.breathing.toggled.connect(lambda on: self._updating or self.doc.set_camera(
+            "Focus breathing" if on else "Hold framing", False, focus_breathing=bool(on)))
+        options.addWidget(self.focus_from)
+        options.addWidget(self.breathing)
+        options.addStretch(1)
+        section.add(options)
+        self.focus_info = hint("")
+        section.add(self.focus_info)
         buttons = QHBoxLayout()
         if focus_action is not None:
             tool = QToolButton()
@@ -425,14 +500,170 @@ class CameraPanel(QWidget):
         row.addWidget(QLabel("H"))
         row.addWidget(self.sensor_h)
         section.add(row)
+        grid = QGridLayout()
+        self.sensor_fit = QComboBox()
+        for fit in declared_choices(ThinLensCamera, "sensor_fit"):
+            self.sensor_fit.addItem(SENSOR_FIT_NAMES.get(fit, fit), fit)
+        self.sensor_fit.setToolTip("Which part of the sensor an image of another shape shows (Blender's and "
+                                   "Unity's fits)")
+        self.sensor_fit.currentIndexChanged.connect(
+            lambda i: self._updating or self.doc.set_camera("Sensor fit", False,
+                                                            sensor_fit=self.sensor_fit.itemData(i)))
+        low, high = declared_range(ThinLensCamera, "circle_of_confusion_mm")
+        self.coc = NumberEdit(0.0, high, decimals=4, step=0.001, suffix=" mm")
+        self.coc.setSpecialValueText("auto")
+        self.coc.setToolTip("Circle of confusion of the depth-of-field readout: auto is the imaged area's "
+                            "diagonal / 1500")
+        self.coc.edited.connect(lambda v, merge: self.doc.set_camera(
+            "Circle of confusion", merge, circle_of_confusion_mm=float(v) if v >= low else None))
+        grid.addWidget(QLabel("Fit"), 0, 0)
+        grid.addWidget(self.sensor_fit, 0, 1)
+        grid.addWidget(QLabel("CoC"), 1, 0)
+        grid.addWidget(self.coc, 1, 1)
+        section.add(grid)
         self.sensor_info = hint("")
         section.add(self.sensor_info)
         return section
 
+    def _exposure_section(self) -> Section:
+        section = Section("Exposure")
+        grid = QGridLayout()
+        self.exposure_mode = QComboBox()
+        self.exposure_mode.addItem("Compensated", "compensated")
+        self.exposure_mode.addItem("Physical (ISO, shutter)", "physical")
+        self.exposure_mode.setToolTip("Compensated: the brightness stays the same at every aperture, to judge "
+                                      "depth of field. Physical: each stop of aperture, shutter or ISO is a stop "
+                                      "of light (radiance in cd/m²)")
+        self.exposure_mode.currentIndexChanged.connect(
+            lambda i: self._updating or self.doc.set_camera("Exposure mode", False,
+                                                            exposure_mode=self.exposure_mode.itemData(i)))
+        self.iso = QComboBox()
+        self.iso.setEditable(True)
+        self.iso.setInsertPolicy(QComboBox.NoInsert)
+        for speed in ISO_SPEEDS:
+            self.iso.addItem(f"{speed}", float(speed))
+        self.iso.setToolTip("Sensor speed: any value")
+        self.iso.lineEdit().editingFinished.connect(self._iso_typed)
+        self.iso.activated.connect(lambda i: self._set_iso(self.iso.itemData(i)))
+        self.shutter = QComboBox()
+        self.shutter.setEditable(True)
+        self.shutter.setInsertPolicy(QComboBox.NoInsert)
+        for seconds in SHUTTER_SPEEDS:
+            self.shutter.addItem(format_shutter(seconds), float(seconds))
+        self.shutter.setToolTip("Exposure time: choose or type any (1/125, 0.5, 2 s)")
+        self.shutter.lineEdit().editingFinished.connect(self._shutter_typed)
+        self.shutter.activated.connect(lambda i: self._set_shutter(self.shutter.itemData(i)))
+        for row, (label, widget) in enumerate((("Mode", self.exposure_mode), ("ISO", self.iso),
+                                               ("Shutter", self.shutter))):
+            grid.addWidget(QLabel(label), row, 0)
+            grid.addWidget(widget, row, 1)
+        section.add(grid)
+        self.exposure_info = hint("")
+        section.add(self.exposure_info)
+        return section
+
     # -- edits ----------------------------------------------------------------------------------------------------
     def stop_scale(self) -> tuple[float, ...]:
+        """The exact f-numbers one step moves between: the chosen scale, within the mounted lens."""
         lens = self.doc.lens
-        return lens.available_stops() if lens is not None else THIRD_STOPS
+        return lens.available_stops(self.scale_name) if lens is not None else STOP_SCALES[self.scale_name].exact
+
+    def _stop_scale_chosen(self, index: int) -> None:
+        if self._updating or index < 0:
+            return
+        self.scale_name = self.stop_scale_combo.itemData(index)
+        if self.settings is not None:
+            self.settings.setValue("camera/stop_scale", self.scale_name)
+        self.refresh()
+
+    def focus_limits(self) -> tuple[float, float]:
+        """The focus distances the camera (and its lens) can set, in its reference."""
+        return closest_focus(self.doc.scene.camera, self.doc.lens), FOCUS_RANGE[1]
+
+    def set_focus(self, metres: float, merge: bool = False, text: str = "Focus distance") -> bool:
+        """Focus at ``metres`` (in the camera's reference), or refuse and say why when the lens cannot."""
+        closest, _ = self.focus_limits()
+        if metres < closest * (1 - 1e-9):
+            lens = self.doc.lens
+            why = (f"the {lens.name} focuses no nearer than {format_distance(lens.min_focus_distance_m)} from the "
+                   "sensor" if lens is not None and lens.min_focus_distance_m is not None
+                   and closest > self.doc.scene.camera.closest_focus_m else
+                   f"a {format_focal_length(self.doc.scene.camera.focal_length_mm)} lens focuses no nearer than "
+                   f"{format_distance(closest)}")
+            self.status_message.emit(f"Cannot focus at {format_distance(metres)}: {why}")
+            self.refresh()
+            return False
+        self.doc.set_camera(text, merge, focus_distance_m=float(metres))
+        return True
+
+    def _focus_from_chosen(self, index: int) -> None:
+        if self._updating or index < 0:
+            return
+        cam = self.doc.scene.camera
+        reference = self.focus_from.itemData(index)
+        if reference == cam.focus_from:
+            return
+        # The plane of focus stays put: the reading changes by the lens-to-sensor distance.
+        plane = cam.plane_of_focus_m
+        reading = plane if reference == "lens" else plane + cam.image_distance_mm / 1000
+        self.doc.set_camera("Focus measured from the " + reference, False, focus_from=reference,
+                            focus_distance_m=float(reading))
+
+    def set_aperture_image(self, path: str) -> None:
+        """Use the image at ``path`` as the stop ("" for the blades); a missing or black image is refused with a
+        message, and the camera keeps its stop."""
+        if path:
+            trial = ThinLensCamera(aperture_image=path)
+            try:
+                trial.aperture(self.doc.scene.base_dir())
+            except ValueError as exc:
+                self.status_message.emit(str(exc))
+                self.refresh()
+                return
+        self.doc.set_camera("Aperture image" if path else "No aperture image", False, aperture_image=path)
+
+    def _choose_aperture_image(self) -> None:
+        path, _ = QFileDialog.getOpenFileName(self, "Aperture image", str(self.doc.scene.base_dir()),
+                                              "Images (*.png *.jpg *.jpeg *.exr *.hdr *.tif *.tiff)")
+        if path:
+            self.set_aperture_image(path)
+
+    def _set_iso(self, value) -> None:
+        low, high = declared_range(ThinLensCamera, "iso")
+        if value is None or not low <= float(value) <= high:
+            self.status_message.emit(f"ISO must lie between {low:g} and {high:g}")
+            self.refresh()
+            return
+        self.doc.set_camera(f"ISO {float(value):g}", False, iso=float(value))
+
+    def _iso_typed(self) -> None:
+        if self._updating:
+            return
+        text = self.iso.lineEdit().text().strip().lower().removeprefix("iso").strip()
+        try:
+            value = float(text)
+        except ValueError:
+            self.status_message.emit(f"not an ISO speed: '{text}'")
+            self.refresh()
+            return
+        if not math.isclose(value, self.doc.scene.camera.iso):
+            self._set_iso(value)
+
+    def _set_shutter(self, seconds) -> None:
+        if seconds is not None:
+            self.doc.set_camera(f"Shutter {format_shutter(seconds)}", False, shutter_s=float(seconds))
+
+    def _shutter_typed(self) -> None:
+        if self._updating:
+            return
+        try:
+            seconds = parse_shutter(self.shutter.lineEdit().text())
+        except ValueError as exc:
+            self.status_message.emit(str(exc))
+            self.refresh()
+            return
+        if not math.isclose(seconds, self.doc.scene.camera.shutter_s, rel_tol=1e-6):
+            self._set_shutter(seconds)
 
     def choose_lens(self, lens: LensPreset | None) -> None:
         if lens == self.doc.lens:
@@ -449,8 +680,8 @@ class CameraPanel(QWidget):
         if lens is not None:
             clamped = lens.clamp_f_number(n)
             if not math.isclose(clamped, n, rel_tol=1e-9):
-                self.status_message.emit(f"The {lens.name} goes from f/{lens.widest_f_number:g} to "
-                                         f"f/{lens.narrowest_f_number:g}")
+                self.status_message.emit(f"The {lens.name} goes from {format_f_number(lens.widest_f_number)} to "
+                                         f"{format_f_number(lens.narrowest_f_number)}")
             n = clamped
         self.doc.set_camera(f"Aperture {format_f_number(n)}", merge, f_number=float(n))
         self.refresh()  # the clamp may leave the camera as it was; show the truth either way
@@ -470,7 +701,7 @@ class CameraPanel(QWidget):
             return
         text = self.aperture_combo.lineEdit().text()
         try:
-            n = parse_f_number(text)
+            n = parse_f_number(text, self.scale_name)
         except ValueError as exc:
             self.status_message.emit(str(exc))
             self.refresh()
@@ -486,7 +717,11 @@ class CameraPanel(QWidget):
                 self.refresh()
                 return
             mm = lens.clamp_focal_length(mm)
-        self.doc.set_camera(f"Focal length {mm:g} mm", merge, focal_length_mm=float(mm))
+        changes = camera_changes_keeping_focus(self.doc.scene.camera, lens, focal_length_mm=float(mm))
+        if "focus_distance_m" in changes:
+            self.status_message.emit(f"Focus moved out to {format_distance(changes['focus_distance_m'])}: a "
+                                     f"{format_focal_length(mm)} lens focuses no nearer")
+        self.doc.set_camera(f"Focal length {mm:g} mm", merge, **changes)
         self.refresh()
 
     def _focal_slid(self, position: int) -> None:
@@ -505,8 +740,8 @@ class CameraPanel(QWidget):
     def _focus_slid(self, position: int) -> None:
         if self._updating:
             return
-        metres = slider_to_log(position, *FOCUS_RANGE)
-        metres = float(f"{metres:.3g}")
+        closest, far = self.focus_limits()
+        metres = max(closest, float(f"{slider_to_log(position, closest, far):.3g}"))
         self.doc.set_camera("Focus distance", True, focus_distance_m=metres)
 
     def _blades_edited(self, value: int, merge: bool) -> None:
@@ -523,7 +758,8 @@ class CameraPanel(QWidget):
         if sensor is None:
             self.refresh()
             return
-        self.doc.set_camera(f"Sensor {sensor.name}", False, sensor_mm=(sensor.width_mm, sensor.height_mm))
+        self.doc.set_camera(f"Sensor {sensor.name}", False, sensor_mm=(sensor.width_mm, sensor.height_mm),
+                            circle_of_confusion_mm=sensor.circle_of_confusion_mm)
 
     def _sensor_edited(self, merge: bool) -> None:
         if self._updating:
@@ -563,12 +799,28 @@ class CameraPanel(QWidget):
             self.open_up.setEnabled(cam.f_number > scale[0] * 1.0001)
             self.stop_down.setEnabled(cam.f_number < scale[-1] * 0.9999)
             diameter = cam.focal_length_mm / cam.f_number
-            self.aperture_info.setText(f"Entrance pupil {diameter:.1f} mm. Brightness stays the same at every "
-                                       "aperture (exposure is compensated).")
+            light = self.light_fraction()
+            brightness = ("Brightness stays the same at every aperture (exposure is compensated)."
+                          if cam.exposure_mode != "physical" else "Each stop is a stop of light (physical exposure).")
+            self.aperture_info.setText(f"Entrance pupil {diameter:.1f} mm"
+                                       + (f", passing {light:.0%} of the round stop's light" if light < 0.999 else "")
+                                       + f". {brightness}")
+            step = STEP_WORDS[self.scale_name]
+            self.open_up.setToolTip(f"Open up {step} ([)")
+            self.stop_down.setToolTip(f"Stop down {step} (])")
+            self.stop_scale_combo.setCurrentIndex(self.stop_scale_combo.findData(self.scale_name))
+            self.stop_slider.slider.setPageStep(STOP_SCALES[self.scale_name].steps_per_stop)
             self.iris.set_state(cam.f_number, cam.aperture_blades, cam.blade_rotation_deg)
             self.blades.set_quietly(cam.aperture_blades)
             self.rotation.set_quietly(cam.blade_rotation_deg)
-            self.rotation.setEnabled(cam.aperture_blades >= 3)
+            bladed = cam.aperture_blades >= 3 and not cam.aperture_image
+            self.rotation.setEnabled(bladed)
+            self.curvature.set_quietly(cam.blade_curvature)
+            self.curvature.setEnabled(bladed)
+            self.squeeze.set_quietly(cam.anamorphic_squeeze)
+            self.barrel.set_quietly(cam.barrel_clipping)
+            self.aperture_image_label.setText(Path(cam.aperture_image).name if cam.aperture_image else "blades")
+            self.aperture_image_clear.setEnabled(bool(cam.aperture_image))
             # Focal length.
             lo, hi = self._focal_limits()
             prime = lens is not None and not lens.is_zoom
@@ -583,9 +835,16 @@ class CameraPanel(QWidget):
             self.fov_info.setText(f"Field of view {math.degrees(cam.fov_x):.1f}° × {fov_y:.1f}°"
                                   + (" · fixed by the prime" if prime else ""))
             # Focus.
+            closest, far = self.focus_limits()
             self.focus.set_quietly(cam.focus_distance_m)
             if not self.focus_slider.isSliderDown():
-                self.focus_slider.setValue(log_to_slider(cam.focus_distance_m, *FOCUS_RANGE))
+                self.focus_slider.setValue(log_to_slider(max(closest, cam.focus_distance_m), closest, far))
+            self.focus_from.setCurrentIndex(self.focus_from.findData(cam.focus_from))
+            self.breathing.setChecked(cam.focus_breathing)
+            reference = "sensor" if cam.focus_from == "sensor" else "lens"
+            self.focus_info.setText(f"Measured from the {reference}; nearest {format_distance(closest)}. Plane of "
+                                    f"focus {format_distance(cam.plane_of_focus_m)} ahead of the lens, sensor "
+                                    f"{cam.image_distance_mm:.1f} mm behind it.")
             # Sensor.
             sw, sh = cam.sensor_mm
             index = next((i for i, s in enumerate(self.sensors)
@@ -595,24 +854,41 @@ class CameraPanel(QWidget):
             self.sensor_w.set_quietly(sw)
             self.sensor_h.set_quietly(sh)
             crop = crop_factor(sw, sh)
-            coc = circle_of_confusion_mm(sw, sh)
-            self.sensor_info.setText(f"Crop factor {crop:.2f} · circle of confusion {coc * 1000:.0f} µm · "
+            width, height = cam.resolution
+            coc = cam.coc_mm(width, height)
+            film_w, film_h = cam.imaged_area_mm(width, height)
+            self.sensor_fit.setCurrentIndex(self.sensor_fit.findData(cam.sensor_fit))
+            self.coc.set_quietly(cam.circle_of_confusion_mm or 0.0)
+            self.sensor_info.setText(f"Crop factor {crop:.2f} · the image shows {film_w:.1f} × {film_h:.1f} mm · "
+                                     f"circle of confusion {coc * 1000:.0f} µm · "
                                      f"{cam.focal_length_mm * crop:.0f} mm full-frame equivalent")
-            # Depth of field (the renderer's planar model: these numbers describe the picture on screen).
-            dof = depth_of_field(cam.focal_length_mm, cam.f_number, cam.focus_distance_m, coc, model="planar")
+            # Exposure.
+            physical = cam.exposure_mode == "physical"
+            self.exposure_mode.setCurrentIndex(self.exposure_mode.findData(cam.exposure_mode))
+            self.iso.setEditText(f"{cam.iso:g}")
+            self.shutter.setEditText(format_shutter(cam.shutter_s))
+            self.iso.setEnabled(physical)
+            self.shutter.setEnabled(physical)
+            ev = ev100(cam.f_number, cam.shutter_s, cam.iso)
+            self.exposure_info.setText(
+                f"EV₁₀₀ {ev:.1f}: a reflected-light meter calls {0.125 * 2 ** ev:.3g} cd/m² mid-grey."
+                if physical else "The picture keeps its brightness whatever the aperture, shutter and ISO.")
+            # Depth of field: exactly the picture the renderer draws, with the aperture's real area.
+            dof = cam.depth_of_field(width, height, light)
             self.dof_near.setText(format_distance(dof.near_m))
             self.dof_far.setText(format_distance(dof.far_m))
             self.dof_total.setText(format_distance(dof.total_m) if not math.isinf(dof.total_m) else "∞")
             self.dof_hyper.setText(format_distance(dof.hyperfocal_m))
-            self.dof_diagram.set_state(cam.focus_distance_m, dof.near_m, dof.far_m, dof.hyperfocal_m)
+            self.dof_diagram.set_state(cam.focus_distance_m, dof.near_m, max(dof.near_m, dof.far_m), dof.hyperfocal_m)
             self.dof_info.setText(f"Sharp from {format_distance(dof.near_m)} to {format_distance(dof.far_m)} for a "
                                   f"{coc * 1000:.0f} µm circle of confusion. Focus at the hyperfocal distance to "
                                   "keep everything from half of it to infinity sharp.")
         finally:
             self._updating = False
 
-    def dof_limits(self) -> tuple[float, float]:
-        cam = self.doc.scene.camera
-        coc = circle_of_confusion_mm(*cam.sensor_mm)
-        dof = depth_of_field(cam.focal_length_mm, cam.f_number, cam.focus_distance_m, coc, model="planar")
-        return dof.near_m, dof.far_m
+    def light_fraction(self) -> float:
+        """The light the camera's stop passes, as a fraction of the round f/N stop's (an aperture image's mask)."""
+        try:
+            return self.doc.scene.camera.aperture(self.doc.scene.base_dir()).light_fraction
+        except ValueError:  # an aperture image gone missing since: the render says so; the readout goes on
+            return 1.0

@@ -17,6 +17,7 @@ from typing import Any
 from PySide6.QtGui import QUndoCommand
 
 from lenslab.optics import LensPreset
+from lenslab.scene.editing import camera_changes_keeping_focus
 from lenslab.scene.events import SceneChange
 from lenslab.scene.lights import Light
 from lenslab.scene.scene import Node
@@ -81,17 +82,19 @@ class SetValuesCommand(QUndoCommand):
 
 
 class LensCommand(QUndoCommand):
-    """Mount a lens preset (or none): it sets the focal length, clamps the aperture and sets the iris."""
+    """Mount a lens preset (or none): it sets the focal length, clamps the aperture, sets the iris and moves the
+    focus out to the lens's minimum if it was nearer."""
 
     def __init__(self, doc, lens: LensPreset | None):
         super().__init__(f"Lens {lens.name}" if lens else "No lens limits")
         self.doc = doc
         self.old_lens, self.new_lens = doc.lens, lens
         cam = doc.scene.camera
-        self.old = {k: getattr(cam, k) for k in ("focal_length_mm", "f_number", "aperture_blades", "blade_rotation_deg")}
-        self.new = dict(self.old)
+        changes = {}
         if lens is not None:
-            self.new.update(lens.mount(cam.focal_length_mm, cam.f_number))
+            changes = camera_changes_keeping_focus(cam, lens, **lens.mount(cam.focal_length_mm, cam.f_number))
+        self.old = {k: getattr(cam, k) for k in changes}
+        self.new = changes
 
     def _apply(self, lens, values) -> None:
         for key, value in values.items():

@@ -4,6 +4,7 @@ render. The layout, the display settings and the recent files are remembered bet
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import threading
@@ -43,7 +44,8 @@ from lenslab.gui.properties import PropertyEditor
 from lenslab.gui.scene_tree import SceneTreeView, node_context_menu
 from lenslab.gui.viewport import Viewport
 from lenslab.gui.worker import VIEWPORT_DISPATCH_SECONDS
-from lenslab.optics import circle_of_confusion_mm, depth_of_field, format_camera_settings, format_distance
+from lenslab.optics import format_camera_settings, format_distance
+from lenslab.optics.exposure import format_shutter
 from lenslab.render.film import TONE_MAPS
 from lenslab.scene import editing
 from lenslab.scene.io.loader import open_scene, resolve_scene_path, shipped_scene_names
@@ -263,7 +265,7 @@ class MainWindow(QMainWindow):
         self.setDockOptions(QMainWindow.AnimatedDocks | QMainWindow.AllowTabbedDocks)
         self.scene_tree = SceneTreeView(self.doc)
         self.properties = PropertyEditor(self.doc)
-        self.camera_panel = CameraPanel(self.doc, self.actions["tool_focus"])
+        self.camera_panel = CameraPanel(self.doc, self.actions["tool_focus"], settings=self.settings)
         self.camera_panel.focus_selection_button.clicked.connect(self.focus_on_selection)
         camera_scroll = QScrollArea()
         camera_scroll.setWidgetResizable(True)
@@ -454,6 +456,8 @@ class MainWindow(QMainWindow):
     def _update_hud(self) -> None:
         cam = self.doc.scene.camera
         self.viewport.hud_text = format_camera_settings(cam.focal_length_mm, cam.f_number, cam.focus_distance_m)
+        if cam.exposure_mode == "physical":
+            self.viewport.hud_text += f" \u00b7 {format_shutter(cam.shutter_s)} \u00b7 ISO {cam.iso:g}"
         self.viewport.update()
 
     # -- document events ---------------------------------------------------------------------------------------
@@ -467,7 +471,7 @@ class MainWindow(QMainWindow):
         if change.kind == "camera":
             self._update_hud()
             if change.field[:1] in (("focus_distance_m",), ("f_number",), ("sensor_mm",)) or change.field == ():
-                self._show_focus_overlay(self.doc.scene.camera.focus_distance_m)
+                self._show_focus_overlay(self.doc.scene.camera.plane_of_focus_m)
         if change.kind == "scene":
             self._update_hud()
         self._update_actions()
@@ -499,7 +503,7 @@ class MainWindow(QMainWindow):
     def _gbuffer(self, gbuffer) -> None:
         self.viewport.set_gbuffer(gbuffer)
         if self.viewport.overlay_visible():
-            self._show_focus_overlay(self.doc.scene.camera.focus_distance_m)
+            self._show_focus_overlay(self.doc.scene.camera.plane_of_focus_m)
 
     def _device(self, info: dict) -> None:
         self.device_label.setText(info.get("renderer", "GPU"))
@@ -576,17 +580,30 @@ class MainWindow(QMainWindow):
             return
         paths = self.doc.model.node_paths()
         name = self.doc.model.node(paths[result.node_index]).name if 0 <= result.node_index < len(paths) else "surface"
-        self.doc.set_camera(f"Focus on {name} ({result.depth:.2f} m)", False, focus_distance_m=float(result.depth))
-        self.statusBar().showMessage(f"Focused on {name} at {format_distance(result.depth)}", 4000)
+        camera = self.doc.scene.camera
+        # The pick's depth is from the lens; the camera's focus reading may be from the sensor.
+        if camera.focus_from == "sensor" and result.depth <= camera.focal_length_mm / 1000:
+            self.statusBar().showMessage(f"{name} is nearer than any lens focuses", 4000)
+            return
+        setting = round(camera.focus_setting_for(float(result.depth)), 4)
+        if self.camera_panel.set_focus(setting, text=f"Focus on {name} ({format_distance(setting)})"):
+            self.statusBar().showMessage(f"Focused on {name} at {format_distance(setting)}", 4000)
 
     def _focus_preview(self, depth: float) -> None:
         self._show_focus_overlay(depth, hold=True)
 
-    def _show_focus_overlay(self, focus: float, hold: bool = False) -> None:
+    def _show_focus_overlay(self, depth: float, hold: bool = False) -> None:
+        """The zone of sharpness on the picture, were the plane of focus ``depth`` ahead of the lens (the depth
+        buffer's distances)."""
         cam = self.doc.scene.camera
-        coc = circle_of_confusion_mm(*cam.sensor_mm)
-        dof = depth_of_field(cam.focal_length_mm, cam.f_number, max(focus, 1e-3), coc, model="planar")
-        self.viewport.show_focus_overlay(focus, dof.near_m, dof.far_m, hold)
+        if cam.focus_from == "sensor" and depth <= cam.focal_length_mm / 1000 * 1.0001:
+            return
+        try:
+            trial = dataclasses.replace(cam, focus_distance_m=cam.focus_setting_for(max(depth, 1e-3)))
+            dof = trial.depth_of_field(*cam.resolution, self.camera_panel.light_fraction(), reference="lens")
+        except ValueError:  # nearer than the lens can focus: no zone to show
+            return
+        self.viewport.show_focus_overlay(depth, dof.near_m, dof.far_m, hold)
 
     def _exposure_changed(self, value: int) -> None:
         self.viewport.set_display(exposure=value / 10)
@@ -839,10 +856,10 @@ class MainWindow(QMainWindow):
         fresh = g is not None and g.generation >= self._structure_generation  # its node numbers are today's
         distance = editing.focus_distance_for(self.doc.model, paths, g if fresh else None)
         if distance is None:
-            self.statusBar().showMessage("The selection is behind the camera", 4000)
+            self.statusBar().showMessage("The selection is behind the camera, or nearer than the lens focuses", 4000)
             return
         name = self.doc.model.node(paths[0]).name
-        self.doc.set_camera(f"Focus on {name}", False, focus_distance_m=distance)
+        self.camera_panel.set_focus(distance, text=f"Focus on {name}")
 
     # -- export -----------------------------------------------------------------------------------------------------
     def export_dialog(self) -> None:

@@ -462,18 +462,27 @@ class RenderWorker(QThread):
         """The preview pass tone-mapped at its own quarter size, then enlarged: RGBA8 at the viewport's size."""
         from lenslab.render.film import to_8bit, tone_map
 
-        if self._preview_display is None or self._preview_display[0] != self._display_settings:
-            rgb = to_8bit(tone_map(self._preview_image, *self._display_settings))
+        look = self._display_look()
+        if self._preview_display is None or self._preview_display[0] != look:
+            rgb = to_8bit(tone_map(self._preview_image, *look))
             rgba = np.concatenate([rgb, np.full(rgb.shape[:2] + (1,), 255, np.uint8)], axis=2)
             w, h = self._size
-            self._preview_display = (self._display_settings, upscale_nearest(rgba, w, h))
+            self._preview_display = (look, upscale_nearest(rgba, w, h))
         return self._preview_display[1]
+
+    def _display_look(self) -> tuple[float, str]:
+        """The viewport's exposure and tone curve, with the camera's own exposure added in the physical mode (so
+        a stop of aperture darkens the picture by a stop, as the exported file will be)."""
+        exposure, tone = self._display_settings
+        session = self._session
+        scale = session.camera.exposure_scale(session.frame.aperture.light_fraction)
+        return exposure + math.log2(scale), tone
 
     def _publish_session(self, converged: bool, with_linear: bool = False) -> None:
         from lenslab.render.film import resolve
 
         session = self._session
-        picture = session.display(*self._display_settings)
+        picture = session.display(*self._display_look())
         empty = picture[..., 3] == 0  # pixels the first full pass has not reached yet
         has_empty = bool(empty.any())
         if has_empty and self._preview_image is not None:

@@ -116,11 +116,6 @@ class ThinLensCamera:
             return float(depth_m)
         return sensor_distance_m(self.focal_length_mm, depth_m)
 
-    def distance_from_reference(self, depth_m):
-        """A depth ahead of the lens as this camera's focus scale would read it (adds the lens-to-sensor distance
-        when focus is measured from the sensor)."""
-        return depth_m + (self.image_distance_mm / MM_PER_M if self.focus_from == "sensor" else 0.0)
-
     def imaged_area_mm(self, width: int | None = None, height: int | None = None) -> tuple[float, float]:
         """The part of the sensor (mm) an image of ``width`` x ``height`` shows (default: the camera's own)."""
         width, height = int(width or self.resolution[0]), int(height or self.resolution[1])
@@ -151,9 +146,10 @@ class ThinLensCamera:
         return exposure_scale(self.f_number, self.shutter_s, self.iso, light_fraction)
 
     def depth_of_field(self, width: int | None = None, height: int | None = None,
-                       light_fraction: float = 1.0) -> DepthOfField:
+                       light_fraction: float = 1.0, reference: str | None = None) -> DepthOfField:
         """Near and far limits of acceptable sharpness and the hyperfocal distance, in the camera's focus
-        reference, for exactly the picture the renderer draws.
+        reference (or ``reference``: "lens" for depths along the view axis, as a depth buffer holds them), for
+        exactly the picture the renderer draws.
 
         A point at depth d ahead of the lens makes a blur disk of diameter ``c = A |d - s| / d * v / s`` on the
         sensor (A the aperture's diameter, s the plane of focus, v the lens-to-sensor distance); the limits are
@@ -170,9 +166,10 @@ class ThinLensCamera:
         # The hyperfocal distance: the focus whose blur at infinity is c. With v = f s / (s - f) that is
         # s = f + A f / c (the textbook H = f^2 / (N c) + f); with v = f it is A f / c.
         hyperfocal = aperture * f / c + (f if self.focus_breathing else 0.0)
-        reference_shift = v if self.focus_from == "sensor" else 0.0
+        from_sensor = (reference or self.focus_from) == "sensor"
+        reference_shift = v if from_sensor else 0.0
         near_m, far_m = (near + reference_shift) / MM_PER_M, (far + reference_shift) / MM_PER_M
-        if self.focus_from == "sensor":
+        if from_sensor:
             hyperfocal_m = (sensor_distance_m(f, hyperfocal / MM_PER_M) if self.focus_breathing
                             else (hyperfocal + f) / MM_PER_M)
         else:

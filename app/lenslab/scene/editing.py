@@ -150,7 +150,8 @@ def relative_file_name(path: Path, folder: Path) -> str:
 
 # -- focusing ---------------------------------------------------------------------------------------------------
 def focus_distance_for(model: EditableScene, paths: Iterable[tuple], gbuffer=None) -> float | None:
-    """The focus distance that makes the nodes at ``paths`` sharp, rounded to 0.1 mm.
+    """The focus distance (in the camera's reference: from the sensor or the lens) that makes the nodes at
+    ``paths`` sharp, rounded to 0.1 mm.
 
     With a depth buffer (``gbuffer``: per-pixel ``node_index`` and ``depth`` arrays, nodes numbered in
     ``model.node_paths()`` order, made since the node tree last changed), the median depth of the pixels the
@@ -168,9 +169,12 @@ def focus_distance_for(model: EditableScene, paths: Iterable[tuple], gbuffer=Non
             distance = float(np.median(gbuffer.depth[mask]))
     if distance is None:
         distance = model.scene.camera.frame().depth_of(world_matrix(model, paths[0])[:3, 3])
-    if distance <= FOCUS_DISTANCE_RANGE_M[0]:
+    camera = model.scene.camera
+    if distance <= FOCUS_DISTANCE_RANGE_M[0] or (camera.focus_from == "sensor" and distance <= camera.focal_length_mm
+                                                   / 1000):
         return None
-    return round(distance, 4)
+    setting = camera.focus_setting_for(distance)
+    return round(setting, 4) if setting >= camera.closest_focus_m else None
 
 
 # -- transforms ---------------------------------------------------------------------------------------------------
@@ -275,3 +279,29 @@ def _rounded(v, digits: int) -> tuple[float, ...]:
     """A point as plain floats, rounded so that the property editor shows what was meant (0.3, not
     0.30000000000000004)."""
     return tuple(float(round(c, digits)) for c in v)
+
+
+# -- the camera ---------------------------------------------------------------------------------------------------
+def closest_focus(camera, lens=None) -> float:
+    """The nearest focus distance (in the camera's reference) the camera can set: the thin lens's limit, and a
+    mounted lens's marked minimum (which is from the sensor plane)."""
+    closest = camera.closest_focus_m
+    if lens is not None and lens.min_focus_distance_m is not None:
+        limit = lens.min_focus_distance_m
+        if camera.focus_from == "lens":  # the plane the sensor-side reading puts in focus
+            from lenslab.optics.thinlens import object_distance_m
+
+            limit = object_distance_m(camera.focal_length_mm, max(limit, 4 * camera.focal_length_mm / 1000))
+        closest = max(closest, limit)
+    return closest
+
+
+def camera_changes_keeping_focus(camera, lens=None, **changes) -> dict:
+    """``changes`` to the camera, plus the focus moved out to the closest the new camera can focus if it was
+    nearer (a longer focal length or a lens with a farther minimum cannot focus as close): the camera stays one
+    the renderer can draw, and the user sees why in the focus field."""
+    changed = dataclasses.replace(camera, **changes)
+    closest = closest_focus(changed, lens)
+    if changed.focus_distance_m < closest:
+        changes = {**changes, "focus_distance_m": math.ceil(closest * 1e4) / 1e4}
+    return changes

@@ -1,0 +1,124 @@
+"""The studio's side of a real camera's controls: stop scales, focus limits, the new optics and exposure."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from lenslab.color import srgb_to_linear
+
+from .helpers import wait_for_frame
+
+pytestmark = pytest.mark.gl
+
+
+def stops_moved(before: float, after: float) -> float:
+    return 2 * math.log2(after / before)
+
+
+@pytest.mark.parametrize("scale, fraction", [("third", 1 / 3), ("half", 1 / 2), ("full", 1.0)])
+def test_one_key_press_is_one_step_of_the_chosen_scale(window, settings, scale, fraction):
+    panel = window.camera_panel
+    panel.stop_scale_combo.setCurrentIndex(-1)  # so that choosing the default is a change too
+    panel.stop_scale_combo.setCurrentIndex(panel.stop_scale_combo.findData(scale))
+    assert settings.value("camera/stop_scale") == scale
+    window.actions["stop_down"].trigger()  # from f/1.8, a value between marks: onto the next mark
+    for _ in range(3):
+        before = window.doc.scene.camera.f_number
+        window.actions["stop_down"].trigger()
+        assert stops_moved(before, window.doc.scene.camera.f_number) == pytest.approx(fraction)
+    # The slider's labels and the combo show marks; the camera holds exact values.
+    assert panel.aperture_combo.currentText() in {f"f/{m:g}" for m in (2.8, 3.3, 4, 5.6, 8, 11, 4.5, 5, 3.2)}
+    window.actions["open_up"].trigger()
+    assert window.doc.scene.camera.f_number == pytest.approx(before)
+
+
+def test_focus_nearer_than_the_lens_is_refused_and_a_longer_lens_moves_it_out(window, qtbot):
+    panel = window.camera_panel
+    messages = []
+    panel.status_message.connect(messages.append)
+    lens = next(lens for lens in panel.lenses if lens.name == "85 mm f/1.4")
+    panel.choose_lens(lens)
+    assert panel.focus_limits()[0] == pytest.approx(0.8)
+    before = window.doc.scene.camera.focus_distance_m
+    assert not panel.set_focus(0.5)
+    assert window.doc.scene.camera.focus_distance_m == before
+    assert "85 mm f/1.4 focuses no nearer than 80.0 cm from the sensor" in messages[-1]
+    assert panel.set_focus(0.9)
+    # Free, 50 mm at 0.25 m: a 200 mm lens cannot focus there (four focal lengths), so zooming moves it out.
+    panel.choose_lens(None)
+    panel.set_focal_length(50.0, False)
+    assert panel.set_focus(0.25)
+    panel.set_focal_length(200.0, False)
+    cam = window.doc.scene.camera
+    assert cam.focal_length_mm == 200.0 and cam.focus_distance_m == pytest.approx(0.8)
+    assert "Focus moved out" in messages[-1]
+    window.doc.undo_stack.undo()  # one undo step puts both back
+    assert (window.doc.scene.camera.focal_length_mm, window.doc.scene.camera.focus_distance_m) == (50.0, 0.25)
+
+
+def test_the_new_controls_edit_the_camera_and_undo(window, tmp_path):
+    panel = window.camera_panel
+    cam = window.doc.scene.camera
+    edits = [(panel.curvature, "blade_curvature", 0.6), (panel.squeeze, "anamorphic_squeeze", 1.8),
+             (panel.barrel, "barrel_clipping", 0.4), (panel.coc, "circle_of_confusion_mm", 0.02)]
+    for widget, field, value in edits:
+        widget.setValue(value)
+        assert getattr(window.doc.scene.camera, field) == pytest.approx(value), field
+    panel.coc.setValue(0.0)  # "auto"
+    assert window.doc.scene.camera.circle_of_confusion_mm is None
+    panel.sensor_fit.setCurrentIndex(panel.sensor_fit.findData("fill"))
+    assert window.doc.scene.camera.sensor_fit == "fill"
+    panel.breathing.setChecked(False)
+    assert window.doc.scene.camera.focus_breathing is False
+    plane = window.doc.scene.camera.plane_of_focus_m
+    panel.focus_from.setCurrentIndex(panel.focus_from.findData("lens"))
+    assert window.doc.scene.camera.focus_from == "lens"
+    assert window.doc.scene.camera.plane_of_focus_m == pytest.approx(plane)  # the plane of focus stays
+    for _ in range(9):
+        window.doc.undo_stack.undo()
+    assert window.doc.scene.camera == cam
+
+
+def test_a_missing_aperture_image_keeps_the_stop_and_says_why(window, tmp_path):
+    import OpenImageIO as oiio
+
+    panel = window.camera_panel
+    messages = []
+    panel.status_message.connect(messages.append)
+    panel.set_aperture_image(str(tmp_path / "nosuch.png"))
+    assert window.doc.scene.camera.aperture_image == "" and "aperture image not found" in messages[-1]
+    star = tmp_path / "mask.exr"
+    out = oiio.ImageOutput.create(str(star))
+    out.open(str(star), oiio.ImageSpec(8, 8, 1, oiio.FLOAT))
+    mask = np.zeros((8, 8), np.float32)
+    mask[2:6, 2:6] = 1.0
+    out.write_image(mask)
+    out.close()
+    panel.set_aperture_image(str(star))
+    assert window.doc.scene.camera.aperture_image == str(star)
+    assert panel.light_fraction() == pytest.approx(4 * 0.25 / math.pi)
+    assert "passing 32%" in panel.aperture_info.text()
+
+
+def test_physical_exposure_darkens_the_picture_a_stop_per_stop(window, qtbot):
+    window.viewport.set_display(exposure=0.0, operator="clamp")
+    window.controller.set_display(0.0, "clamp")
+
+    def picture(f_number: float, mode: str) -> np.ndarray:
+        with qtbot.waitSignal(window.controller.restarted, timeout=5000) as restart:
+            window.doc.set_camera("test", False, f_number=f_number, exposure_mode=mode, iso=100.0, shutter_s=4.0)
+        return wait_for_frame(qtbot, window, min_spp=16, generation=restart.args[0]).display[..., :3]
+
+    def ratio(a: np.ndarray, b: np.ndarray) -> float:
+        """Mean linear radiance of a over b, where neither is clipped (the lamp is)."""
+        unclipped = (a.max(axis=2) < 250) & (b.max(axis=2) < 250)
+        return float(srgb_to_linear(a[unclipped] / 255.0).mean() / srgb_to_linear(b[unclipped] / 255.0).mean())
+
+    physical = ratio(picture(2 ** 1.5, "physical"), picture(4.0, "physical"))
+    assert "f/4 · focus" in window.viewport.hud_text and window.viewport.hud_text.endswith("4 s · ISO 100")
+    compensated = ratio(picture(2 ** 1.5, "compensated"), picture(4.0, "compensated"))
+    assert physical == pytest.approx(2.0, rel=0.12)
+    assert compensated == pytest.approx(1.0, rel=0.08)
