@@ -184,9 +184,22 @@ def test_a_shutter_bracket_and_the_camera_controls_of_a_shot(tmp_path):
 
 @pytest.mark.parametrize("entry, message", [
     ('shutter = "forever"', "shutter: not a shutter time: 'forever'"),
-    ("blades = 2", "aperture_blades must be 0 (round) or at least 3"),
-    ("anamorphic = 9.0", "anamorphic_squeeze 9.0 is out of range [0.25, 4]"),
-    ('sensor = "super 8"', "no sensor preset called 'super 8'"),
+    ("blades = 2", "shot 1: blades must be 0 (round) or at least 3"),
+    ("blades = 2.5", "shot 1: blades: expected a whole number, not 2.5"),
+    ("anamorphic = 9.0", "shot 1: anamorphic 9.0 is out of range [0.25, 4]"),
+    ("coc = 0", "shot 1: coc 0.0 is out of range [0.0005, 1]"),
+    ("blade_curvature = [0.5, 2]", "shot 1, blade_curvature 2: blade_curvature 2.0 is out of range [0, 1]"),
+    ("barrel_clipping = -1", "shot 1: barrel_clipping -1.0 is out of range [0, 1]"),
+    ("iso = 0", "shot 1: iso 0.0 is out of range"),
+    ('shutter = "1/0"', "shot 1: shutter: not a shutter time: '1/0'"),
+    ("shutter = 5000", "shot 1: shutter 5000.0 is out of range"),
+    ('sensor = "super 8"', "shot 1: no sensor preset called 'super 8'"),
+    ('sensor_fit = "stretch"', "shot 1: sensor_fit 'stretch' is not one of auto, horizontal"),
+    ('focus_from = "film"', "shot 1: focus_from 'film' is not one of sensor, lens"),
+    ('exposure_mode = "auto"', "shot 1: exposure_mode 'auto' is not one of compensated, physical"),
+    ('focus_breathing = "no"', "shot 1: focus_breathing: expected true or false, not 'no'"),
+    ("focus_breathing = {from = 0, to = 1, steps = 2}", "shot 1: focus_breathing: expected true or false, not a table"),
+    ('sensor = {from = 1, to = 2, steps = 2}', "shot 1: sensor: expected a string, not a table"),
 ])
 def test_bad_camera_controls_in_a_batch_name_the_shot(tmp_path, entry, message):
     assert message in error(tmp_path, f"""
@@ -195,3 +208,62 @@ def test_bad_camera_controls_in_a_batch_name_the_shot(tmp_path, entry, message):
         output = "a.png"
         {entry}
         """)
+
+
+def test_sweeps_over_the_camera_controls_name_and_file_each_shot(tmp_path):
+    shots = batch(tmp_path, """
+        [[shots]]
+        name = "bracket"
+        scene = "cornell_box"
+        output = "s_{shutter}_{sensor}.exr"
+        shutter = {from = "1/500", to = "1/125", steps = 3, spacing = "geometric"}
+        sensor = ["Full frame", "APS-C"]
+        [[shots]]
+        name = "stops"
+        scene = "cornell_box"
+        output = "b_{blades}_{anamorphic}_{index}.png"
+        blades = [0, 6]
+        anamorphic = [1, 2]
+        focus_breathing = [true, false]
+        exposure_mode = "physical"
+        """).shots
+    bracket, stops = shots[:6], shots[6:]
+    assert [s.output.name for s in bracket] == ["s_1_500_Full_frame.exr", "s_1_500_APS-C.exr", "s_1_250_Full_frame.exr",
+                                                "s_1_250_APS-C.exr", "s_1_125_Full_frame.exr", "s_1_125_APS-C.exr"]
+    assert [s.overrides.shutter_s for s in bracket[::2]] == pytest.approx([1 / 500, 1 / 250, 1 / 125])
+    assert bracket[1].name == "bracket 1/500 s, APS-C"
+    assert all(s.overrides.exposure_mode == "physical" for s in bracket)  # a shutter alone means it
+    assert len(stops) == 8 and stops[0].name == "stops blades 0, anamorphic 1, focus_breathing true"
+    assert [(s.overrides.aperture_blades, s.overrides.anamorphic_squeeze, s.overrides.focus_breathing)
+            for s in stops[:2]] == [(0, 1.0, True), (0, 1.0, False)]
+    assert stops[-1].output.name == "b_6_2_8.png" and stops[-1].overrides.exposure_mode == "physical"
+
+
+def test_an_aperture_image_is_read_beside_the_batch_file(tmp_path):
+    (shot,) = batch(tmp_path, """
+        [[shots]]
+        scene = "cornell_box"
+        output = "a.exr"
+        aperture_image = "stops/star.png"
+        sensor_fit = "overscan"
+        focus_from = "lens"
+        coc = 0.02
+        barrel_clipping = 0.5
+        """).shots
+    overrides = shot.overrides
+    assert overrides.aperture_image == str(tmp_path / "stops" / "star.png")
+    assert (overrides.sensor_fit, overrides.focus_from, overrides.circle_of_confusion_mm) == ("overscan", "lens", 0.02)
+    camera = overrides.apply(open_scene("cornell_box")).camera
+    assert (camera.aperture_image, camera.barrel_clipping) == (str(tmp_path / "stops" / "star.png"), 0.5)
+
+
+def test_a_shot_focused_nearer_than_its_lens_fails_when_its_scene_is_opened(tmp_path):
+    (shot,) = batch(tmp_path, """
+        [[shots]]
+        scene = "cornell_box"
+        output = "a.exr"
+        lens = "85mm f/1.4"
+        focus_distance = 0.5
+        """).shots
+    with pytest.raises(ValueError, match=r"nearer than the lens '85 mm f/1.4' focuses \(minimum 80.0 cm\)"):
+        shot.open_scene()

@@ -330,15 +330,27 @@ def test_a_lens_mounts_and_focus_nearer_than_it_can_is_refused(renderer, tmp_pat
     ("--iso", "-3", "out of range"),
     ("--sensor-fit", "stretch", "invalid choice: 'stretch'"),
     ("--f-stop", "f/0.2", "f-number out of range"),
+    ("--f-stop", "wide", "wide"),
+    ("--blades", "33", "out of range [0, 32]"),
+    ("--barrel-clipping", "2", "out of range [0, 1]"),
+    ("--coc", "0", "out of range [0.0005, 1]"),
+    ("--focus-from", "film", "invalid choice: 'film'"),
+    ("--exposure-mode", "auto", "invalid choice: 'auto'"),
+    ("--shutter", "1/0", "not a shutter time: '1/0'"),
+    ("--aperture-image", "no_such_star.png", "no such file: no_such_star.png"),
 ])
 def test_nonsense_camera_values_are_one_usage_line(capsys, flag, value, message):
     status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", "x.png", flag, value)
     assert status == 2 and message in err and err.count("\n") == 1 and flag in err
 
 
-def test_an_unknown_sensor_names_the_ones_there_are(capsys, tmp_path):
+def test_an_unknown_sensor_or_lens_names_the_ones_there_are(capsys, tmp_path):
     status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.png", "--sensor", "super 8")
-    assert status == 1 and "no sensor preset called 'super 8' (there are: " in err and "APS-C" in err
+    assert status == 2 and err.count("\n") == 1
+    assert "argument --sensor: no sensor preset called 'super 8' (there are: " in err and "APS-C" in err
+    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.png", "--lens", "400mm")
+    assert status == 2 and err.count("\n") == 1
+    assert "argument --lens: no lens preset called '400mm' (there are: " in err and "85 mm f/1.4" in err
 
 
 def test_the_presets_are_listed(capsys):
@@ -346,3 +358,85 @@ def test_the_presets_are_listed(capsys):
     assert status == 0 and "85 mm f/1.4" in out and "f/1.4 to f/16" in out and "80.0 cm" in out
     status, out, _ = run_cli(capsys, "--list-sensors")
     assert status == 0 and "APS-C" in out and "23.5 x 15.6 mm" in out and "1.53x" in out and "29 µm" in out
+
+
+def _camera(*argv):
+    """The camera the command line would render: the arguments parsed and applied to the Cornell box."""
+    from lenslab.cli import build_parser, scene_overrides
+    from lenslab.scene.io.loader import open_scene
+
+    return scene_overrides(build_parser().parse_args(["cornell_box", *argv])).apply(open_scene("cornell_box")).camera
+
+
+def test_each_camera_flag_reaches_the_camera(tmp_path, monkeypatch):
+    from lenslab.optics.stops import exact_f_number
+
+    (tmp_path / "star.png").write_bytes(b"")  # only its name travels; the renderer reads it
+    monkeypatch.chdir(tmp_path)
+    cases = [
+        (["--sensor", "Micro Four Thirds"], "sensor_mm", (17.3, 13.0)),
+        (["--sensor-fit", "overscan"], "sensor_fit", "overscan"),
+        (["--focus-from", "lens"], "focus_from", "lens"),
+        (["--no-focus-breathing"], "focus_breathing", False),
+        (["--coc", "0.025"], "circle_of_confusion_mm", 0.025),
+        (["--blades", "0"], "aperture_blades", 0),
+        (["--blades", "9"], "aperture_blades", 9),
+        (["--blade-curvature", "0.25"], "blade_curvature", 0.25),
+        (["--anamorphic", "2"], "anamorphic_squeeze", 2.0),
+        (["--barrel-clipping", "0.75"], "barrel_clipping", 0.75),
+        (["--aperture-image", "star.png"], "aperture_image", str(tmp_path / "star.png")),
+        (["--exposure-mode", "physical"], "exposure_mode", "physical"),
+        (["--iso", "1600"], "iso", 1600.0),
+        (["--shutter", "1/125"], "shutter_s", 1 / 125),
+        (["--shutter", "0.5"], "shutter_s", 0.5),
+        (["--shutter", "2s"], "shutter_s", 2.0),
+        (["--f-stop", "f/11"], "f_number", exact_f_number(11)),  # the exact stop, 2^3.5
+        (["--f-stop", "2.8"], "f_number", exact_f_number(2.8)),
+        (["--lens", "135mm f/2"], "focal_length_mm", 135.0),
+    ]
+    for argv, field_name, expected in cases:
+        assert getattr(_camera(*argv), field_name) == pytest.approx(expected), argv
+    assert _camera("--f-stop", "f/11").f_number == pytest.approx(2 ** 3.5)
+    assert _camera("--no-focus-breathing").focus_breathing is False and _camera().focus_breathing is True
+    mounted = _camera("--lens", "24-70 mm f/2.8", "--focal-length", "35", "--f-stop", "4")
+    assert (mounted.focal_length_mm, mounted.f_number, mounted.aperture_blades) == (35.0, 4.0, 9)
+    assert mounted.blade_curvature == pytest.approx(0.6)
+
+
+@pytest.mark.parametrize("argv, mode", [(["--iso", "400"], "physical"), (["--shutter", "1/60"], "physical"),
+                                        (["--iso", "400", "--exposure-mode", "compensated"], "compensated"),
+                                        ([], "compensated")])
+def test_an_iso_or_a_shutter_switches_to_a_physical_exposure(argv, mode):
+    assert _camera(*argv).exposure_mode == mode
+
+
+def test_settings_a_lens_does_not_have_are_one_usage_line(capsys):
+    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", "x.png", "--lens", "85mm f/1.4",
+                             "--f-stop", "1.2")
+    assert status == 2 and err.count("\n") == 1
+    assert err.startswith("lenslab: error: f/1.2 is not on the lens '85 mm f/1.4' (f/1.4 to f/16)")
+
+
+def test_a_focus_from_the_lens_nearer_than_the_lens_focuses_is_refused(capsys, tmp_path):
+    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "a.png", *SMALL,
+                             "--lens", "135 mm f/2", "--focus-from", "lens", "--focus-distance", "0.7")
+    assert status == 1 and err.count("\n") == 1
+    assert "focus 70.0 cm from the lens (" in err and "nearer than the lens '135 mm f/2' focuses (minimum 90.0 cm" in err
+    assert not (tmp_path / "a.png").exists()
+
+
+def test_the_listed_presets_are_the_shipped_ones(capsys):
+    from lenslab.optics import load_lens_presets, load_sensor_presets
+
+    status, out, err = run_cli(capsys, "--list-lenses")
+    lines = out.splitlines()
+    assert status == 0 and not err and lines[0].split() == ["lens", "focal", "length", "stops", "blades", "closest",
+                                                            "focus"]
+    assert [line.startswith(lens.name + " ") for line, lens in zip(lines[1:], load_lens_presets())] == \
+        [True] * len(load_lens_presets()) and len(lines) == 1 + len(load_lens_presets())
+    assert "70-200 mm" in out and "f/2.8 to f/22" in out
+    status, out, err = run_cli(capsys, "--list-sensors")
+    lines = out.splitlines()
+    assert status == 0 and not err and len(lines) == 1 + len(load_sensor_presets())
+    assert all(line.startswith(sensor.name + " ") for line, sensor in zip(lines[1:], load_sensor_presets()))
+    assert "Full frame" in out and "36 x 24 mm" in out and "1.00x" in out

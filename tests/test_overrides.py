@@ -61,3 +61,102 @@ def test_a_setting_the_lens_does_not_have_is_refused(bad, message):
     with pytest.raises(ValueError) as caught:
         SceneOverrides(**bad)
     assert message in str(caught.value)
+
+
+# -- every camera control (issue 13) --------------------------------------------------------------------------
+def test_every_camera_control_reaches_the_camera(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    changed = SceneOverrides(sensor="aps-c", sensor_fit="fill", focus_from="lens", focus_breathing=False,
+                             circle_of_confusion_mm=0.02, aperture_blades=6, blade_curvature=0.5,
+                             anamorphic_squeeze=1.5, barrel_clipping=0.3, aperture_image="star.png",
+                             exposure_mode="physical", iso=800.0, shutter_s=1 / 30).apply(open_scene("cornell_box"))
+    camera = changed.camera
+    assert camera.sensor_mm == (23.5, 15.6) and camera.sensor_fit == "fill"
+    assert (camera.focus_from, camera.focus_breathing, camera.circle_of_confusion_mm) == ("lens", False, 0.02)
+    assert (camera.aperture_blades, camera.blade_curvature, camera.anamorphic_squeeze) == (6, 0.5, 1.5)
+    assert camera.barrel_clipping == 0.3
+    assert camera.aperture_image == str(tmp_path / "star.png")  # the working folder's, made absolute
+    assert (camera.exposure_mode, camera.iso, camera.shutter_s) == ("physical", 800.0, 1 / 30)
+
+
+@pytest.mark.parametrize("given, mode", [({"iso": 400.0}, "physical"), ({"shutter_s": 0.5}, "physical"),
+                                         ({"iso": 400.0, "exposure_mode": "compensated"}, "compensated"),
+                                         ({}, "compensated")])
+def test_an_iso_or_a_shutter_means_a_physical_exposure(given, mode):
+    assert SceneOverrides(**given).apply(open_scene("cornell_box")).camera.exposure_mode == mode
+
+
+def test_a_sensor_brings_its_own_circle_of_confusion_or_the_diagonal_rule(tmp_path, monkeypatch):
+    scene = open_scene("cornell_box")
+    scene.camera.circle_of_confusion_mm = 0.03  # the old sensor's: not the new one's
+    assert SceneOverrides(sensor="Micro Four Thirds").apply(scene).camera.circle_of_confusion_mm is None
+    assert SceneOverrides(sensor="APS-C", circle_of_confusion_mm=0.015).apply(scene).camera.circle_of_confusion_mm \
+        == 0.015  # given with it: the one given
+    user = tmp_path / "config" / "lenslab" / "presets"
+    user.mkdir(parents=True)
+    (user / "sensors.json").write_text('{"sensors": [{"name": "Super 35 (cinema)", "width_mm": 24.89, '
+                                       '"height_mm": 18.66, "circle_of_confusion_mm": 0.025}]}')
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "config"))
+    camera = SceneOverrides(sensor="super 35 (cinema)").apply(scene).camera
+    assert (camera.sensor_mm, camera.circle_of_confusion_mm) == ((24.89, 18.66), 0.025)
+
+
+def test_a_lens_mounts_its_blade_roundness_as_curvature():
+    camera = SceneOverrides(lens="85 mm f/1.4").apply(open_scene("cornell_box")).camera
+    assert (camera.aperture_blades, camera.blade_curvature) == (11, 0.8)
+    straight = SceneOverrides(lens="85 mm f/1.4", blade_curvature=0.0).apply(open_scene("cornell_box")).camera
+    assert straight.blade_curvature == 0.0  # given with the lens: the one given
+
+
+def _focused(**given):
+    scene = open_scene("cornell_box")
+    return SceneOverrides(**given).apply(scene).camera
+
+
+def test_a_lens_focuses_no_nearer_than_its_minimum_from_the_sensor():
+    assert _focused(lens="85mm f/1.4", focus_distance_m=0.8).focus_distance_m == 0.8  # the minimum itself
+    with pytest.raises(ValueError) as caught:
+        _focused(lens="85mm f/1.4", focus_distance_m=0.79)
+    assert str(caught.value) == ("focus 79.0 cm from the sensor is nearer than the lens '85 mm f/1.4' focuses "
+                                 "(minimum 80.0 cm)")
+    with pytest.raises(ValueError, match="minimum 80.0 cm"):  # holding the framing does not move the sensor mark
+        _focused(lens="85mm f/1.4", focus_distance_m=0.79, focus_breathing=False)
+
+
+def test_a_focus_measured_from_the_lens_is_compared_from_the_sensor():
+    # 0.72 m ahead of an 85 mm lens: the sensor is 96.4 mm behind it, 81.6 cm from the plane of focus.
+    assert _focused(lens="85mm f/1.4", focus_from="lens", focus_distance_m=0.72).focus_distance_m == 0.72
+    for breathing in (True, False):
+        with pytest.raises(ValueError) as caught:
+            _focused(lens="85mm f/1.4", focus_from="lens", focus_distance_m=0.6, focus_breathing=breathing)
+        assert str(caught.value) == ("focus 60.0 cm from the lens (69.9 cm from the sensor) is nearer than the lens "
+                                     "'85 mm f/1.4' focuses (minimum 80.0 cm from the sensor)")
+
+
+def test_nothing_nearer_than_the_thin_lens_can_focus():
+    with pytest.raises(ValueError, match=r"nearer than a 200 mm lens can focus: at least 80\.0 cm"):
+        _focused(focal_length_mm=200.0, focus_distance_m=0.5)
+    with pytest.raises(ValueError, match="nearer than a 50 mm lens can focus"):
+        _focused(focal_length_mm=50.0, focus_from="lens", focus_distance_m=0.04)
+    with pytest.raises(ValueError, match="nearer than a 50 mm lens can focus"):  # a lens without a marked minimum
+        _focused(lens="50mm f/1.2", focus_from="lens", focus_distance_m=0.04)
+
+
+@pytest.mark.parametrize("bad, message", [
+    ({"sensor": "super 8"}, "no sensor preset called 'super 8'"),
+    ({"sensor_fit": "stretch"}, "sensor_fit 'stretch' is not one of auto, horizontal"),
+    ({"focus_from": "film"}, "focus_from 'film' is not one of sensor, lens"),
+    ({"exposure_mode": "auto"}, "exposure_mode 'auto' is not one of compensated, physical"),
+    ({"circle_of_confusion_mm": 2.0}, "circle_of_confusion_mm 2.0 is out of range"),
+    ({"aperture_blades": 2}, "aperture_blades must be 0 (round) or at least 3"),
+    ({"aperture_blades": 40}, "aperture_blades 40 is out of range [0, 32]"),
+    ({"blade_curvature": 1.5}, "blade_curvature 1.5 is out of range [0, 1]"),
+    ({"anamorphic_squeeze": 0.1}, "anamorphic_squeeze 0.1 is out of range [0.25, 4]"),
+    ({"barrel_clipping": -0.5}, "barrel_clipping -0.5 is out of range [0, 1]"),
+    ({"iso": 0.0}, "iso 0.0 is out of range"),
+    ({"shutter_s": 1e5}, "shutter_s 100000.0 is out of range"),
+])
+def test_nonsense_camera_controls_are_refused_by_name(bad, message):
+    with pytest.raises(ValueError) as caught:
+        SceneOverrides(**bad)
+    assert message in str(caught.value)

@@ -79,6 +79,32 @@ def _shutter_argument(text: str) -> float:
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
+def _preset_argument(find):
+    """An argparse type: the name of a lens or sensor preset there is (the name as given: the scene overrides
+    look it up again). A preset file that cannot be read is an error of its own, not a usage error."""
+    from lenslab.optics.presetfiles import PresetError
+
+    def parse(text: str) -> str:
+        try:
+            find(text)
+        except PresetError as exc:
+            raise CliError(str(exc)) from None
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+        return text
+
+    return parse
+
+
+def _aperture_image_argument(text: str) -> str:
+    """A file of the stop's shape, relative to the current folder: made absolute, as the scene reads its own
+    aperture image relative to the scene's folder."""
+    path = Path(text).expanduser()
+    if not path.is_file():
+        raise argparse.ArgumentTypeError(f"no such file: {text}")
+    return str(path.resolve())
+
+
 def _blades_argument(text: str) -> int:
     from lenslab.optics.lenses import MAX_APERTURE_BLADES
 
@@ -89,6 +115,8 @@ def _blades_argument(text: str) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from lenslab.optics.lenses import find_lens
+    from lenslab.optics.sensors import find_sensor
     from lenslab.scene.camera import MAX_IMAGE_SIDE, ThinLensCamera
     from lenslab.scene.io.loader import shipped_scene_names
     from lenslab.scene.scene import RenderSettings
@@ -101,10 +129,12 @@ def build_parser() -> argparse.ArgumentParser:
         "  lenslab cornell_box --headless -o cornell.png --spp 64\n"
         "  lenslab my_scene.json --headless -o shot.exr --f-stop 1.4 --focus-distance 2.5 --time-limit 60\n"
         "  lenslab product_shot --headless -o p.exr --lens '85mm f/1.4' --f-stop 2 --iso 400 --shutter 1/60\n"
-        "The camera settings override the scene's camera for this render only. A marked stop (--f-stop 11) is the "
-        "exact stop (2^3.5); focus is measured from the sensor plane unless the scene says otherwise. In the "
-        "default compensated exposure brightness does not change with the f-number; with --iso or --shutter "
-        "each stop is a stop of light. Lenses and sensors: --list-lenses, --list-sensors. Shipped scenes: " + ", ".join(shipped_scene_names()) + ".\n"
+        "The camera settings override the scene's camera for this render only. A marked stop (--f-stop 11) is\n"
+        "the exact stop (2^3.5); focus is measured from the sensor plane unless the scene says otherwise, and a\n"
+        "mounted lens focuses no nearer than its minimum. In the default compensated exposure brightness does not\n"
+        "change with the f-number; with --iso or --shutter each stop is a stop of light.\n"
+        "Lenses and sensors: --list-lenses, --list-sensors.\n"
+        "Shipped scenes: " + ", ".join(shipped_scene_names()) + ".\n"
         "Render many shots (brackets, focus stacks, a farm): lenslab batch --help.\n"
         "Compare with Mitsuba 3: lenslab validate --help.\n",
         formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -125,10 +155,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--focus-distance", type=_declared(float, ThinLensCamera, "focus_distance_m"), metavar="M",
                    help="distance to the plane of focus, in metres")
     camera = p.add_argument_group("camera and lens")
-    camera.add_argument("--lens", metavar="NAME", help="mount a lens preset: its focal lengths, stops, iris and "
-                        "minimum focus (see --list-lenses)")
-    camera.add_argument("--sensor", metavar="NAME", help="a sensor preset: its size and circle of confusion "
-                        "(see --list-sensors)")
+    camera.add_argument("--lens", type=_preset_argument(find_lens), metavar="NAME",
+                        help="mount a lens preset: its focal lengths, stops, iris and minimum focus "
+                             "(see --list-lenses)")
+    camera.add_argument("--sensor", type=_preset_argument(find_sensor), metavar="NAME",
+                        help="a sensor preset: its size and circle of confusion (see --list-sensors)")
     camera.add_argument("--sensor-fit", choices=declared_choices(ThinLensCamera, "sensor_fit"),
                         help="which part of the sensor the image shows (auto: the long sides together)")
     camera.add_argument("--focus-from", choices=declared_choices(ThinLensCamera, "focus_from"),
@@ -144,7 +175,8 @@ def build_parser() -> argparse.ArgumentParser:
                         metavar="SQUEEZE", help="anamorphic squeeze: bokeh height over width (e.g. 1.33, 2)")
     camera.add_argument("--barrel-clipping", type=_declared(float, ThinLensCamera, "barrel_clipping"), metavar="C",
                         help="cat's-eye bokeh toward the frame's corners, 0 to 1")
-    camera.add_argument("--aperture-image", metavar="FILE", help="a grayscale image of the stop (custom bokeh)")
+    camera.add_argument("--aperture-image", type=_aperture_image_argument, metavar="FILE",
+                        help="a grayscale image of the stop (custom bokeh), relative to the current folder")
     camera.add_argument("--exposure-mode", choices=declared_choices(ThinLensCamera, "exposure_mode"),
                         help="compensated (brightness kept) or physical (each stop a stop of light)")
     camera.add_argument("--iso", type=_declared(float, ThinLensCamera, "iso"), metavar="S",
@@ -222,17 +254,23 @@ def _warn(message: str) -> None:
 
 def scene_overrides(args):
     """The command line's settings for this render, on top of the scene's own (headless and studio alike)."""
+    from lenslab.optics.presetfiles import PresetError
     from lenslab.scene.overrides import SceneOverrides
 
-    return SceneOverrides(f_number=args.f_stop, focal_length_mm=args.focal_length,
-                          focus_distance_m=args.focus_distance, width=args.width, height=args.height, spp=args.spp,
-                          seed=args.seed, max_depth=args.max_depth, sampler=args.sampler, clamp=args.clamp,
-                          lens=args.lens, sensor=args.sensor, sensor_fit=args.sensor_fit, focus_from=args.focus_from,
-                          focus_breathing=args.focus_breathing, circle_of_confusion_mm=args.coc,
-                          aperture_blades=args.blades, blade_curvature=args.blade_curvature,
-                          anamorphic_squeeze=args.anamorphic, barrel_clipping=args.barrel_clipping,
-                          aperture_image=args.aperture_image, exposure_mode=args.exposure_mode, iso=args.iso,
-                          shutter_s=args.shutter, defines=parse_defines(args.defines))
+    try:
+        return SceneOverrides(
+            f_number=args.f_stop, focal_length_mm=args.focal_length, focus_distance_m=args.focus_distance,
+            width=args.width, height=args.height, spp=args.spp, seed=args.seed, max_depth=args.max_depth,
+            sampler=args.sampler, clamp=args.clamp, lens=args.lens, sensor=args.sensor, sensor_fit=args.sensor_fit,
+            focus_from=args.focus_from, focus_breathing=args.focus_breathing, circle_of_confusion_mm=args.coc,
+            aperture_blades=args.blades, blade_curvature=args.blade_curvature, anamorphic_squeeze=args.anamorphic,
+            barrel_clipping=args.barrel_clipping, aperture_image=args.aperture_image,
+            exposure_mode=args.exposure_mode, iso=args.iso, shutter_s=args.shutter,
+            defines=parse_defines(args.defines))
+    except PresetError:
+        raise
+    except ValueError as exc:  # settings that do not go together (f/1.2 on an f/1.4 lens): a usage error
+        raise CliError(f"{exc} (see lenslab --help)", EXIT_USAGE) from None
 
 
 def _progress_display():

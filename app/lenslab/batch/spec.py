@@ -49,7 +49,7 @@ _OVERRIDE_KEYS = {  # batch key: SceneOverrides field
     "sensor": "sensor", "sensor_fit": "sensor_fit", "focus_from": "focus_from", "coc": "circle_of_confusion_mm",
     "blades": "aperture_blades", "blade_curvature": "blade_curvature", "anamorphic": "anamorphic_squeeze",
     "barrel_clipping": "barrel_clipping", "aperture_image": "aperture_image", "exposure_mode": "exposure_mode",
-    "iso": "iso", "shutter": "shutter_s",
+    "iso": "iso", "shutter": "shutter_s", "focus_breathing": "focus_breathing",
 }
 _KINDS = {
     "name": str, "scene": str, "output": str, "lens": str, "sampler": str, "tone_map": str,
@@ -58,7 +58,7 @@ _KINDS = {
     "sensor": str, "sensor_fit": str, "focus_from": str, "aperture_image": str, "exposure_mode": str,
     "coc": float, "blade_curvature": float, "anamorphic": float, "barrel_clipping": float, "iso": float,
     "shutter": float,  # seconds, or text as a camera shows it: "1/125"
-    "blades": int,
+    "blades": int, "focus_breathing": bool,
     "width": int, "height": int, "spp": int, "seed": int, "max_depth": int, "split": int,
     "defines": dict,
 }
@@ -182,14 +182,14 @@ def _values(key: str, raw, where: str) -> list:
             raise BatchError(f"{where}: {key}: an empty list sweeps over nothing")
         return [_scalar(key, value, where) for value in raw]
     if isinstance(raw, dict) and kind is not dict:
-        if key in _NOT_SWEPT or kind is str:
+        if key in _NOT_SWEPT or kind in (str, bool):
             raise BatchError(f"{where}: {key}: expected {_kind_name(kind)}, not a table")
         return _range(key, raw, where)
     return [_scalar(key, raw, where)]
 
 
 def _kind_name(kind) -> str:
-    return {str: "a string", float: "a number", int: "a whole number", dict: "a table"}[kind]
+    return {str: "a string", float: "a number", int: "a whole number", dict: "a table", bool: "true or false"}[kind]
 
 
 def _scalar(key: str, value, where: str):
@@ -203,6 +203,7 @@ def _scalar(key: str, value, where: str):
             raise BatchError(f"{where}: shutter: {exc}") from None
     ok = (isinstance(value, str) if kind is str else
           isinstance(value, dict) if kind is dict else
+          isinstance(value, bool) if kind is bool else
           isinstance(value, int) and not isinstance(value, bool) if kind is int else
           isinstance(value, (int, float)) and not isinstance(value, bool))
     if not ok:
@@ -273,6 +274,8 @@ def _describe(values: dict, keys) -> str:
         value = values[key]
         if isinstance(value, str):
             words.append(value if key in ("lens", "scene", "sensor") else f"{key} {value}")
+        elif isinstance(value, bool):
+            words.append(f"{key} {str(value).lower()}")
         elif key == "shutter":
             from lenslab.optics.exposure import format_shutter
 
@@ -281,6 +284,15 @@ def _describe(values: dict, keys) -> str:
             units = {"f_number": "f/{:g}", "focal_length": "{:g} mm", "focus_distance": "{:g} m", "iso": "ISO {:g}"}
             words.append(units.get(key, key + " {:g}").format(value))
     return ", ".join(words)
+
+
+def _in_batch_words(message: str) -> str:
+    """A scene override's message with its field named as the batch file names it ("anamorphic_squeeze 9 is out
+    of range" -> "anamorphic 9 is out of range")."""
+    for key, field_name in _OVERRIDE_KEYS.items():
+        if key != field_name and message.startswith(field_name + " "):
+            return key + message[len(field_name):]
+    return message
 
 
 def _shot(number: int, index: int, values: dict, swept: list[str], folder: Path, where: str) -> Shot:
@@ -296,7 +308,7 @@ def _shot(number: int, index: int, values: dict, swept: list[str], folder: Path,
                                       if key in values},
                                    defines={str(k): str(v) for k, v in values.get("defines", {}).items()})
     except ValueError as exc:
-        raise BatchError(f"{where}: {exc}") from None
+        raise BatchError(f"{where}: {_in_batch_words(str(exc))}") from None
     time_limit = values.get("time_limit")
     if time_limit is not None and not 0 < time_limit <= 1e7:
         raise BatchError(f"{where}: time_limit: {time_limit:g} s is out of range (0, 1e7]")
@@ -321,6 +333,10 @@ class _OutputFormatter(string.Formatter):
     lens's name "85 mm f/1.4" becomes 85_mm_f_1.4, safe in a file name."""
 
     def format_field(self, value, format_spec):
+        if isinstance(value, _ShutterTime) and not format_spec:  # 1/125 s is 1_125, 0.5 s is 0.5
+            from lenslab.optics.exposure import format_shutter
+
+            value = format_shutter(value).removesuffix(" s")
         if isinstance(value, float) and not format_spec:
             return f"{value:g}"
         if isinstance(value, str):
@@ -328,10 +344,16 @@ class _OutputFormatter(string.Formatter):
         return super().format_field(value, format_spec)
 
 
+class _ShutterTime(float):
+    """A shutter time in an output's name: written as the camera shows it (1_125 for 1/125 s)."""
+
+
 def _output_name(values: dict, index: int, where: str) -> str:
     template = values["output"]
     fields = {key: value for key, value in values.items() if key not in ("output", "defines")}
     fields["index"] = index
+    if "shutter" in fields:
+        fields["shutter"] = _ShutterTime(fields["shutter"])
     try:
         return _OutputFormatter().format(template, **fields)
     except KeyError as exc:

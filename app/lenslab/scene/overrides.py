@@ -15,7 +15,7 @@ from typing import Callable
 
 from lenslab.optics.lenses import find_lens
 from lenslab.optics.sensors import find_sensor
-from lenslab.optics.thinlens import format_distance
+from lenslab.optics.thinlens import format_distance, sensor_distance_m
 from lenslab.optics.stops import exact_f_number, format_f_number
 from lenslab.scene.camera import MAX_IMAGE_SIDE, ThinLensCamera
 from lenslab.scene.fields import declared_choices, declared_range
@@ -123,7 +123,7 @@ class SceneOverrides:
             camera_changes["resolution"] = self._resolution(scene.camera.resolution)
         render_changes = {name: getattr(self, name) for name in _RENDER_FIELDS if getattr(self, name) is not None}
         camera = dataclasses.replace(scene.camera, **camera_changes)
-        if self.lens is not None:
+        if self.lens is not None:  # the lens's marked minimum first: it says more than the thin-lens limit
             _check_minimum_focus(camera, find_lens(self.lens))
         camera.validate()  # nothing nearer than the thin lens can focus, whatever the lens
         return dataclasses.replace(scene, camera=camera, render=dataclasses.replace(scene.render, **render_changes))
@@ -138,13 +138,24 @@ class SceneOverrides:
 
 
 def _check_minimum_focus(camera: ThinLensCamera, lens) -> None:
-    """A lens focuses no nearer than its marked minimum, which is measured from the sensor plane."""
-    if lens.min_focus_distance_m is None:
+    """A lens focuses no nearer than its marked minimum, which is measured from the sensor plane: a camera that
+    measures focus from the lens is compared by the distance from the sensor of the plane it focuses on (the
+    lens's own extension, whether or not the framing is held)."""
+    if lens.min_focus_distance_m is None or camera.pinhole:
         return
-    from_sensor = camera.plane_of_focus_m + camera.image_distance_mm / 1000
+    minimum = format_distance(lens.min_focus_distance_m)
+    if camera.focus_from == "sensor":
+        from_sensor = float(camera.focus_distance_m)
+        said = f"focus {format_distance(from_sensor)} from the sensor"
+    else:
+        if camera.plane_of_focus_m * 1000.0 <= camera.focal_length_mm:
+            return  # within one focal length: no lens focuses there (validate says so)
+        from_sensor = sensor_distance_m(camera.focal_length_mm, camera.plane_of_focus_m)
+        said = (f"focus {format_distance(camera.focus_distance_m)} from the lens "
+                f"({format_distance(from_sensor)} from the sensor)")
+        minimum += " from the sensor"
     if from_sensor < lens.min_focus_distance_m * (1 - 1e-9):
-        raise ValueError(f"focus {format_distance(from_sensor)} from the sensor is nearer than the lens "
-                         f"'{lens.name}' focuses (minimum {format_distance(lens.min_focus_distance_m)})")
+        raise ValueError(f"{said} is nearer than the lens '{lens.name}' focuses (minimum {minimum})")
 
 
 def _declared_choices_or_none(cls: type, name: str):
