@@ -64,7 +64,7 @@ FOCUS_RANGE = (0.05, 200.0)
 
 def lens_short_name(lens: LensPreset) -> str:
     focal = (f"{lens.focal_range_mm[0]:g}-{lens.focal_range_mm[1]:g}" if lens.is_zoom else f"{lens.focal_length_mm:g}")
-    return f"{focal} f/{lens.widest_f_number:g}"
+    return f"{focal} {format_f_number(lens.widest_f_number)}"
 
 
 class IrisGlyph(QWidget):
@@ -782,7 +782,8 @@ class CameraPanel(QWidget):
             if lens is None:
                 self.lens_info.setText("Free: any focal length and aperture.")
             else:
-                self.lens_info.setText(f"{lens.name} · f/{lens.widest_f_number:g}–f/{lens.narrowest_f_number:g}"
+                self.lens_info.setText(f"{lens.name} · {format_f_number(lens.widest_f_number)}–"
+                                       f"{format_f_number(lens.narrowest_f_number)}"
                                        + (f" · {lens.aperture_blades} blades" if lens.aperture_blades else ""))
             # Aperture.
             scale = self.stop_scale()
