@@ -306,9 +306,15 @@ def test_stops_between():
 
 
 @pytest.mark.parametrize("n,expected", [(5.657, 5.6), (1.0, 1.4), (100, 22), (2.09, 2.0), (2.1, 2.2), (2.15, 2.2), (11.3, 11)])
-def test_nearest_stop(n, expected):
+def test_nearest_stop_on_the_marks(n, expected):
     # Distance is measured in stops: 2.1 is linearly midway between 2 and 2.2 but nearer 2.2 in log.
-    assert nearest_stop(n) == expected
+    assert nearest_stop(n, THIRD_STOPS) == expected
+
+
+@pytest.mark.parametrize("n,k", [(5.6, 15), (5.657, 15), (11, 21), (11.3, 21), (3.0, 10), (100, 40), (0.5, -3)])
+def test_nearest_stop_is_an_exact_third_stop(n, k):
+    assert nearest_stop(n) == pytest.approx(2 ** (k / 6), rel=1e-12)  # f/1 is k = 0; f/0.7 (k = -3) is the end
+    assert nearest_stop(n, "full") in STOP_SCALES["full"].exact
 
 
 @pytest.mark.parametrize(
@@ -319,16 +325,44 @@ def test_nearest_stop(n, expected):
         (3.0, 1, 3.2), (3.0, -1, 2.8), (3.0, 2, 3.5), (3.0, -2, 2.5),  # between marks
         (1.2, -1, 1.2), (1.2, 1, 1.4), (32, 1, 32), (32, -1, 22),  # beyond the ends
         (5.657, 0, 5.6),
+        (2 ** 1.5, 1, 3.2), (2 ** 3.5, -1, 10),  # an exact stop on a scale of marks is its mark
     ],
 )
-def test_step_stop(n, steps, expected):
-    assert step_stop(n, steps) == expected
+def test_step_stop_on_the_marks(n, steps, expected):
+    assert step_stop(n, steps, THIRD_STOPS) == expected
+
+
+@pytest.mark.parametrize(
+    "n,steps,k",
+    [
+        (2 ** 1.5, 1, 10), (2 ** 1.5, 3, 12), (2 ** 1.5, -3, 6), (2 ** 2.5, 6, 21),
+        (2.8, 1, 10), (5.6, 6, 21), (11, -1, 20),  # a mark is its exact stop
+        (2.8, -100, -3), (2.8, 100, 42), (128, 1, 42), (0.7, -1, -3),  # clamped to f/0.7 .. f/128
+        (3.0, 1, 10), (3.0, -1, 9), (3.0, 2, 11), (3.0, -2, 8),  # between marks: the next mark first
+        (0.6, -1, None), (0.6, 1, -3), (2.9, 0, 9),
+    ],
+)
+def test_step_stop_moves_between_exact_third_stops(n, steps, k):
+    expected = n if k is None else 2 ** (k / 6)
+    assert step_stop(n, steps) == pytest.approx(expected, rel=1e-12)
 
 
 def test_step_stop_on_a_custom_scale():
     lens_scale = (1.2,) + THIRD_STOPS[:-3]  # an f/1.2 .. f/16 lens
     assert step_stop(1.4, -1, lens_scale) == 1.2
     assert step_stop(14, 5, lens_scale) == 16
+
+
+def test_a_scale_argument_is_a_name_a_stop_scale_or_numbers():
+    half = STOP_SCALES["half"]
+    assert step_stop(4, 1, "half") == step_stop(4, 1, half) == step_stop(4, 1, half.exact) == 2 ** 2.25
+    assert nearest_stop(4.5, half) == nearest_stop(4.5, "half") == 2 ** 2.25
+    assert stops.stop_scale("half") is half and stops.stop_scale(half) is half
+    assert stops.stop_scale() is STOP_SCALES[stops.DEFAULT_STOP_SCALE] is STOP_SCALES["third"]
+    for call in (lambda: step_stop(4, 1, "quarter"), lambda: exact_f_number(4, "quarter"),
+                 lambda: parse_f_number("4", "quarter"), lambda: marked_f_number(4, "quarter")):
+        with pytest.raises(ValueError, match="quarter.*full, half, third"):
+            call()
 
 
 @pytest.mark.parametrize(
@@ -338,31 +372,104 @@ def test_format_f_number(n, text):
     assert format_f_number(n) == text
 
 
+# Conventional marks further than 3 % from their stop: f/0.84 and f/13.45 are marked 0.8 and 13 on halves,
+# f/1.26 is marked 1.2 on thirds (the f/1.2 lens).
+_ROUGH_MARKS = {("half", 0.8), ("half", 13), ("third", 1.2)}
+
+
+@pytest.mark.parametrize("scale, marks", [
+    ("full", (0.7, 1, 1.4, 2, 2.8, 4, 5.6, 8, 11, 16, 22, 32, 45, 64, 90, 128)),
+    ("half", (0.7, 0.8, 1, 1.2, 1.4, 1.7, 2, 2.4, 2.8, 3.3, 4, 4.8, 5.6, 6.7, 8, 9.5, 11, 13, 16, 19, 22, 27, 32, 38,
+              45, 54, 64, 76, 90, 108, 128)),
+    ("third", EXTENDED_THIRD_STOPS),
+])
+def test_every_mark_is_its_exact_stop_rounded(scale, marks):
+    stops = STOP_SCALES[scale]
+    assert stops.name == scale and stops.marks == marks and len(stops.exact) == len(marks)
+    assert stops.exact[0] == pytest.approx(2 ** -0.5) and stops.exact[-1] == 128  # f/0.7 .. f/128 each
+    per_stop = {"full": 1, "half": 2, "third": 3}[scale]
+    assert stops.steps_per_stop == per_stop and stops.step_in_stops == pytest.approx(1 / per_stop)
+    k0 = -marks.index(1)
+    for i, (mark, exact) in enumerate(zip(marks, stops.exact)):
+        assert exact == 2 ** ((k0 + i) / (2 * per_stop))  # f/1 is k = 0
+        assert mark == pytest.approx(exact, rel=0.05 if (scale, mark) in _ROUGH_MARKS else 0.03), mark
+        # ... and within half a step of its own stop (in stops of light), so nearer it than any other.
+        assert abs(2 * math.log2(mark / exact)) < 0.5 / per_stop, mark
+        assert nearest_stop(mark, scale) == exact
+    assert all(m in STOP_SCALES[s].marks for s, m in _ROUGH_MARKS)  # the exceptions are real marks
+
+
+def test_the_marked_names_are_the_third_stop_marks():
+    assert THIRD_STOPS == EXTENDED_THIRD_STOPS[EXTENDED_THIRD_STOPS.index(1.4):EXTENDED_THIRD_STOPS.index(22) + 1]
+    assert stops.FULL_STOPS == STOP_SCALES["full"].marks and stops.HALF_STOPS == STOP_SCALES["half"].marks
+    # Every full stop is on the half and the third scales, with the same mark.
+    for mark, exact in zip(STOP_SCALES["full"].marks, STOP_SCALES["full"].exact):
+        for scale in ("half", "third"):
+            assert exact_f_number(mark, scale) == pytest.approx(exact) and marked_f_number(exact, scale) == mark
+
+
 @pytest.mark.parametrize("scale", ["full", "half", "third"])
 def test_a_mark_reads_as_its_exact_stop_and_shows_as_its_mark(scale):
     stops = STOP_SCALES[scale]
     assert len(stops.marks) == len(stops.exact)
     for mark, exact in zip(stops.marks, stops.exact):
-        assert mark == pytest.approx(exact, rel=0.05)  # the conventional rounding, never further
         assert parse_f_number(f"f/{mark:g}", scale) == exact
         assert exact_f_number(mark, scale) == exact
+        assert exact_f_number(mark * (1 + 5e-4), scale) == exact  # float noise is the same mark
         assert marked_f_number(exact, scale) == mark
+        assert marked_f_number(exact_f_number(mark, scale), scale) == mark  # round trip, both ways
+        assert exact_f_number(marked_f_number(exact, scale), scale) == exact
         assert format_f_number(exact) == f"f/{mark:g}"
 
 
 @pytest.mark.parametrize("scale, fraction", [("full", 1.0), ("half", 0.5), ("third", 1 / 3)])
 def test_one_step_is_exactly_one_mark_of_the_scale(scale, fraction):
+    exact = STOP_SCALES[scale].exact
+    for n, after in zip(exact, exact[1:]):
+        assert step_stop(n, 1, scale) == after and step_stop(after, -1, scale) == n
+        assert 2 * math.log2(after / n) == pytest.approx(fraction, abs=1e-12)  # stops of light
     n = exact_f_number(2.8, scale)
-    for _ in range(6):
-        after = step_stop(n, 1, scale)
-        assert 2 * math.log2(after / n) == pytest.approx(fraction)  # stops of light
-        n = after
+    assert 2 * math.log2(step_stop(n, 3, scale) / n) == pytest.approx(3 * fraction, abs=1e-12)
+    # By marks alone the steps are uneven: f/10 -> f/11 looks like 0.28 stop, f/11 -> f/13 like 0.48.
+    assert 2 * math.log2(11 / 10) < 0.3 < 0.45 < 2 * math.log2(13 / 11)
 
 
 def test_a_mark_two_scales_share_is_read_on_the_scale_given():
     assert exact_f_number(13, "third") == pytest.approx(2 ** (11 / 3))  # 12.70
     assert exact_f_number(13, "half") == pytest.approx(2 ** 3.75)  # 13.45
+    assert exact_f_number(13, STOP_SCALES["half"]) == pytest.approx(2 ** 3.75)
+    assert parse_f_number("f/13", "third") == pytest.approx(12.699, abs=1e-3)
+    assert parse_f_number("f/13", "half") == pytest.approx(13.454, abs=1e-3)
+    assert marked_f_number(2 ** 3.75) == 13 == marked_f_number(2 ** (11 / 3))  # either shows as f/13
+    assert format_f_number(2 ** 3.75) == format_f_number(2 ** (11 / 3)) == "f/13"
+    assert step_stop(13, 1, "third") == pytest.approx(2 ** 3.5 * 2 ** (1 / 3))  # 12.70 -> 14.25
+    assert step_stop(13, 1, "half") == 16  # 13.45 -> 16
+    assert exact_f_number(3.3, "third") == 3.3 and exact_f_number(3.3, "half") == pytest.approx(2 ** 1.75)
     assert exact_f_number(5.65) == 5.65  # not a mark: as written
+
+
+def test_marked_f_number_leaves_other_numbers_alone():
+    assert marked_f_number(2 ** 3.5) == 11 and marked_f_number(2 ** (5 / 6)) == 1.8
+    assert marked_f_number(2 ** 1.75) == 3.3  # a half stop, not a third: found on the half scale
+    assert marked_f_number(2 ** 1.75, "third") == 2 ** 1.75  # asked for thirds only
+    assert marked_f_number(2 ** 3.5 * 1.01) == 2 ** 3.5 * 1.01  # 1 % off an exact stop is no stop
+    assert marked_f_number(3.0) == 3.0 and marked_f_number(11) == 11
+
+
+@pytest.mark.parametrize(
+    "n,text", [(2 ** 3.5, "f/11"), (2 ** 2.5, "f/5.6"), (5.657, "f/5.6"), (2 ** (5 / 6), "f/1.8"), (2 ** 1.75, "f/3.3"),
+               (2 ** (11 / 3), "f/13"), (2 ** (-1 / 6), "f/0.9"), (2 ** 6.5, "f/90"), (2 ** (41 / 6), "f/114"),
+               (3.0, "f/3"), (11.2, "f/11.2"), (12, "f/12"), (0.95, "f/0.95")]
+)
+def test_format_f_number_shows_the_mark_of_an_exact_stop(n, text):
+    assert format_f_number(n) == text
+
+
+@pytest.mark.parametrize("text,exact", [("f/11", 2 ** 3.5), ("f/5.6", 2 ** 2.5), ("1.8", 2 ** (5 / 6)),
+                                        ("F22", 2 ** 4.5), ("1:1.2", 2 ** (1 / 3)), ("f/3", 3.0), ("f/3.3", 3.3),
+                                        ("11.31", 11.31), ("f/12", 12.0)])
+def test_parse_f_number_gives_the_exact_stop_of_a_mark(text, exact):
+    assert parse_f_number(text) == pytest.approx(exact, rel=1e-12)
 
 
 @pytest.mark.parametrize(

@@ -1,6 +1,7 @@
 """Lens and sensor presets: every shipped file loads, every broken file is reported by name and key."""
 
 import json
+import math
 from pathlib import Path
 
 import pytest
@@ -9,7 +10,8 @@ from lenslab.optics import presetfiles
 from lenslab.optics.lenses import LensPreset, load_lens_presets, read_lens_file
 from lenslab.optics.presetfiles import PresetError, shipped_presets_dir, user_presets_dir
 from lenslab.optics.sensors import FULL_FRAME, SensorPreset, load_sensor_presets
-from lenslab.optics.stops import THIRD_STOPS, exact_f_number, step_stop
+from lenslab.optics.presetfiles import FieldError
+from lenslab.optics.stops import STOP_SCALES, THIRD_STOPS, exact_f_number, step_stop
 
 REPO = Path(__file__).resolve().parents[1]
 SHIPPED_LENS_FILES = sorted((REPO / "presets" / "lenses").glob("*.json"))
@@ -100,6 +102,40 @@ def test_sensor_properties():
     assert FULL_FRAME.coc_mm == pytest.approx(0.028844, rel=1e-4)
 
 
+def test_a_sensor_may_name_its_circle_of_confusion(tmp_path):
+    write(tmp_path / "sensors.json", {"sensors": [
+        {"name": "Super 35 (cine)", "width_mm": 24.89, "height_mm": 18.66, "circle_of_confusion_mm": 0.025},
+        {"name": "Own default", "width_mm": 36, "height_mm": 24, "circle_of_confusion_mm": None},
+        {"name": "Plain", "width_mm": 36, "height_mm": 24}]})
+    cine, explicit_null, plain = load_sensor_presets([tmp_path], include_shipped=False)
+    assert (cine.circle_of_confusion_mm, cine.coc_mm) == (0.025, 0.025)  # the file's value, not 31.1 mm / 1500
+    assert explicit_null.circle_of_confusion_mm is None and plain.circle_of_confusion_mm is None
+    assert explicit_null.coc_mm == plain.coc_mm == pytest.approx(math.hypot(36, 24) / 1500)
+    assert plain == FULL_FRAME.__class__("Plain", 36, 24)
+    assert isinstance(SensorPreset("x", 36, 24, circle_of_confusion_mm=1).circle_of_confusion_mm, float)
+
+
+def test_shipped_sensors_use_the_diagonal_rule_unless_they_say():
+    for sensor in load_sensor_presets(include_user=False):
+        expected = sensor.circle_of_confusion_mm or math.hypot(sensor.width_mm, sensor.height_mm) / 1500
+        assert sensor.coc_mm == pytest.approx(expected)
+
+
+@pytest.mark.parametrize("coc", [0, -0.02, 1.5, math.nan, math.inf, "0.02", True])
+def test_a_bad_circle_of_confusion_is_refused_naming_the_key(coc):
+    with pytest.raises(FieldError) as info:
+        SensorPreset("x", 36, 24, circle_of_confusion_mm=coc)
+    assert info.value.key == "circle_of_confusion_mm"
+
+
+def test_the_sensor_and_the_camera_accept_the_same_circles_of_confusion():
+    from lenslab.optics.sensors import SENSOR_COC_RANGE_MM
+    from lenslab.scene.camera import ThinLensCamera
+    from lenslab.scene.fields import declared_range
+
+    assert declared_range(ThinLensCamera, "circle_of_confusion_mm") == SENSOR_COC_RANGE_MM
+
+
 # --- lens behaviour -------------------------------------------------------------------------
 
 def test_prime_clamps():
@@ -129,6 +165,18 @@ def test_available_stops_include_the_lens_ends():
     assert step_stop(2 ** 0.5, -1, stops) == stops[0]
     assert fast.available_stops("full") == pytest.approx((2 ** (1 / 3), 2 ** 0.5, 2, 2 ** 1.5, 4, 2 ** 2.5, 8,
                                                           2 ** 3.5, 16))
+    assert fast.available_stops(STOP_SCALES["full"]) == fast.available_stops("full")
+    half = fast.available_stops("half")
+    assert half[0] == exact_f_number(1.2) and half[-1] == 16
+    assert all(n in STOP_SCALES["half"].exact for n in half[1:])  # f/1.2 (2^(1/3)) is no half stop: the lens's end
+    # A lens marked f/1.4 to f/22 ends on exact stops, so every step within it is one mark of the scale.
+    lens = LensPreset("85", focal_length_mm=85, widest_f_number=1.4, narrowest_f_number=22)
+    assert (lens.widest_f_number, lens.narrowest_f_number) == (2 ** 0.5, 2 ** 4.5)
+    for scale, fraction in (("full", 1), ("half", 1 / 2), ("third", 1 / 3)):
+        stops = lens.available_stops(scale)
+        assert (stops[0], stops[-1]) == (2 ** 0.5, 2 ** 4.5) and len(stops) == 8 * fraction ** -1 + 1
+        assert [step_stop(n, 1, stops) for n in stops[:-1]] == list(stops[1:])
+        assert all(2 * math.log2(b / a) == pytest.approx(fraction) for a, b in zip(stops, stops[1:]))
     odd = LensPreset("odd", focal_length_mm=40, widest_f_number=1.7, narrowest_f_number=21)
     stops = odd.available_stops(THIRD_STOPS)
     assert stops[0] == 1.7 and stops[1] == 1.8 and stops[-2:] == (20, 21)
@@ -242,6 +290,16 @@ BROKEN_SENSORS = [
     ({"sensors": [{"name": "x", "width_mm": 36}]}, "sensors[0].height_mm"),
     ({"sensors": [GOOD_SENSOR | {"crop": 1.5}]}, "sensors[0].crop"),
     ({"sensors": [GOOD_SENSOR, GOOD_SENSOR]}, "sensors[1].name"),
+    ({"sensors": [GOOD_SENSOR | {"circle_of_confusion_mm": 0}]}, "sensors[0].circle_of_confusion_mm"),
+    ({"sensors": [GOOD_SENSOR | {"circle_of_confusion_mm": -0.03}]}, "sensors[0].circle_of_confusion_mm"),
+    ({"sensors": [GOOD_SENSOR | {"circle_of_confusion_mm": 30}]}, "sensors[0].circle_of_confusion_mm"),  # µm, not mm
+    ({"sensors": [GOOD_SENSOR | {"circle_of_confusion_mm": "0.03"}]}, "sensors[0].circle_of_confusion_mm"),
+    ({"sensors": [GOOD_SENSOR | {"circle_of_confusion_mm": True}]}, "sensors[0].circle_of_confusion_mm"),
+    ('{"sensors": [{"name": "x", "width_mm": 36, "height_mm": 24, "circle_of_confusion_mm": NaN}]}',
+     "sensors[0].circle_of_confusion_mm"),
+    ('{"sensors": [{"name": "x", "width_mm": 36, "height_mm": 24, "circle_of_confusion_mm": Infinity}]}',
+     "sensors[0].circle_of_confusion_mm"),
+    ({"sensors": [GOOD_SENSOR | {"coc_mm": 0.03}]}, "sensors[0].coc_mm"),  # the file's key is the field's name
 ]
 
 

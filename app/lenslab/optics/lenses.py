@@ -146,8 +146,8 @@ class LensPreset:
         return min(max(n, self.widest_f_number), self.narrowest_f_number)
 
     def available_stops(self, scale: Scale = "third") -> tuple[float, ...]:
-        """The stops of ``scale`` (a name from stops.STOP_SCALES: exact values; or a sequence of f-numbers) this
-        lens can set, plus its own end stops.
+        """The stops of ``scale`` (a name from stops.STOP_SCALES or a StopScale: its exact values; or a sequence
+        of f-numbers) this lens can set, plus its own end stops.
 
         f/1.2 .. f/16 in thirds gives the exact (1.26, 1.41, 1.59, ..., 16).  The lens's own widest
         and narrowest f-numbers are always included, even when they are not

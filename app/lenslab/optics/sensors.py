@@ -19,6 +19,7 @@ __all__ = [
     "SensorPreset",
     "FULL_FRAME",
     "SENSOR_SIDE_RANGE_MM",
+    "SENSOR_COC_RANGE_MM",
     "crop_factor",
     "DEFAULT_SENSOR_NAME",
     "SENSORS_FILE",
@@ -36,6 +37,9 @@ _FULL_FRAME_DIAGONAL_MM = math.hypot(36.0, 24.0)
 #: side to beyond 8x10 inch sheet film (254 mm); much more is a typo (metres entered as millimetres, say).
 SENSOR_SIDE_RANGE_MM = (1.0, 500.0)
 
+#: The circles of confusion a sensor preset may name, mm (as the camera's ``circle_of_confusion_mm`` accepts).
+SENSOR_COC_RANGE_MM = (0.0005, 1.0)
+
 
 def crop_factor(width_mm: float, height_mm: float) -> float:
     """Full-frame diagonal over this sensor's diagonal (1.53 for APS-C 23.5 x 15.6): what a focal length is
@@ -51,7 +55,8 @@ class SensorPreset:
     width_mm: float
     height_mm: float
     description: str = field(default="", compare=False)
-    #: This format's own circle of confusion, mm (a cinema or a print standard); None: the diagonal / 1500.
+    #: This format's own circle of confusion, mm (a cinema or a print standard, a stricter criterion for large
+    #: prints); None: the diagonal / 1500. Read it through :attr:`coc_mm`, which applies that default.
     circle_of_confusion_mm: float | None = None
 
     def __post_init__(self):
@@ -65,8 +70,9 @@ class SensorPreset:
             object.__setattr__(self, key, value)  # store ints from JSON as floats
         coc = self.circle_of_confusion_mm
         if coc is not None:
-            if isinstance(coc, bool) or not (0.0005 <= float(coc) <= 1.0):
-                raise FieldError("circle_of_confusion_mm", f"must lie in [0.0005, 1] mm, got {coc!r}")
+            low, high = SENSOR_COC_RANGE_MM
+            if isinstance(coc, bool) or not isinstance(coc, (int, float)) or not (low <= coc <= high):
+                raise FieldError("circle_of_confusion_mm", f"must lie in [{low:g}, {high:g}] mm, got {coc!r}")
             object.__setattr__(self, "circle_of_confusion_mm", float(coc))
 
     @property

@@ -1,4 +1,4 @@
-"""Aperture stops: the marked f-number scale, snapping and stepping along it, text in and out.
+"""Aperture stops: full, half and third-stop scales (marks and exact values), snapping and stepping, text.
 
 An f-number ``N`` is focal length over entrance-pupil diameter; each *stop*
 halves the light, i.e. multiplies ``N`` by ``sqrt(2)``, a half stop by ``2 ** (1/4)`` and a third stop by
@@ -17,16 +17,20 @@ import bisect
 import math
 import re
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Sequence, Union
 
 __all__ = [
     "DEFAULT_STOP_SCALE",
     "STOP_SCALES",
     "StopScale",
+    "stop_scale",
     "exact_f_number",
     "marked_f_number",
     "THIRD_STOPS",
     "EXTENDED_THIRD_STOPS",
+    "HALF_STOPS",
+    "FULL_STOPS",
     "MIN_F_NUMBER",
     "MAX_F_NUMBER",
     "F_NUMBER_RANGE",
@@ -38,7 +42,8 @@ __all__ = [
     "parse_f_number",
 ]
 
-#: The third-stop scale as marked on lenses and camera displays, f/1.4 to f/22.
+#: The third-stop scale as marked on lenses and camera displays, f/1.4 to f/22: *marked* values (the exact
+#: ones are ``STOP_SCALES["third"].exact``), kept for callers that want the printed numbers.
 THIRD_STOPS: tuple[float, ...] = (
     1.4, 1.6, 1.8, 2, 2.2, 2.5, 2.8, 3.2, 3.5, 4, 4.5, 5, 5.6,
     6.3, 7.1, 8, 9, 10, 11, 13, 14, 16, 18, 20, 22,
@@ -46,8 +51,7 @@ THIRD_STOPS: tuple[float, ...] = (
 
 #: The same scale continued both ways over the whole valid range, f/0.7 to
 #: f/128 (marked values: 1.1 and 1.2 for 1.12 and 1.26, 25 and 29 for 25.4
-#: and 28.5, ...).  Lens presets use it for apertures outside f/1.4..f/22,
-#: such as f/1.2 primes and f/32 macros.
+#: and 28.5, ...): the marks of ``STOP_SCALES["third"]``.
 EXTENDED_THIRD_STOPS: tuple[float, ...] = (
     (0.7, 0.8, 0.9, 1, 1.1, 1.2)
     + THIRD_STOPS
@@ -64,16 +68,29 @@ HALF_STOPS: tuple[float, ...] = (0.7, 0.8, 1, 1.2, 1.4, 1.7, 2, 2.4, 2.8, 3.3, 4
 @dataclass(frozen=True)
 class StopScale:
     """A scale of apertures: ``marks`` as printed on lenses, ``exact`` the f-numbers they stand for,
-    ``2 ** (k / (2 * steps_per_stop))`` from f/1 (k = 0)."""
+    ``2 ** (k / (2 * steps_per_stop))`` with f/1 at k = 0.
+
+    A mark is the exact value rounded the conventional way (two significant digits, with the traditional
+    exceptions such as 11 for 11.31 and 13 for both 12.70 and 13.45), so marks alone are uneven steps; the iris
+    is calibrated to the exact values, and those are what LensLab renders.
+    """
 
     name: str
+    #: Marks per stop of light: 1 (full), 2 (half) or 3 (third).
     steps_per_stop: int
+    #: The marked f-numbers, ascending, one a step; they must include f/1.
     marks: tuple[float, ...]
 
-    @property
+    @cached_property
     def exact(self) -> tuple[float, ...]:
+        """The exact f-numbers of the marks, in the same order (each mark's own stop of light)."""
         first = -self.marks.index(1)  # the mark f/1 is k = 0
         return tuple(2.0 ** ((first + i) / (2 * self.steps_per_stop)) for i in range(len(self.marks)))
+
+    @property
+    def step_in_stops(self) -> float:
+        """One step of this scale in stops of light (1, 1/2, 1/3)."""
+        return 1.0 / self.steps_per_stop
 
 
 #: The scales a camera steps its aperture along, by name.
@@ -89,29 +106,47 @@ DEFAULT_STOP_SCALE = "third"
 Scale = Union[str, StopScale, Sequence[float]]
 
 
+def stop_scale(scale: str | StopScale = DEFAULT_STOP_SCALE) -> StopScale:
+    """The :class:`StopScale` named ``scale`` ("full", "half", "third"); a StopScale as it is.
+
+    Raises ValueError listing the names for any other name.
+    """
+    if isinstance(scale, StopScale):
+        return scale
+    if scale not in STOP_SCALES:
+        raise ValueError(f"unknown stop scale {scale!r} (choose from {', '.join(STOP_SCALES)})")
+    return STOP_SCALES[scale]
+
+
 def _scale_values(scale: Scale) -> Sequence[float]:
-    if isinstance(scale, str):
-        if scale not in STOP_SCALES:
-            raise ValueError(f"unknown stop scale '{scale}' (choose from {', '.join(STOP_SCALES)})")
-        scale = STOP_SCALES[scale]
-    return scale.exact if isinstance(scale, StopScale) else scale
+    """The f-numbers a scale argument stands for: a name's or a StopScale's exact values, a sequence itself."""
+    if isinstance(scale, (str, StopScale)):
+        return stop_scale(scale).exact
+    return scale
 
 
-def exact_f_number(n: float, scale: str = DEFAULT_STOP_SCALE) -> float:
+def exact_f_number(n: float, scale: str | StopScale = DEFAULT_STOP_SCALE) -> float:
     """The exact f-number of a marked stop of ``scale`` (11 -> 11.3137 on the third-stop scale, 13 -> 12.70 on
-    thirds but 13.45 on halves); any other number as it is."""
-    stops = STOP_SCALES[scale]
+    thirds but 13.45 on halves); any other number as it is.
+
+    Marks are rounded for printing; the iris is calibrated to the exact value, so that is what a typed or
+    preset mark means. A number within 1e-3 (relative) of a mark counts as that mark.
+    """
+    stops = stop_scale(scale)
     for mark, exact in zip(stops.marks, stops.exact):
         if math.isclose(n, mark, rel_tol=_SAME_STOP_REL_TOL):
             return exact
     return float(n)
 
 
-def marked_f_number(n: float, scale: str | None = None) -> float:
-    """The mark a lens prints for an exact stop (11.3137 -> 11); any other number as it is. Without ``scale``,
-    the third-stop marks are tried, then the half-stop ones."""
+def marked_f_number(n: float, scale: str | StopScale | None = None) -> float:
+    """The mark a lens prints for an exact stop (11.3137 -> 11); any other number as it is.
+
+    Without ``scale``, the third-stop marks are tried, then the half-stop ones (every full stop is on both).
+    A number within 1e-3 (relative) of an exact stop counts as that stop.
+    """
     for name in ((scale,) if scale else ("third", "half")):
-        stops = STOP_SCALES[name]
+        stops = stop_scale(name)
         for mark, exact in zip(stops.marks, stops.exact):
             if math.isclose(n, exact, rel_tol=_SAME_STOP_REL_TOL):
                 return mark
@@ -156,54 +191,62 @@ def stops_between(n1: float, n2: float) -> float:
     return 2.0 * math.log2(_checked(n2) / _checked(n1))
 
 
-def nearest_stop(n: float, scale: Scale = THIRD_STOPS) -> float:
-    """The value on ``scale`` closest to ``n`` in stops (log scale).
+def nearest_stop(n: float, scale: Scale = DEFAULT_STOP_SCALE) -> float:
+    """The value on ``scale`` closest to ``n`` in stops (log scale): an exact stop for a named scale.
 
-    Values outside the scale snap to its end.  ``scale`` must be ascending;
-    pass ``lens.available_stops()`` to snap within what a lens can do.
+    Values outside the scale snap to its end.  ``scale`` is a name from :data:`STOP_SCALES`, a
+    :class:`StopScale` (both mean its exact values) or a sequence of f-numbers, ascending; pass
+    ``lens.available_stops(name)`` to snap within what a lens can do.
     """
     n = _checked(n)
-    return min(_scale_values(scale), key=lambda stop: abs(math.log(stop / n)))
+    return float(min(_scale_values(scale), key=lambda stop: abs(math.log(stop / n))))
 
 
-def _index_on_scale(n: float, scale: Sequence[float]) -> int | None:
-    for i, stop in enumerate(scale):
-        if math.isclose(n, stop, rel_tol=_SAME_STOP_REL_TOL):
-            return i
+def _index_on_scale(n: float, values: Sequence[float], scale: Scale) -> int | None:
+    """Where ``n`` sits on ``values``: as it is, else as the exact stop of a mark (5.6 on a scale of exact
+    values is 5.657) or the mark of an exact stop (5.657 on a scale of marks is 5.6); None between stops."""
+    names = [scale.name if isinstance(scale, StopScale) else scale] if isinstance(scale, (str, StopScale)) else []
+    names += [name for name in ("third", "half", "full") if name not in names]
+    candidates = [n] + [exact_f_number(n, name) for name in names] + [marked_f_number(n)]
+    for candidate in candidates:
+        for i, stop in enumerate(values):
+            if math.isclose(candidate, stop, rel_tol=_SAME_STOP_REL_TOL):
+                return i
     return None
 
 
-def step_stop(n: float, steps: int, scale: Scale = THIRD_STOPS) -> float:
-    """Move ``steps`` marks along ``scale`` from ``n`` (positive = smaller aperture).
+def step_stop(n: float, steps: int, scale: Scale = DEFAULT_STOP_SCALE) -> float:
+    """Move ``steps`` marks along ``scale`` from ``n`` (positive = smaller aperture, less light).
 
-    From a value on the scale, one step is one mark.  From a value between
-    marks, the first step lands on the next mark in that direction (so from
-    f/3, +1 gives f/3.2 and -1 gives f/2.8).  The result is clamped to the
-    ends of the scale, but never moves against the requested direction: from
-    f/1.2 on a scale starting at f/1.4, -1 returns f/1.2 unchanged.
-    ``steps == 0`` snaps to the nearest mark.
+    ``scale`` as for :func:`nearest_stop`; a named scale steps between exact values, so from an exact stop one
+    step is exactly one mark's worth of light: 1, 1/2 or 1/3 stop on the full, half or third scale (by mark
+    alone, f/5.6 -> f/6.3 would look like 0.34 stop and f/10 -> f/11 like 0.28). A marked value counts as its
+    exact stop (from 5.6, +1 gives 6.35 on thirds). From a value between marks, the first step lands on the
+    next mark in that direction (so from f/3, +1 gives 3.17 and -1 gives 2.83 on thirds). The result is clamped
+    to the ends of the scale, but never moves against the requested direction: from f/1.2 on a scale starting
+    at f/1.4, -1 returns f/1.2 unchanged. ``steps == 0`` snaps to the nearest mark.
     """
     n = _checked(n)
     steps = int(steps)
-    scale = _scale_values(scale)
+    values = _scale_values(scale)
     if steps == 0:
-        return nearest_stop(n, scale)
-    last = len(scale) - 1
-    i = _index_on_scale(n, scale)
+        return nearest_stop(n, values)
+    last = len(values) - 1
+    i = _index_on_scale(n, values, scale)
     if i is None:
         if steps > 0:
-            i = bisect.bisect_right(scale, n)  # first mark above n
+            i = bisect.bisect_right(values, n)  # first mark above n
             if i > last:
                 return n  # already past the narrow end
             i += steps - 1
         else:
-            i = bisect.bisect_left(scale, n) - 1  # last mark below n
+            i = bisect.bisect_left(values, n) - 1  # last mark below n
             if i < 0:
                 return n  # already past the wide end
             i += steps + 1
     else:
         i += steps
-    return float(scale[min(max(i, 0), last)])
+    return float(values[min(max(i, 0), last)])
 
 
 def format_f_number(n: float) -> str:
@@ -223,9 +266,11 @@ _F_NUMBER_RE = re.compile(
 )
 
 
-def parse_f_number(text: str, scale: str = DEFAULT_STOP_SCALE) -> float:
+def parse_f_number(text: str, scale: str | StopScale = DEFAULT_STOP_SCALE) -> float:
     """Parse ``"f/2.8"``, ``"2.8"``, ``"F2.8"``, ``"1:2.8"`` (and ``"2,8"``): a marked stop of ``scale`` gives
-    its exact value (2.8 -> 2.8284), any other number itself.
+    its exact value (2.8 -> 2.8284), any other number itself ("3" is f/3). Someone typing "f/11" means the stop
+    engraved 11, whose iris is 2^3.5 = 11.31; ``scale`` settles marks two scales read differently ("13" is
+    12.70 on thirds, 13.45 on halves).
 
     Raises ValueError naming the text when it is not an f-number or is
     outside [0.5, 128].
