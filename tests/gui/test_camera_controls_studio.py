@@ -122,3 +122,50 @@ def test_physical_exposure_darkens_the_picture_a_stop_per_stop(window, qtbot):
     compensated = ratio(picture(2 ** 1.5, "compensated"), picture(4.0, "compensated"))
     assert physical == pytest.approx(2.0, rel=0.12)
     assert compensated == pytest.approx(1.0, rel=0.08)
+
+
+@pytest.mark.parametrize("scale, fraction", [("third", 1 / 3), ("half", 1 / 2), ("full", 1.0)])
+def test_the_shutter_steps_on_the_chosen_scale_and_names_the_menu(window, scale, fraction):
+    panel = window.camera_panel
+    panel.stop_scale_combo.setCurrentIndex(panel.stop_scale_combo.findData(scale))
+    amount = {"third": "⅓", "half": "½", "full": "1"}[scale]
+    assert window.actions["stop_down"].text() == f"Stop Down {amount} Stop"
+    window.doc.set_camera("test", False, exposure_mode="physical", shutter_s=1 / 125)
+    assert panel.shutter_longer.isEnabled()
+    panel.step_shutter(+1)
+    longer = window.doc.scene.camera.shutter_s
+    # Dial marks are rounded (1/60 for 1/62.5): one step is the scale's fraction to within the rounding.
+    assert math.log2(longer * 125) == pytest.approx(fraction, abs=0.08)
+    panel.step_shutter(-1)
+    assert window.doc.scene.camera.shutter_s == pytest.approx(1 / 125)
+    panel.step_shutter(-1000)  # the dial's end holds
+    assert window.doc.scene.camera.shutter_s == pytest.approx(1 / 8000)
+    assert not panel.shutter_shorter.isEnabled()
+
+
+def test_the_shutter_buttons_sleep_while_exposure_is_compensated(window):
+    window.doc.set_camera("test", False, exposure_mode="compensated")
+    assert not window.camera_panel.shutter_longer.isEnabled()
+    assert not window.camera_panel.shutter.isEnabled()
+
+
+def test_auto_circle_of_confusion_shows_its_value_and_steps_from_it(window):
+    panel = window.camera_panel
+    window.doc.set_camera("test", False, circle_of_confusion_mm=None)
+    film_w, film_h = window.doc.scene.camera.imaged_area_mm(*window.doc.scene.camera.resolution)
+    auto = math.hypot(film_w, film_h) / 1500
+    assert panel.coc.specialValueText() == f"auto · {auto:.4f} mm"
+    panel.coc.stepBy(1)  # the first step up from auto starts at the auto value, not at zero
+    assert window.doc.scene.camera.circle_of_confusion_mm == pytest.approx(round(auto, 4))
+
+
+def test_folded_sections_are_remembered(make_window, small_scene, settings):
+    window = make_window(small_scene)
+    bokeh = window.camera_panel.sections["bokeh"]
+    assert bokeh.header.isChecked() and bokeh.body.isVisibleTo(window)
+    bokeh.header.setChecked(False)
+    assert not bokeh.body.isVisibleTo(window)
+    again = make_window(small_scene)
+    assert not again.camera_panel.sections["bokeh"].header.isChecked()
+    assert not again.camera_panel.sections["bokeh"].body.isVisibleTo(again)
+    assert again.camera_panel.sections["exposure"].header.isChecked()

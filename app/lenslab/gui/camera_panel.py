@@ -41,11 +41,12 @@ from lenslab.optics import (
     parse_f_number,
     step_stop,
 )
+from lenslab.optics.dof import COC_DIAGONAL_DIVISOR
 from lenslab.optics.exposure import ev100, format_shutter, parse_shutter
 from lenslab.optics.sensors import crop_factor
 from lenslab.optics.stops import DEFAULT_STOP_SCALE, STOP_SCALES, marked_f_number
 from lenslab.scene.camera import ThinLensCamera
-from lenslab.scene.editing import camera_changes_keeping_focus, closest_focus
+from lenslab.scene.editing import camera_changes_keeping_focus, closest_focus, file_reference
 from lenslab.scene.fields import declared_choices, declared_range
 
 FULL_STOPS = STOP_SCALES["full"].exact  # labelled under the aperture slider
@@ -53,10 +54,45 @@ STOP_SCALE_NAMES = {"third": "Third stops", "half": "Half stops", "full": "Full 
 STEP_WORDS = {"third": "a third of a stop", "half": "half a stop", "full": "a stop"}
 SENSOR_FIT_NAMES = {"auto": "Auto (long sides together)", "horizontal": "Horizontal", "vertical": "Vertical",
                     "fill": "Fill (crop the sensor)", "overscan": "Overscan (whole sensor)"}
-ISO_SPEEDS = (50, 100, 200, 400, 800, 1600, 3200, 6400, 12800, 25600)
-#: The full-stop shutter scale a camera dial shows, seconds.
-SHUTTER_SPEEDS = (30, 15, 8, 4, 2, 1, 1 / 2, 1 / 4, 1 / 8, 1 / 15, 1 / 30, 1 / 60, 1 / 125, 1 / 250, 1 / 500,
-                  1 / 1000, 1 / 2000, 1 / 4000, 1 / 8000)
+ISO_SPEEDS = (50, 64, 80, 100, 125, 160, 200, 250, 320, 400, 500, 640, 800, 1000, 1250, 1600, 2000, 2500, 3200, 4000,
+              5000, 6400, 12800, 25600, 51200, 102400)
+#: The shutter speeds a camera's dial shows, seconds, longest first, on each stop scale (30 s to 1/8000 s).
+SHUTTER_SCALES = {
+    "full": (30, 15, 8, 4, 2, 1, 1 / 2, 1 / 4, 1 / 8, 1 / 15, 1 / 30, 1 / 60, 1 / 125, 1 / 250, 1 / 500, 1 / 1000,
+             1 / 2000, 1 / 4000, 1 / 8000),
+    "half": (30, 20, 15, 10, 8, 6, 4, 3, 2, 1.5, 1, 0.7, 1 / 2, 1 / 3, 1 / 4, 1 / 6, 1 / 8, 1 / 10, 1 / 15, 1 / 20,
+             1 / 30, 1 / 45, 1 / 60, 1 / 90, 1 / 125, 1 / 180, 1 / 250, 1 / 350, 1 / 500, 1 / 750, 1 / 1000, 1 / 1500,
+             1 / 2000, 1 / 3000, 1 / 4000, 1 / 6000, 1 / 8000),
+    "third": (30, 25, 20, 15, 13, 10, 8, 6, 5, 4, 3.2, 2.5, 2, 1.6, 1.3, 1, 0.8, 0.6, 1 / 2, 0.4, 1 / 3, 1 / 4, 1 / 5,
+              1 / 6, 1 / 8, 1 / 10, 1 / 13, 1 / 15, 1 / 20, 1 / 25, 1 / 30, 1 / 40, 1 / 50, 1 / 60, 1 / 80, 1 / 100,
+              1 / 125, 1 / 160, 1 / 200, 1 / 250, 1 / 320, 1 / 400, 1 / 500, 1 / 640, 1 / 800, 1 / 1000, 1 / 1250,
+              1 / 1600, 1 / 2000, 1 / 2500, 1 / 3200, 1 / 4000, 1 / 5000, 1 / 6400, 1 / 8000),
+}
+SHUTTER_SPEEDS = SHUTTER_SCALES["full"]
+
+
+def step_shutter(seconds: float, steps: int, scale: str = DEFAULT_STOP_SCALE) -> float:
+    """Move ``steps`` marks of the shutter dial of ``scale`` from ``seconds`` (positive: a longer time, more
+    light). From a time between marks the first step lands on the next mark that way; the dial's ends hold."""
+    marks = SHUTTER_SCALES[scale][::-1]  # shortest first: a positive step is a longer time
+    same = [i for i, mark in enumerate(marks) if math.isclose(mark, seconds, rel_tol=1e-3)]
+    if same:
+        i = same[0] + steps
+    elif steps > 0:
+        longer = [i for i, mark in enumerate(marks) if mark > seconds]
+        if not longer:
+            return float(seconds)
+        i = longer[0] + steps - 1
+    elif steps < 0:
+        shorter = [i for i, mark in enumerate(marks) if mark < seconds]
+        if not shorter:
+            return float(seconds)
+        i = shorter[-1] + steps + 1
+    else:
+        return float(min(marks, key=lambda mark: abs(math.log(mark / seconds))))
+    return float(marks[min(max(i, 0), len(marks) - 1)])
+
+
 COMMON_FOCAL_LENGTHS = (14, 24, 35, 50, 85, 135, 200)
 FOCAL_RANGE = (8.0, 800.0)
 FOCUS_RANGE = (0.05, 200.0)
@@ -65,6 +101,27 @@ FOCUS_RANGE = (0.05, 200.0)
 def lens_short_name(lens: LensPreset) -> str:
     focal = (f"{lens.focal_range_mm[0]:g}-{lens.focal_range_mm[1]:g}" if lens.is_zoom else f"{lens.focal_length_mm:g}")
     return f"{focal} {format_f_number(lens.widest_f_number)}"
+
+
+class AutoNumberEdit(NumberEdit):
+    """A number field whose lowest value means "auto", shown with the value auto stands for; the first step up
+    from auto starts from that value rather than from zero."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.auto_value = 0.0
+        self.setSpecialValueText("auto")
+
+    def set_auto_value(self, value: float) -> None:
+        self.auto_value = float(value)
+        self.setSpecialValueText(f"auto · {value:.{self.decimals()}f}{self.suffix()}")
+
+    def stepBy(self, steps: int) -> None:
+        if steps > 0 and self.value() <= self.minimum() and self.auto_value > self.minimum():
+            self.setValue(round(self.auto_value, self.decimals()))
+            steps -= 1
+        if steps:
+            super().stepBy(steps)
 
 
 class IrisGlyph(QWidget):
@@ -228,18 +285,28 @@ class StopSlider(QWidget):
         font.setPointSizeF(max(7.0, font.pointSizeF() - 2))
         p.setFont(font)
         p.setPen(QColor("#8c8f94"))
+        metrics = p.fontMetrics()
         n = len(self.scale)
         handle = 12
-        span = self.labels.width() - handle
-        for i, stop in enumerate(self.scale):
-            if any(math.isclose(stop, s, rel_tol=1e-3) for s in FULL_STOPS) or i in (0, n - 1):
-                x = handle / 2 + (span * i / max(1, n - 1))
-                p.drawText(QRectF(x - 14, 0, 28, 14), Qt.AlignCenter, f"{marked_f_number(stop):g}")
+        width = self.labels.width()
+        span = width - handle
+        # The ends, then the full stops between them, each where it fits without touching a label already drawn.
+        marked = [i for i, stop in enumerate(self.scale) if any(math.isclose(stop, s, rel_tol=1e-3) for s in FULL_STOPS)]
+        drawn: list[tuple[float, float]] = []
+        for i in [0, n - 1] + [i for i in marked if i not in (0, n - 1)]:
+            text = f"{marked_f_number(self.scale[i]):g}"
+            half = metrics.horizontalAdvance(text) / 2 + 1
+            x = min(max(handle / 2 + span * i / max(1, n - 1), half), width - half)  # never cut at the edges
+            if any(x - half < right + 4 and x + half > left - 4 for left, right in drawn):
+                continue
+            drawn.append((x - half, x + half))
+            p.drawText(QRectF(x - half, 0, 2 * half, 14), Qt.AlignCenter, text)
         p.end()
 
 
 class CameraPanel(QWidget):
     status_message = Signal(str)
+    stop_scale_changed = Signal(str)  # "full", "half" or "third": what one step of [ and ] now is
 
     def __init__(self, doc, focus_action: QAction | None = None, parent=None, settings=None):
         super().__init__(parent)
@@ -260,8 +327,10 @@ class CameraPanel(QWidget):
         layout = QVBoxLayout(self)
         layout.setContentsMargins(10, 6, 10, 6)
         layout.setSpacing(2)
+        self.sections: dict[str, Section] = {}
         layout.addWidget(self._lens_section())
         layout.addWidget(self._aperture_section())
+        layout.addWidget(self._bokeh_section())
         layout.addWidget(self._focal_section())
         layout.addWidget(self._focus_section(focus_action))
         layout.addWidget(self._dof_section())
@@ -274,7 +343,7 @@ class CameraPanel(QWidget):
 
     # -- sections ----------------------------------------------------------------------------------------------
     def _lens_section(self) -> Section:
-        section = Section("Lens")
+        section = self._section("lens", "Lens")
         grid = QGridLayout()
         grid.setSpacing(4)
         self.lens_buttons: list[QPushButton] = []
@@ -299,8 +368,19 @@ class CameraPanel(QWidget):
         section.add(self.lens_info)
         return section
 
+    def _section(self, key: str, title: str, expanded: bool = True) -> Section:
+        """A section that folds away, open or folded as the user left it last time (QSettings)."""
+        if self.settings is not None:
+            expanded = str(self.settings.value(f"camera/section/{key}", expanded)).lower() in ("true", "1")
+        section = Section(title, expanded=expanded)
+        section.setObjectName(f"{key}Section")
+        if self.settings is not None:
+            section.toggled.connect(lambda on: self.settings.setValue(f"camera/section/{key}", bool(on)))
+        self.sections[key] = section
+        return section
+
     def _aperture_section(self) -> Section:
-        section = Section("Aperture")
+        section = self._section("aperture", "Aperture")
         row = QHBoxLayout()
         self.iris = IrisGlyph()
         row.addWidget(self.iris)
@@ -313,7 +393,8 @@ class CameraPanel(QWidget):
         self.aperture_combo.setEditable(True)
         self.aperture_combo.setInsertPolicy(QComboBox.NoInsert)
         self.aperture_combo.setMinimumWidth(90)
-        self.aperture_combo.setToolTip("f-number: choose a stop or type any value (2.8, f/3, 1:2.8)")
+        self.aperture_combo.setToolTip("f-number: choose a stop or type any value (2.8, f/3, 1:2.8); a marked stop "
+                                       "means its exact value (f/11 is 11.31)")
         self.aperture_combo.currentIndexChanged.connect(self._aperture_chosen)
         self.aperture_combo.lineEdit().editingFinished.connect(self._aperture_typed)
         self.stop_down = QToolButton()
@@ -327,9 +408,26 @@ class CameraPanel(QWidget):
         self.stop_slider = StopSlider()
         self.stop_slider.moved.connect(lambda n, merge: self.set_f_number(n, merge))
         section.add(self.stop_slider)
+        steps = QHBoxLayout()
+        self.stop_scale_combo = QComboBox()
+        self.stop_scale_combo.setObjectName("stopScale")
+        for name, text in STOP_SCALE_NAMES.items():
+            self.stop_scale_combo.addItem(text, name)
+        self.stop_scale_combo.setToolTip("What one step of [ and ], the −/+ buttons and the shutter's steps move: "
+                                         "the scale shows marked stops, the camera takes the exact ones (f/11 is "
+                                         "11.31)")
+        self.stop_scale_combo.currentIndexChanged.connect(self._stop_scale_chosen)
+        steps.addWidget(QLabel("Steps"))
+        steps.addWidget(self.stop_scale_combo)
+        steps.addStretch(1)
+        section.add(steps)
         self.aperture_info = hint("")
         section.add(self.aperture_info)
-        # Iris.
+        return section
+
+    def _bokeh_section(self) -> Section:
+        """The iris's shape and the lens's optical quirks: what the out-of-focus highlights look like."""
+        section = self._section("bokeh", "Iris and bokeh")
         grid = QGridLayout()
         grid.setHorizontalSpacing(6)
         self.blades = IntEdit(*declared_range(ThinLensCamera, "aperture_blades"))
@@ -340,38 +438,33 @@ class CameraPanel(QWidget):
                                    suffix=" °")
         self.rotation.setToolTip("Rotation of the blade polygon")
         self.rotation.edited.connect(lambda v, merge: self.doc.set_camera("Blade rotation", merge, blade_rotation_deg=v))
-        grid.addWidget(QLabel("Blades"), 0, 0)
-        grid.addWidget(self.blades, 0, 1)
-        grid.addWidget(QLabel("Rotation"), 0, 2)
-        grid.addWidget(self.rotation, 0, 3)
         self.curvature = self._camera_number("blade_curvature", "Blade curvature", 2, 0.05,
                                              "Blade edges: 0 straight (polygonal bokeh) to 1 round")
         self.squeeze = self._camera_number("anamorphic_squeeze", "Anamorphic squeeze", 2, 0.05,
-                                           "Bokeh height over width: 1 spherical, 1.33, 1.5, 1.8 or 2 anamorphic")
+                                           "Anamorphic squeeze, bokeh height over width: 1 spherical; 1.33, 1.5, "
+                                           "1.8 or 2 anamorphic; below 1 the oval lies on its side")
         self.barrel = self._camera_number("barrel_clipping", "Barrel clipping", 2, 0.05,
-                                          "Cat's-eye bokeh and vignetting toward the corners: how far the barrel "
-                                          "cuts into the stop at the frame's corner")
-        for row, (label, widget) in enumerate((("Curvature", self.curvature), ("Squeeze", self.squeeze)), start=1):
-            grid.addWidget(QLabel(label), row, 0)
-            grid.addWidget(widget, row, 1)
-        grid.addWidget(QLabel("Cat's eye"), 1, 2)
-        grid.addWidget(self.barrel, 1, 3)
-        self.stop_scale_combo = QComboBox()
-        for name, text in STOP_SCALE_NAMES.items():
-            self.stop_scale_combo.addItem(text, name)
-        self.stop_scale_combo.setToolTip("What one step of [ and ] moves: the scale shows marked stops, the "
-                                         "camera takes the exact ones (f/11 is 11.31)")
-        self.stop_scale_combo.currentIndexChanged.connect(self._stop_scale_chosen)
-        grid.addWidget(QLabel("Steps"), 2, 2)
-        grid.addWidget(self.stop_scale_combo, 2, 3)
+                                          "Barrel clipping: cat's-eye bokeh and vignetting toward the corners, how "
+                                          "far the barrel cuts into the stop at the frame's corner (0 none, 1 by "
+                                          "the stop's radius)")
+        for i, (label, widget) in enumerate((("Blades", self.blades), ("Rotation", self.rotation),
+                                             ("Curvature", self.curvature), ("Squeeze", self.squeeze),
+                                             ("Cat's eye", self.barrel))):
+            text = QLabel(label)
+            text.setToolTip(widget.toolTip())
+            grid.addWidget(text, i // 2, (i % 2) * 2)
+            grid.addWidget(widget, i // 2, (i % 2) * 2 + 1)
+        grid.setColumnStretch(1, 1)
+        grid.setColumnStretch(3, 1)
         section.add(grid)
         image_row = QHBoxLayout()
         self.aperture_image_button = QPushButton("Aperture image…")
-        self.aperture_image_button.setToolTip("A grayscale image of the stop for custom bokeh (a star, a heart)")
+        self.aperture_image_button.setToolTip("A grayscale image of the stop for custom bokeh (a star, a heart): "
+                                              "white lets light through, black stops it")
         self.aperture_image_button.clicked.connect(self._choose_aperture_image)
         self.aperture_image_clear = QToolButton()
         self.aperture_image_clear.setText("×")
-        self.aperture_image_clear.setToolTip("Back to the blades")
+        self.aperture_image_clear.setToolTip("No aperture image: back to the blades")
         self.aperture_image_clear.clicked.connect(lambda: self.set_aperture_image(""))
         self.aperture_image_label = hint("")
         image_row.addWidget(self.aperture_image_button)
@@ -388,7 +481,7 @@ class CameraPanel(QWidget):
         return edit
 
     def _focal_section(self) -> Section:
-        section = Section("Focal length")
+        section = self._section("focal", "Focal length")
         row = QHBoxLayout()
         self.focal = NumberEdit(*declared_range(ThinLensCamera, "focal_length_mm"), decimals=1, step=1.0, suffix=" mm")
         self.focal.setObjectName("focalLength")
@@ -417,7 +510,7 @@ class CameraPanel(QWidget):
         return section
 
     def _focus_section(self, focus_action: QAction | None) -> Section:
-        section = Section("Focus")
+        section = self._section("focus", "Focus")
         row = QHBoxLayout()
         self.focus_slider = QSlider(Qt.Horizontal)
         self.focus_slider.setRange(0, 1000)
@@ -463,7 +556,7 @@ class CameraPanel(QWidget):
         return section
 
     def _dof_section(self) -> Section:
-        section = Section("Depth of field")
+        section = self._section("dof", "Depth of field")
         grid = QGridLayout()
         grid.setHorizontalSpacing(10)
         grid.setVerticalSpacing(2)
@@ -483,7 +576,7 @@ class CameraPanel(QWidget):
         return section
 
     def _sensor_section(self) -> Section:
-        section = Section("Sensor")
+        section = self._section("sensor", "Sensor")
         self.sensor_combo = QComboBox()
         for sensor in self.sensors:
             self.sensor_combo.addItem(f"{sensor.name}  ({sensor.width_mm:g} × {sensor.height_mm:g})", sensor)
@@ -510,23 +603,27 @@ class CameraPanel(QWidget):
             lambda i: self._updating or self.doc.set_camera("Sensor fit", False,
                                                             sensor_fit=self.sensor_fit.itemData(i)))
         low, high = declared_range(ThinLensCamera, "circle_of_confusion_mm")
-        self.coc = NumberEdit(0.0, high, decimals=4, step=0.001, suffix=" mm")
-        self.coc.setSpecialValueText("auto")
-        self.coc.setToolTip("Circle of confusion of the depth-of-field readout: auto is the imaged area's "
-                            "diagonal / 1500")
+        self.coc = AutoNumberEdit(0.0, high, decimals=4, step=0.001, suffix=" mm")
+        self.coc.setObjectName("circleOfConfusion")
+        self.coc.setToolTip("Circle of confusion, the blur the depth-of-field readout calls sharp: auto is the "
+                            "diagonal of the sensor area the image shows / 1500; type a value for a stricter or "
+                            "looser standard, or 0 for auto")
         self.coc.edited.connect(lambda v, merge: self.doc.set_camera(
             "Circle of confusion", merge, circle_of_confusion_mm=float(v) if v >= low else None))
         grid.addWidget(QLabel("Fit"), 0, 0)
         grid.addWidget(self.sensor_fit, 0, 1)
-        grid.addWidget(QLabel("CoC"), 1, 0)
+        coc_label = QLabel("CoC")
+        coc_label.setToolTip(self.coc.toolTip())
+        grid.addWidget(coc_label, 1, 0)
         grid.addWidget(self.coc, 1, 1)
+        grid.setColumnStretch(1, 1)
         section.add(grid)
         self.sensor_info = hint("")
         section.add(self.sensor_info)
         return section
 
     def _exposure_section(self) -> Section:
-        section = Section("Exposure")
+        section = self._section("exposure", "Exposure")
         grid = QGridLayout()
         self.exposure_mode = QComboBox()
         self.exposure_mode.addItem("Compensated", "compensated")
@@ -546,17 +643,30 @@ class CameraPanel(QWidget):
         self.iso.lineEdit().editingFinished.connect(self._iso_typed)
         self.iso.activated.connect(lambda i: self._set_iso(self.iso.itemData(i)))
         self.shutter = QComboBox()
+        self.shutter.setObjectName("shutter")
         self.shutter.setEditable(True)
         self.shutter.setInsertPolicy(QComboBox.NoInsert)
-        for seconds in SHUTTER_SPEEDS:
-            self.shutter.addItem(format_shutter(seconds), float(seconds))
-        self.shutter.setToolTip("Exposure time: choose or type any (1/125, 0.5, 2 s)")
+        self.shutter.setToolTip("Exposure time: choose a speed of the dial or type any (1/125, 0.5, 2 s)")
         self.shutter.lineEdit().editingFinished.connect(self._shutter_typed)
         self.shutter.activated.connect(lambda i: self._set_shutter(self.shutter.itemData(i)))
-        for row, (label, widget) in enumerate((("Mode", self.exposure_mode), ("ISO", self.iso),
-                                               ("Shutter", self.shutter))):
-            grid.addWidget(QLabel(label), row, 0)
-            grid.addWidget(widget, row, 1)
+        self.shutter_shorter = QToolButton()
+        self.shutter_shorter.setText("−")
+        self.shutter_shorter.clicked.connect(lambda: self.step_shutter(-1))
+        self.shutter_longer = QToolButton()
+        self.shutter_longer.setText("+")
+        self.shutter_longer.clicked.connect(lambda: self.step_shutter(+1))
+        shutter_row = QHBoxLayout()
+        shutter_row.setSpacing(2)
+        shutter_row.addWidget(self.shutter_shorter)
+        shutter_row.addWidget(self.shutter, 1)
+        shutter_row.addWidget(self.shutter_longer)
+        grid.addWidget(QLabel("Mode"), 0, 0)
+        grid.addWidget(self.exposure_mode, 0, 1)
+        grid.addWidget(QLabel("ISO"), 1, 0)
+        grid.addWidget(self.iso, 1, 1)
+        grid.addWidget(QLabel("Shutter"), 2, 0)
+        grid.addLayout(shutter_row, 2, 1)
+        grid.setColumnStretch(1, 1)
         section.add(grid)
         self.exposure_info = hint("")
         section.add(self.exposure_info)
@@ -575,6 +685,7 @@ class CameraPanel(QWidget):
         if self.settings is not None:
             self.settings.setValue("camera/stop_scale", self.scale_name)
         self.refresh()
+        self.stop_scale_changed.emit(self.scale_name)
 
     def focus_limits(self) -> tuple[float, float]:
         """The focus distances the camera (and its lens) can set, in its reference."""
@@ -613,14 +724,19 @@ class CameraPanel(QWidget):
         """Use the image at ``path`` as the stop ("" for the blades); a missing or black image is refused with a
         message, and the camera keeps its stop."""
         if path:
+            from lenslab.scene.aperture_images import resolve
+
             trial = ThinLensCamera(aperture_image=path)
             try:
                 trial.aperture(self.doc.scene.base_dir())
-            except ValueError as exc:
-                self.status_message.emit(str(exc))
+            except (ValueError, OSError) as exc:
+                self.status_message.emit(f"Aperture image not used: {exc}")
                 self.refresh()
                 return
-        self.doc.set_camera("Aperture image" if path else "No aperture image", False, aperture_image=path)
+            # Named relative to the scene file, as meshes are (absolute while the scene has no file).
+            path = file_reference(resolve(path, self.doc.scene.base_dir()), self.doc.path)
+        self.doc.set_camera(f"Aperture image {Path(path).name}" if path else "No aperture image", False,
+                            aperture_image=path)
 
     def _choose_aperture_image(self) -> None:
         path, _ = QFileDialog.getOpenFileName(self, "Aperture image", str(self.doc.scene.base_dir()),
@@ -649,9 +765,17 @@ class CameraPanel(QWidget):
         if not math.isclose(value, self.doc.scene.camera.iso):
             self._set_iso(value)
 
-    def _set_shutter(self, seconds) -> None:
+    def _set_shutter(self, seconds, merge: bool = False) -> None:
         if seconds is not None:
-            self.doc.set_camera(f"Shutter {format_shutter(seconds)}", False, shutter_s=float(seconds))
+            self.doc.set_camera(f"Shutter {format_shutter(seconds)}", merge, shutter_s=float(seconds))
+
+    def step_shutter(self, steps: int) -> None:
+        """``steps`` marks of the shutter dial on the chosen stop scale (positive: longer, more light)."""
+        current = self.doc.scene.camera.shutter_s
+        seconds = step_shutter(current, steps, self.scale_name)
+        if not math.isclose(seconds, current, rel_tol=1e-9):
+            self._set_shutter(seconds, merge=True)
+        self.refresh()
 
     def _shutter_typed(self) -> None:
         if self._updating:
@@ -803,7 +927,14 @@ class CameraPanel(QWidget):
             light = self.light_fraction()
             brightness = ("Brightness stays the same at every aperture (exposure is compensated)."
                           if cam.exposure_mode != "physical" else "Each stop is a stop of light (physical exposure).")
-            self.aperture_info.setText(f"Entrance pupil {diameter:.1f} mm"
+            if cam.aperture_image:
+                iris = f"the stop is {Path(cam.aperture_image).name}"
+            else:
+                iris = (f"{cam.aperture_blades} blades" if cam.aperture_blades >= 3 else "round")
+                extras = [f"squeeze {cam.anamorphic_squeeze:g}" if cam.anamorphic_squeeze != 1 else "",
+                          f"cat's eye {cam.barrel_clipping:g}" if cam.barrel_clipping > 0 else ""]
+                iris = ", ".join([iris] + [e for e in extras if e])
+            self.aperture_info.setText(f"Entrance pupil {diameter:.1f} mm ({iris})"
                                        + (f", passing {light:.0%} of the round stop's light" if light < 0.999 else "")
                                        + f". {brightness}")
             step = STEP_WORDS[self.scale_name]
@@ -859,6 +990,7 @@ class CameraPanel(QWidget):
             coc = cam.coc_mm(width, height)
             film_w, film_h = cam.imaged_area_mm(width, height)
             self.sensor_fit.setCurrentIndex(self.sensor_fit.findData(cam.sensor_fit))
+            self.coc.set_auto_value(math.hypot(film_w, film_h) / COC_DIAGONAL_DIVISOR)
             self.coc.set_quietly(cam.circle_of_confusion_mm or 0.0)
             self.sensor_info.setText(f"Crop factor {crop:.2f} · the image shows {film_w:.1f} × {film_h:.1f} mm · "
                                      f"circle of confusion {coc * 1000:.0f} µm · "
@@ -867,7 +999,18 @@ class CameraPanel(QWidget):
             physical = cam.exposure_mode == "physical"
             self.exposure_mode.setCurrentIndex(self.exposure_mode.findData(cam.exposure_mode))
             self.iso.setEditText(f"{cam.iso:g}")
+            dial = SHUTTER_SCALES[self.scale_name]
+            if [self.shutter.itemData(i) for i in range(self.shutter.count())] != [float(t) for t in dial]:
+                self.shutter.clear()
+                for seconds in dial:
+                    self.shutter.addItem(format_shutter(seconds), float(seconds))
+            self.shutter.setCurrentIndex(next((i for i, t in enumerate(dial)
+                                               if math.isclose(t, cam.shutter_s, rel_tol=1e-3)), -1))
             self.shutter.setEditText(format_shutter(cam.shutter_s))
+            self.shutter_shorter.setToolTip(f"Shorter by {step}: less light")
+            self.shutter_longer.setToolTip(f"Longer by {step}: more light")
+            self.shutter_shorter.setEnabled(physical and cam.shutter_s > dial[-1] * 1.0001)
+            self.shutter_longer.setEnabled(physical and cam.shutter_s < dial[0] * 0.9999)
             self.iso.setEnabled(physical)
             self.shutter.setEnabled(physical)
             ev = ev100(cam.f_number, cam.shutter_s, cam.iso)

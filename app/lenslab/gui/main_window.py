@@ -266,6 +266,8 @@ class MainWindow(QMainWindow):
         self.scene_tree = SceneTreeView(self.doc)
         self.properties = PropertyEditor(self.doc)
         self.camera_panel = CameraPanel(self.doc, self.actions["tool_focus"], settings=self.settings)
+        self.camera_panel.stop_scale_changed.connect(self._name_stop_actions)
+        self._name_stop_actions(self.camera_panel.scale_name)
         self.camera_panel.focus_selection_button.clicked.connect(self.focus_on_selection)
         camera_scroll = QScrollArea()
         camera_scroll.setWidgetResizable(True)
@@ -452,6 +454,12 @@ class MainWindow(QMainWindow):
         self.actions["rename"].setEnabled(has_any)
         self.actions["focus_on_selection"].setEnabled(has_nodes)
         self.camera_panel.focus_selection_button.setEnabled(has_nodes)
+
+    def _name_stop_actions(self, scale: str) -> None:
+        """[ and ] step the camera panel's stop scale: their menu entries say by how much."""
+        amount = {"full": "1", "half": "½", "third": "⅓"}.get(scale, "⅓")
+        self.actions["open_up"].setText(f"Open Up {amount} Stop")
+        self.actions["stop_down"].setText(f"Stop Down {amount} Stop")
 
     def _update_hud(self) -> None:
         cam = self.doc.scene.camera
