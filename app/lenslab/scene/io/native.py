@@ -24,7 +24,7 @@ from lenslab.atomic import atomic_path
 from lenslab.scene.materials import MATERIAL_TYPES, Material
 from lenslab.scene.scene import ENVIRONMENT_TYPES, Environment, Node, Scene, SceneError
 from lenslab.scene.shapes import SHAPE_TYPES, MeshFile, Shape
-from lenslab.scene.textures import TEXTURE_TYPES, ImageTexture, Texture
+from lenslab.scene.textures import TEXTURE_TYPES, Texture
 from lenslab.scene.lights import LIGHT_TYPES, Light
 
 FORMAT_KEY = "lenslab_scene"
