@@ -351,6 +351,9 @@ def test_an_unknown_sensor_or_lens_names_the_ones_there_are(capsys, tmp_path):
     status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.png", "--lens", "400mm")
     assert status == 2 and err.count("\n") == 1
     assert "argument --lens: no lens preset called '400mm' (there are: " in err and "85 mm f/1.4" in err
+    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.png", "--lens", "24")
+    assert status == 2 and err.count("\n") == 1
+    assert "argument --lens: '24' could be any of 24 mm f/1.4, 24-70 mm f/2.8: name one whole" in err
 
 
 def test_the_presets_are_listed(capsys):
@@ -393,6 +396,7 @@ def test_each_camera_flag_reaches_the_camera(tmp_path, monkeypatch):
         (["--f-stop", "f/11"], "f_number", exact_f_number(11)),  # the exact stop, 2^3.5
         (["--f-stop", "2.8"], "f_number", exact_f_number(2.8)),
         (["--lens", "135mm f/2"], "focal_length_mm", 135.0),
+        (["--lens", "85mm"], "focal_length_mm", 85.0),  # the only 85 mm lens there is
     ]
     for argv, field_name, expected in cases:
         assert getattr(_camera(*argv), field_name) == pytest.approx(expected), argv

@@ -157,7 +157,7 @@ def build_parser() -> argparse.ArgumentParser:
     camera = p.add_argument_group("camera and lens")
     camera.add_argument("--lens", type=_preset_argument(find_lens), metavar="NAME",
                         help="mount a lens preset: its focal lengths, stops, iris and minimum focus "
-                             "(see --list-lenses)")
+                             "(see --list-lenses; the name's beginning will do where only one lens has it: 85mm)")
     camera.add_argument("--sensor", type=_preset_argument(find_sensor), metavar="NAME",
                         help="a sensor preset: its size and circle of confusion (see --list-sensors)")
     camera.add_argument("--sensor-fit", choices=declared_choices(ThinLensCamera, "sensor_fit"),

@@ -241,9 +241,17 @@ def _lens_key(name: str) -> str:
 
 def find_lens(name: str, lenses: Sequence[LensPreset] | None = None) -> LensPreset:
     """The lens preset called ``name`` (its name, or its file's name without .json; case, spaces, dashes and
-    slashes do not matter). A ValueError that lists the lenses there are when none is called that."""
+    slashes do not matter), or else the one lens whose name begins so: "85mm" is the 85 mm f/1.4 while only one
+    85 mm lens is installed. A ValueError that lists the lenses there are when none is called that, or the
+    candidates when the beginning fits several."""
     lenses = load_lens_presets() if lenses is None else lenses
+    wanted = _lens_key(name)
     for lens in lenses:
-        if _lens_key(lens.name) == _lens_key(name):
+        if _lens_key(lens.name) == wanted:
             return lens
+    beginning_so = [lens for lens in lenses if wanted and _lens_key(lens.name).startswith(wanted)]
+    if len(beginning_so) == 1:
+        return beginning_so[0]
+    if beginning_so:
+        raise ValueError(f"'{name}' could be any of {', '.join(lens.name for lens in beginning_so)}: name one whole")
     raise ValueError(f"no lens preset called '{name}' (there are: {', '.join(lens.name for lens in lenses)})")
