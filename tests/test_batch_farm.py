@@ -177,6 +177,20 @@ def test_the_command_refuses_bad_arguments_in_one_line(tmp_path):
         assert run.returncode == status and expected in run.stderr and len(run.stderr.splitlines()) == 1, run.stderr
 
 
+def test_a_local_worker_leaves_ctrl_c_to_the_batch():
+    """A terminal's Ctrl-C reaches the workers too; one that took it would stop and print Dask's traceback."""
+    import operator
+
+    from distributed import Client
+
+    with local_cluster(1) as cluster, Client(cluster) as own_client:
+        (pid_before,) = own_client.run(os.getpid).values()
+        assert list(own_client.run(lambda: signal.getsignal(signal.SIGINT) == signal.SIG_IGN).values()) == [True]
+        os.kill(pid_before, signal.SIGINT)
+        assert own_client.submit(operator.add, 1, 2, pure=False).result(timeout=60) == 3
+        assert list(own_client.run(os.getpid).values()) == [pid_before]  # the same process, not a replacement
+
+
 def test_ctrl_c_keeps_every_finished_shot_and_the_next_run_renders_the_rest(tmp_path, renderer):
     (tmp_path / "shots.toml").write_text("""
         [[shots]]

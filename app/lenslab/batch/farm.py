@@ -76,17 +76,21 @@ class BatchSummary:
 
 
 # -- the cluster -----------------------------------------------------------------------------------------------
+WORKER_SETUP = "lenslab.batch.worker_setup"  # a module every local worker runs as it starts
+
+
 def local_cluster(workers: int, *, dashboard_address: str = ":0"):
     """A Dask cluster of ``workers`` processes on this machine, one task at a time each (a worker renders on one
     GL context). llvmpipe is told to share the cores among them, unless LP_NUM_THREADS says otherwise. Dask's
-    scheduler always serves HTTP; by default on a free port, so that it never takes a dashboard's usual 8787."""
+    scheduler always serves HTTP; by default on a free port, so that it never takes a dashboard's usual 8787.
+    The workers leave Ctrl-C to this process (lenslab.batch.worker_setup says why)."""
     from distributed import LocalCluster
 
     env = {}
     if "LP_NUM_THREADS" not in os.environ:
         env["LP_NUM_THREADS"] = str(max(1, (os.cpu_count() or 1) // workers))
     return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=dashboard_address,
-                        silence_logs=logging.CRITICAL, env=env)
+                        silence_logs=logging.CRITICAL, env=env, preload=[WORKER_SETUP])
 
 
 # -- the run ---------------------------------------------------------------------------------------------------
