@@ -246,10 +246,11 @@ def find_lens(name: str, lenses: Sequence[LensPreset] | None = None) -> LensPres
     candidates when the beginning fits several."""
     lenses = load_lens_presets() if lenses is None else lenses
     wanted = _lens_key(name)
-    for lens in lenses:
-        if _lens_key(lens.name) == wanted:
+    keyed = [(_lens_key(lens.name), lens) for lens in lenses]
+    for key, lens in keyed:
+        if key == wanted:
             return lens
-    beginning_so = [lens for lens in lenses if wanted and _lens_key(lens.name).startswith(wanted)]
+    beginning_so = [lens for key, lens in keyed if wanted and key.startswith(wanted)]
     if len(beginning_so) == 1:
         return beginning_so[0]
     if beginning_so:
