@@ -15,6 +15,7 @@ import time
 from pathlib import Path
 
 from lenslab import __version__
+from lenslab.messages import one_line
 from lenslab.scene.fields import declared_choices, declared_range
 
 EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
@@ -249,7 +250,11 @@ def parse_defines(items: list[str]) -> dict[str, str]:
 
 
 def _warn(message: str) -> None:
-    print(f"lenslab: warning: {message}", file=sys.stderr)
+    print(f"lenslab: warning: {one_line(message)}", file=sys.stderr)
+
+
+def _error(message: object) -> None:
+    print(f"lenslab: error: {one_line(message)}", file=sys.stderr)
 
 
 def scene_overrides(args):
@@ -317,7 +322,7 @@ def render_headless(args) -> int:
             job = RenderJob(renderer, scene, spp=args.spp, time_limit=args.time_limit,
                             dispatch_seconds=HEADLESS_DISPATCH_SECONDS)
     except (SceneError, ValueError) as exc:  # found only when the scene is packed for the GPU: name its file
-        raise SceneError(f"{scene.source_path or args.scene}: {exc}") from None
+        raise SceneError.in_file(scene.source_path or args.scene, exc) from None
     session = job.session
     if console is not None:
         flat, tree = session.flat_scene, session.kdtree
@@ -421,16 +426,21 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return run(argv)
     except CliError as exc:
-        print(f"lenslab: error: {exc}", file=sys.stderr)
+        _error(exc)
         return exc.status
     except (SceneError, GLUnavailable, SceneTooLarge, ExportError, PresetError, ValueError) as exc:
-        print(f"lenslab: error: {exc}", file=sys.stderr)
+        _error(exc)
         return EXIT_ERROR
     except KeyboardInterrupt:
         print("lenslab: interrupted; nothing was written", file=sys.stderr)
         return EXIT_INTERRUPTED
     except OSError as exc:
-        print(f"lenslab: error: {exc}", file=sys.stderr)
+        _error(exc)
+        return EXIT_ERROR
+    except Exception as exc:  # a bug of ours: one line for the user, the traceback on request
+        if os.environ.get("LENSLAB_DEBUG"):
+            raise
+        _error(f"internal error: {type(exc).__name__}: {exc} (please report it; LENSLAB_DEBUG=1 shows where)")
         return EXIT_ERROR
 
 

@@ -116,7 +116,7 @@ def render_part(shot: Shot, part: int, parts: int, *, device: int | None = None,
         job = RenderJob(_renderer(device), scene, spp=spp, time_limit=shot.time_limit,
                         dispatch_seconds=HEADLESS_DISPATCH_SECONDS, first_sample=first)
     except (SceneError, ValueError) as exc:  # found only when the scene is packed for the GPU: name its file
-        raise SceneError(f"{scene.source_path or shot.scene}: {exc}") from None
+        raise SceneError.in_file(scene.source_path or shot.scene, exc) from None
     try:
         warnings.extend(job.session.warnings)
         job.run(on_progress=on_progress)

@@ -124,7 +124,9 @@ def flatten_scene(scene: Scene, mesh_loader=None) -> FlatScene:
     tris, tri_normals, tri_uvs, tri_mat, tri_node = [], [], [], [], []
 
     def add_mesh(mesh: TriangleMesh, matrix: np.ndarray, mat: int, node_index: int) -> None:
-        corners = transform_points(matrix, mesh.vertices)[mesh.faces]
+        with np.errstate(over="ignore", invalid="ignore"):  # overflow is found and named just below
+            corners = transform_points(matrix, mesh.vertices)[mesh.faces]
+        _check_in_world(corners, nodes[node_index])
         if np.linalg.det(matrix[:3, :3]) < 0:  # a mirroring transform flips winding: keep the front face in front
             corners = corners[:, ::-1]
             faces = mesh.faces[:, ::-1]
@@ -155,7 +157,9 @@ def flatten_scene(scene: Scene, mesh_loader=None) -> FlatScene:
                 scale_text = ", ".join(f"{float(v):.6g}" for v in scale)
                 raise SceneError(f"node '{node.name}': a sphere needs a uniform scale, not ({scale_text}); "
                                  "use a mesh for an ellipsoid")
-            spheres.append([*matrix[:3, 3], node.shape.radius * scale[0]])
+            sphere = np.array([*matrix[:3, 3], node.shape.radius * scale[0]])
+            _check_in_world(sphere, node)
+            spheres.append(sphere)
             sph_mat.append(mat)
             sph_node.append(node_index)
             continue
@@ -163,6 +167,9 @@ def flatten_scene(scene: Scene, mesh_loader=None) -> FlatScene:
         warnings.extend(w for w in loaded.warnings if w not in warnings)
         for part in loaded.parts:
             add_mesh(part.mesh, matrix, material_index(node, part), node_index)
+
+    for name, material in zip(material_names, materials):
+        _check_finite_material(name, material)
 
     def cat(parts, shape, dtype):
         return np.concatenate(parts).astype(dtype) if parts else np.zeros(shape, dtype)
@@ -180,3 +187,24 @@ def flatten_scene(scene: Scene, mesh_loader=None) -> FlatScene:
         nodes=nodes,
         warnings=tuple(warnings),
     )
+
+
+#: Beyond this a world-space coordinate overflows float32 on the GPU, or takes every smaller one's precision.
+LARGEST_WORLD_COORDINATE = 1e30
+
+
+def _check_in_world(values: np.ndarray, node: Node) -> None:
+    """Name the node whose transform carries its geometry out of what float32 can hold (or to NaN)."""
+    if not np.isfinite(values).all() or np.abs(values).max(initial=0.0) > LARGEST_WORLD_COORDINATE:
+        raise SceneError(f"node '{node.name}': its transform puts the geometry beyond the {LARGEST_WORLD_COORDINATE:g} "
+                         f"a scene can hold (or makes it not a number)")
+
+
+def _check_finite_material(name: str, material: Material) -> None:
+    """A material's numbers, whichever reader they came through (a glTF's factors are JSON, which allows NaN):
+    one that is not finite would turn every pixel the material touches into NaN."""
+    for f in dataclasses.fields(material):
+        value = getattr(material, f.name)
+        numbers = value if isinstance(value, tuple) else (value,)
+        if any(isinstance(v, float) and not abs(v) <= LARGEST_WORLD_COORDINATE for v in numbers):
+            raise SceneError(f"material '{name}': {f.name} {value} is not a finite number")

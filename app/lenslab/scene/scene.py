@@ -25,6 +25,13 @@ RGB = tuple[float, float, float]
 class SceneError(ValueError):
     """A scene that cannot be loaded or rendered; the message is one line naming the file and the key."""
 
+    @classmethod
+    def in_file(cls, path: object, problem: object) -> "SceneError":
+        """The error for ``problem`` found in the scene file ``path``: the file named once, at the start,
+        whether or not whoever raised ``problem`` had named it already."""
+        text = str(problem)
+        return cls(text if text.startswith(f"{path}: ") else f"{path}: {text}")
+
 
 @dataclass
 class Node:

@@ -36,6 +36,20 @@ def open_scene(text: str | os.PathLike, defines: dict[str, str] | None = None,
     """Load a native (.json) or Mitsuba 3 (.xml) scene. ``defines`` are Mitsuba's ``-D name=value``
     parameters; ``warn`` receives one line per thing an importer approximates or leaves out."""
     path = resolve_scene_path(text)
+    try:
+        return _open(path, defines, warn)
+    except SceneError:
+        raise
+    except RecursionError:
+        raise SceneError(f"{path}: nested too deeply to read") from None
+    except MemoryError:
+        raise SceneError(f"{path}: too large to read into memory") from None
+    except Exception as exc:  # a case the readers missed: still one line naming the file, and a bug to fix
+        raise SceneError(f"{path}: cannot be read ({type(exc).__name__}: {exc}; an internal error, please "
+                         f"report it)") from exc
+
+
+def _open(path: Path, defines: dict[str, str] | None, warn: Callable[[str], None] | None) -> Scene:
     suffix = path.suffix.lower()
     if suffix == ".xml":
         from lenslab.scene.io.mitsuba_xml import load_mitsuba_scene  # only Mitsuba users pay for the importer

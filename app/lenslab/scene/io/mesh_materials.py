@@ -60,7 +60,7 @@ import numpy as np
 
 from lenslab.color import srgb_to_linear
 
-from lenslab.scene.io.meshes import LoadedMesh, MeshLoadError, MeshPart
+from lenslab.scene.io.meshes import LoadedMesh, MeshLoadError, MeshPart, check_geometry
 from lenslab.scene.materials import Conductor, Dielectric, Diffuse, Emissive, Material, Plastic
 from lenslab.scene.shapes import TriangleMesh
 from lenslab.scene.textures import Checkerboard, ImageTexture, InlineImageTexture, Texture
@@ -131,7 +131,8 @@ def _load(path: Path, smooth: bool) -> LoadedMesh:
             key, material, name = (0, mapped.order, ""), mapped.material, mapped.name
             if has_colours:
                 notes.add(mapped.key, mapped.name, "vertex colours ignored")
-        groups.setdefault(key, (material, name, []))[2].append(_baked(geometry, np.asarray(matrix, float), smooth))
+        groups.setdefault(key, (material, name, []))[2].append(_baked(geometry, np.asarray(matrix, float), smooth,
+                                                                      path))
     if not groups:
         raise MeshLoadError(f"{path}: no triangles in file")
     if vertex_colours:
@@ -142,9 +143,12 @@ def _load(path: Path, smooth: bool) -> LoadedMesh:
     return LoadedMesh(parts, notes.warnings())
 
 
-def _baked(geometry, matrix: np.ndarray, smooth: bool) -> TriangleMesh:
-    vertices = transform_points(matrix, np.asarray(geometry.vertices, dtype=np.float64))
+def _baked(geometry, matrix: np.ndarray, smooth: bool, path: Path) -> TriangleMesh:
     faces = np.asarray(geometry.faces, dtype=np.int64)
+    check_geometry(np.asarray(geometry.vertices, dtype=np.float64), faces, path)
+    with np.errstate(over="ignore", invalid="ignore"):  # a glTF node's matrix could still overflow: checked next
+        vertices = transform_points(matrix, np.asarray(geometry.vertices, dtype=np.float64))
+    check_geometry(vertices, faces, path)
     normals = transform_normals(matrix, np.asarray(geometry.vertex_normals, dtype=np.float64)) if smooth else None
     if np.linalg.det(matrix[:3, :3]) < 0:  # a mirroring transform: keep the front faces in front
         faces = faces[:, ::-1]
@@ -353,6 +357,15 @@ def parse_texture_statement(value: str) -> tuple[str, tuple[float, float], list[
     return " ".join(tokens[i:]), tiles, ignored
 
 
+def _check_mtl_numbers(library: Path, material: str, keys: dict[str, tuple[str, str]]) -> None:
+    """Refuse a statement the mapping reads whose numbers are not finite (Ke nan, Kd 1e999): one would reach
+    the renderer as a material that makes every pixel it touches NaN, or silently be taken as zero."""
+    for key, (written, value) in keys.items():
+        if key in MTL_HANDLED and not key.startswith("map_") and key != "newmtl":
+            if any(not math.isfinite(number) for number in _floats(value)):
+                raise MeshLoadError(f"{library}: material '{material}': {written} {value}: not a finite number")
+
+
 class ObjMaterials:
     def __init__(self, path: Path, notes: Notes):
         self.path, self.notes = path, notes
@@ -371,6 +384,7 @@ class ObjMaterials:
                                     "with the node's material or the default grey")
                 continue
             for material, keys in parse_mtl(library.read_text("utf-8", "replace")).items():
+                _check_mtl_numbers(library, material, keys)
                 self.definitions.setdefault(material, (keys, library.parent))
 
     def load_trimesh(self):

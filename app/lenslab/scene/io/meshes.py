@@ -38,6 +38,26 @@ class LoadedMesh:
     warnings: tuple[str, ...] = field(default=())  # what of the file's materials could not be mapped
 
 
+#: Coordinates beyond this would overflow float32 on the GPU once transformed (a metre is 1).
+LARGEST_COORDINATE = 1e30
+
+
+def check_geometry(vertices: np.ndarray, faces: np.ndarray, path: Path | str) -> None:
+    """Refuse what a broken exporter writes and a renderer would index out of bounds or turn into NaN:
+    faces that point past the vertices, and coordinates that are not finite or absurdly large."""
+    if len(faces) and (faces.min() < 0 or faces.max() >= len(vertices)):
+        bad = int(np.count_nonzero((faces < 0) | (faces >= len(vertices))))
+        raise MeshLoadError(f"{path}: {bad} face {'index points' if bad == 1 else 'indices point'} outside the "
+                            f"{len(vertices)} vertices")
+    finite = np.isfinite(vertices).all(axis=-1)
+    if not finite.all():
+        raise MeshLoadError(f"{path}: {np.count_nonzero(~finite)} vertices have coordinates that are not "
+                            f"finite numbers")
+    if len(vertices) and np.abs(vertices).max() > LARGEST_COORDINATE:
+        raise MeshLoadError(f"{path}: coordinates up to {np.abs(vertices).max():.3g}, beyond the "
+                            f"{LARGEST_COORDINATE:g} a scene can hold")
+
+
 def load_mesh_parts(path: Path, smooth: bool = True) -> LoadedMesh:
     """The mesh file as parts, one per material it uses (geometry without one: a part each, material None).
 
@@ -68,6 +88,7 @@ def _load_cached(path: str, mtime_ns: int, smooth: bool) -> TriangleMesh:
         raise MeshLoadError(f"{path}: no triangles in file")
     vertices = np.asarray(mesh.vertices, dtype=np.float64)
     faces = np.asarray(mesh.faces, dtype=np.int64)
+    check_geometry(vertices, faces, path)
     normals = np.asarray(mesh.vertex_normals, dtype=np.float64) if smooth else None
     uvs = None
     visual_uv = getattr(mesh.visual, "uv", None)

@@ -81,10 +81,14 @@ def _ior(p: "Props", name: str, default: float) -> float:
         return NAMED_IOR[key]
     if node.tag not in ("float", "integer"):
         raise node.error("expected a <float> or a named <string> index of refraction")
+    text = node.attrs.get("value", "")
     try:
-        return float(node.attrs.get("value", ""))
+        ior = mv.parse_number(text)
     except ValueError:
-        raise node.error(f"could not parse floating point value \"{node.attrs.get('value')}\"") from None
+        raise node.error(f'could not parse "{text}" as a finite floating point value') from None
+    if ior <= 0:
+        raise node.error(f"an index of refraction must be positive, not {text}")
+    return ior
 
 
 def _roughness(p: "Props", notes: list[str]) -> float:
@@ -112,7 +116,10 @@ def _alpha(p: "Props", name: str, notes: list[str]) -> float:
         p.take(name)
         notes.append(f"a textured {name} is not supported: 0.1 used")
         return 0.1
-    return p.float(name, 0.1)
+    alpha = p.float(name, 0.1)
+    if alpha < 0:
+        raise node.error(f"{name} must not be negative, not {alpha:g}")
+    return alpha
 
 
 def _unit(rgb) -> RGB:

@@ -176,10 +176,19 @@ def nearest_similarity(m: np.ndarray) -> np.ndarray:
 _SPLIT = re.compile(r"[\s,]+")
 
 
+def parse_number(text: str) -> float:
+    """One number of a scene file. Mitsuba would take "nan" or "inf" as well; nothing in a scene has a use
+    for them, and one would reach the GPU as a pixel that never converges, so they are refused here."""
+    value = float(text)
+    if not math.isfinite(value):
+        raise ValueError(f"'{text.strip()}' is not a finite number")
+    return value
+
+
 def split_numbers(text: str) -> list[float]:
     """Numbers separated by commas and/or white space, as Mitsuba's ``string::tokenize``."""
     tokens = [t for t in _SPLIT.split(text.strip()) if t]
-    return [float(t) for t in tokens]
+    return [parse_number(t) for t in tokens]
 
 
 def _lobe(lam: np.ndarray, mu: float, s1: float, s2: float) -> np.ndarray:

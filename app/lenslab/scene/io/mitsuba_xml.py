@@ -26,6 +26,7 @@ Conventions converted here (checked in ``tests/test_mitsuba_import.py``):
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import logging
 import math
@@ -60,6 +61,9 @@ RGB = tuple[float, float, float]
 
 SENSOR_WIDTH_MM = 36.0  # imported cameras get a full-frame-wide sensor; the focal length carries the fov
 MAX_INCLUDE_DEPTH = 15
+#: Deeper than any real scene (a shape in a shape group in an instance in the scene is four); the passes below
+#: recurse once per level, so an absurd depth is refused while parsing rather than exhausting Python's stack.
+MAX_ELEMENT_DEPTH = 100
 DISK_SEGMENTS = 128
 
 # Element names of Mitsuba's format (interpret_tag in parser.cpp).
@@ -121,6 +125,9 @@ def _parse_xml(data: bytes, display: str, folder: Path) -> XNode:
     roots: list[XNode] = []
 
     def start(tag: str, attrs: dict[str, str]) -> None:
+        if len(stack) >= MAX_ELEMENT_DEPTH:
+            raise SceneError(f"{display}: line {parser.CurrentLineNumber}: elements nested more than "
+                             f"{MAX_ELEMENT_DEPTH} deep (no scene needs that many)")
         node = XNode(tag, dict(attrs), parser.CurrentLineNumber, display, folder)
         (stack[-1].children if stack else roots).append(node)
         stack.append(node)
@@ -132,6 +139,8 @@ def _parse_xml(data: bytes, display: str, folder: Path) -> XNode:
     parser.EndElementHandler = end
     try:
         parser.Parse(data, True)
+    except LookupError as exc:  # the XML declaration names an encoding Python does not know
+        raise SceneError(f"{display}: line 1: {exc}") from None
     except expat.ExpatError as exc:
         raise SceneError(
             f"{display}: line {exc.lineno} column {exc.offset + 1}: not well-formed XML ({expat.ErrorString(exc.code)})"
@@ -307,20 +316,22 @@ class Props:
         if node is None:
             return default
         self._expect(node, ("float", "integer"))
+        text = self._attr(node)
         try:
-            return float(self._attr(node))
+            return mv.parse_number(text)
         except ValueError:
-            raise node.error(f"could not parse floating point value \"{node.attrs['value']}\"") from None
+            raise node.error(f'could not parse "{text}" as a finite floating point value') from None
 
     def int(self, name: str, default: int | None = None) -> int | None:
         node = self.take(name)
         if node is None:
             return default
         self._expect(node, ("integer",))
+        text = self._attr(node)
         try:
-            return int(self._attr(node).strip())
-        except ValueError:
-            raise node.error(f"could not parse integer value \"{node.attrs['value']}\"") from None
+            return int(text.strip())
+        except ValueError:  # also a number of more digits than Python will convert
+            raise node.error(f'could not parse integer value "{text}"') from None
 
     def bool(self, name: str, default: bool) -> bool:
         node = self.take(name)
@@ -376,7 +387,7 @@ def _xyz(node: XNode, default: float) -> np.ndarray:
             if len(values) != 3:
                 raise node.error('"value" must have exactly 1 or 3 elements')
             return np.array(values, dtype=float)
-        return np.array([float(node.attrs.get(k, default)) for k in "xyz"])
+        return np.array([mv.parse_number(node.attrs.get(k, str(default))) for k in "xyz"])
     except SceneError:
         raise
     except ValueError:
@@ -396,7 +407,7 @@ def _transform_matrix(node: XNode, importer: "_Importer") -> np.ndarray:
                 if "angle" not in op.attrs:
                     raise op.error('missing attribute "angle"')
                 axis = _xyz(op, 0.0)
-                step = mv.rotate_matrix(axis, float(op.attrs["angle"]))
+                step = mv.rotate_matrix(axis, mv.parse_number(op.attrs["angle"]))
                 if abs(np.linalg.norm(axis) - 1.0) > 1e-6:
                     importer.warn(op, "the rotation axis is not of unit length: Mitsuba 3 does not normalise it, "
                                   "so this rotation also scales (kept, to match Mitsuba)")
@@ -428,6 +439,19 @@ def _three(node: XNode, key: str) -> np.ndarray:
     if len(values) != 3:
         raise node.error(f'"{key}" needs 3 values, got {len(values)}')
     return np.array(values)
+
+
+@contextlib.contextmanager
+def _named_errors(node: XNode):
+    """A value that makes no sense where it lands (a zero that divides, a number outside a function's domain)
+    found deep inside one top-level element: reported at that element, as every other error is, with its
+    file and line. Errors that already name their element pass through."""
+    try:
+        yield
+    except SceneError:
+        raise
+    except (ValueError, ArithmeticError) as exc:
+        raise node.error(str(exc) or type(exc).__name__) from None
 
 
 MITSUBA_DEFAULT_MATERIAL = "mitsuba_default"  # a shape without a BSDF: Mitsuba's diffuse, reflectance 0.5
@@ -514,7 +538,7 @@ class _Importer:
                     raise node.error(f"<rgb> needs one or three values (got {len(values)})")
                 return tuple(values)  # type: ignore[return-value]
             if node.tag == "float":
-                v = float(node.attrs.get("value", ""))
+                v = mv.parse_number(node.attrs.get("value", ""))
                 return (v, v, v)
             if node.tag == "spectrum" and "type" not in node.attrs:
                 if "filename" in node.attrs:
@@ -585,35 +609,40 @@ class _Importer:
             raise root.error("the root element must be <scene>")
         sensors = []
         for child in root.children:
-            tag = child.tag
-            if tag == "integrator":
-                self.integrator(child)
-            elif tag == "sensor":
-                sensors.append(child)
-            elif tag == "shape":
-                self.nodes.extend(self.shape(child))
-            elif tag == "emitter":
-                self.emitter(child)
-            elif tag in ("bsdf", "texture", "spectrum"):
-                pass  # converted where a shape refers to them
-            elif tag == "path":
-                folder = self.resolve_file(child, child.attrs.get("value", ""))
-                if not folder.is_dir():
-                    raise child.error(f"folder not found: {folder}")
-                self.search_dirs.insert(0, folder)
-            elif tag in ("medium", "phase", "volume", "field"):
-                self.warn(child, "participating media are not supported: ignored")
-            elif tag == "ref":
-                self.resolve_ref(child)
-                self.warn(child, "a top-level <ref> adds nothing: ignored")
-            elif tag in OBJECT_TAGS or tag in VALUE_TAGS:
-                self.warn(child, "not expected in <scene>: ignored")
-            else:
-                self.warn(child, "unknown element: ignored")
+            with _named_errors(child):
+                self._top_level(child, sensors)
         if sensors:
-            self.sensor(sensors[0])
+            with _named_errors(sensors[0]):
+                self.sensor(sensors[0])
             for extra in sensors[1:]:
                 self.warn(extra, "only the first sensor is used: ignored")
+
+    def _top_level(self, child: XNode, sensors: list[XNode]) -> None:
+        tag = child.tag
+        if tag == "integrator":
+            self.integrator(child)
+        elif tag == "sensor":
+            sensors.append(child)
+        elif tag == "shape":
+            self.nodes.extend(self.shape(child))
+        elif tag == "emitter":
+            self.emitter(child)
+        elif tag in ("bsdf", "texture", "spectrum"):
+            pass  # converted where a shape refers to them
+        elif tag == "path":
+            folder = self.resolve_file(child, child.attrs.get("value", ""))
+            if not folder.is_dir():
+                raise child.error(f"folder not found: {folder}")
+            self.search_dirs.insert(0, folder)
+        elif tag in ("medium", "phase", "volume", "field"):
+            self.warn(child, "participating media are not supported: ignored")
+        elif tag == "ref":
+            self.resolve_ref(child)
+            self.warn(child, "a top-level <ref> adds nothing: ignored")
+        elif tag in OBJECT_TAGS or tag in VALUE_TAGS:
+            self.warn(child, "not expected in <scene>: ignored")
+        else:
+            self.warn(child, "unknown element: ignored")
 
     def integrator(self, node: XNode) -> None:
         p = Props(self, node)
@@ -828,6 +857,8 @@ class _Importer:
         children = copy.deepcopy(self._groups[key])
         try:
             transforms = mv.decompose_affine(to_world)
+        except SceneError:
+            raise
         except ValueError as exc:
             self.warn(node, f"{exc}: skipped")
             return []
@@ -840,6 +871,8 @@ class _Importer:
         """A node (or, for a sheared matrix, a node holding a node) that puts ``shape`` at ``matrix``."""
         try:
             transforms = mv.decompose_affine(matrix)
+        except SceneError:
+            raise
         except ValueError as exc:
             self.warn(node, f"{exc}: shape skipped")
             return []
@@ -886,6 +919,8 @@ class _Importer:
         aspect = width / height
         try:
             fov_x = _parse_fov(p, aspect)
+        except SceneError:
+            raise
         except ValueError as exc:
             raise node.error(str(exc)) from None
         focus = p.float("focus_distance", 1e4)  # Mitsuba: the far clip plane
@@ -1066,9 +1101,11 @@ def _parse_fov(p: Props, aspect: float) -> float:
         if text.endswith("mm"):
             text = text[:-2]
         try:
-            value = float(text)
+            value = mv.parse_number(text)
         except ValueError:
             raise ValueError(f"could not parse the focal length '{text}' (expected <x>mm)") from None
+        if value <= 0:
+            raise ValueError(f"the focal length must be positive, not '{text}mm'")
         fov = 2 * math.degrees(math.atan(math.hypot(36.0, 24.0) / (2 * value)))
         axis = "diagonal"
     half = math.radians(fov) / 2

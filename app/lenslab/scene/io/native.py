@@ -34,6 +34,9 @@ FORMAT_VERSION = 2
 #: "Versions"). A version 1 file is read with its old meaning, so it renders exactly as it always did.
 _VERSION_1_CAMERA = {"focus_from": "lens", "focus_breathing": False, "sensor_fit": "horizontal"}
 SCENE_SUFFIX = ".json"
+#: How deep nodes may nest. Assemblies from CAD and DCC tools nest a few dozen levels at most; the reader,
+#: the flattener and the studio's tree walk nodes recursively, so a deeper tree is refused when it is read.
+MAX_NODE_DEPTH = 100
 
 # Polymorphic fields: the JSON object's "type" key picks the dataclass.
 _TAGGED = {Shape: SHAPE_TYPES, Material: MATERIAL_TYPES, Environment: ENVIRONMENT_TYPES, Texture: TEXTURE_TYPES, Light: LIGHT_TYPES}
@@ -57,6 +60,8 @@ def _type_hints(cls) -> dict[str, Any]:
 
 
 def _describe(value: Any) -> str:
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 10**30:
+        return f"a {len(str(abs(value)))}-digit number"
     text = json.dumps(value)
     return text if len(text) <= 40 else text[:37] + "..."
 
@@ -64,13 +69,20 @@ def _describe(value: Any) -> str:
 # ---------------------------------------------------------------------------------------------------------
 # Reading
 # ---------------------------------------------------------------------------------------------------------
+#: Past this a number is no measurement of anything in a scene, and float32 on the GPU would make it infinite
+#: or swallow every smaller one; a field's own range is usually far tighter.
+LARGEST_NUMBER = 1e30
+
+
 def _read_number(value: Any, kind: type, path: str, meta: dict) -> float | int:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise _Invalid(path, f"expected a number, got {_describe(value)}")
+    if isinstance(value, float) and not math.isfinite(value):
+        raise _Invalid(path, f"{value} is not a finite number")
+    if abs(value) > LARGEST_NUMBER:  # exact for integers of any length: no conversion to float can overflow
+        raise _Invalid(path, f"{_describe(value)} is too large (the most any value may be is {LARGEST_NUMBER:g})")
     if kind is int and not float(value).is_integer():
         raise _Invalid(path, f"expected a whole number, got {_describe(value)}")
-    if not math.isfinite(value):
-        raise _Invalid(path, f"{value} is not a finite number")
     if "range" in meta:
         lo, hi = meta["range"]
         if not lo <= value <= hi:
@@ -128,7 +140,7 @@ def _read_tagged(value: Any, registry: dict[str, type], path: str) -> Any:
     if not isinstance(value, dict):
         raise _Invalid(path, f"expected an object, got {_describe(value)}")
     kind = value.get("type")
-    if kind not in registry:
+    if not isinstance(kind, str) or kind not in registry:
         raise _Invalid(_join(path, "type"), f"unknown type {_describe(kind)}; expected one of {', '.join(registry)}")
     return _read_dataclass({k: v for k, v in value.items() if k != "type"}, registry[kind], path)
 
@@ -178,6 +190,17 @@ def _check_references(scene: Scene) -> None:
     visit(scene.nodes, "nodes")
 
 
+def _check_node_depth(nodes: Any) -> None:
+    """Refuse a node tree deeper than MAX_NODE_DEPTH before anything recurses into it."""
+    level, depth = nodes if isinstance(nodes, list) else [], 0
+    while level:
+        depth += 1
+        if depth > MAX_NODE_DEPTH:
+            raise _Invalid("nodes", f"nested more than {MAX_NODE_DEPTH} deep (the format's limit)")
+        level = [child for node in level if isinstance(node, dict) and isinstance(node.get("children"), list)
+                 for child in node["children"]]
+
+
 def scene_from_dict(data: Any, source_path: Path | None = None) -> Scene:
     """Build a Scene from parsed JSON; raises _Invalid with the key path."""
     if not isinstance(data, dict):
@@ -189,6 +212,7 @@ def scene_from_dict(data: Any, source_path: Path | None = None) -> Scene:
         raise _Invalid(FORMAT_KEY, f"version {_describe(version)} is not supported (this LensLab reads 1 and "
                                    f"{FORMAT_VERSION})")
     data = {k: v for k, v in data.items() if k != FORMAT_KEY}
+    _check_node_depth(data.get("nodes"))
     if version == 1:
         camera = data.get("camera", {})
         if isinstance(camera, dict):
@@ -214,6 +238,12 @@ def load_scene(path: str | os.PathLike) -> Scene:
         data = json.loads(text)
     except json.JSONDecodeError as exc:
         raise SceneError(f"{path}: line {exc.lineno} column {exc.colno}: not valid JSON ({exc.msg})") from None
+    except RecursionError:
+        raise SceneError(f"{path}: lists or objects nested too deeply to read") from None
+    except ValueError as exc:  # an integer of more digits than Python converts
+        raise SceneError(f"{path}: a number too long to read ({str(exc).split(';')[0]})") from None
+    except MemoryError:
+        raise SceneError(f"{path}: too large to read") from None
     try:
         return scene_from_dict(data, path.resolve())
     except _Invalid as exc:

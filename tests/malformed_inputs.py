@@ -1,0 +1,533 @@
+"""A seeded generator of malformed scenes, and the check that LensLab meets each with one clear line.
+
+Every case starts from a scene that ships with LensLab (native JSON, or one of the Mitsuba XML validation
+scenes) and breaks one thing the way real files break: a key deleted, a value of the wrong type, a number out
+of range or not finite, a string a terminal would obey, a nest too deep, a truncation, flipped bytes, a mesh
+whose faces point past its vertices, a texture cut short, an entity trick in the XML. The contract
+(:func:`check`): the command ends with exit 0 and a whole, finite image, or with a non-zero exit and exactly
+one line ``lenslab: error: ...`` that names a file the case wrote and holds no control characters; never a
+traceback, never a hang.
+
+``tests/test_malformed_inputs.py`` runs a few hundred cases in-process; for a larger run, in a subprocess per
+case as a user meets them::
+
+    python tests/malformed_inputs.py --cases 3000 --seed 11 [--subprocess]
+"""
+
+from __future__ import annotations
+
+import contextlib
+import copy
+import io
+import json
+import math
+import os
+import random
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import time
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parent.parent
+NATIVE_SCENES = ("cornell_box", "dof_chart", "product_shot", "cornell_caustic")  # marbles: a million triangles
+MITSUBA_SCENES = (REPO / "app/lenslab/validate/scenes", REPO / "tests/data/mitsuba")
+RENDER_ARGS = ["--spp", "1", "--width", "8", "--height", "8"]
+CASE_SECONDS = 30
+MAX_ERROR_LINE = 1000
+_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f\x9b]")
+
+
+@dataclass
+class Case:
+    """One malformed input: the files to write in an empty folder, which one to open, what was broken."""
+
+    what: str
+    files: dict[str, bytes]
+    scene: str
+    extra_args: list[str] = field(default_factory=list)
+
+
+@dataclass
+class Outcome:
+    case: Case
+    status: int | None  # None: an exception escaped (a traceback), or the case hung
+    stderr: str
+    seconds: float
+    problem: str = ""  # empty when the contract held
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Values a careless exporter or an attacker might write
+# ---------------------------------------------------------------------------------------------------------
+_HUGE_INT_TEXT = "9" * 400
+_WEIRD_STRINGS = ["", " ", "\x1b[2J\x1b[31mred", "a" * 300, "é☃\u202e", "../" * 20 + "etc/passwd", "/", ".",
+                  "x" * 100_000, "nan", "1e999", "-1", "\x00", "line\nbreak", "CON", "%s%n{0}$p1"]
+
+
+def _weird_json_value(rng: random.Random):
+    choice = rng.randrange(14)
+    if choice == 0:
+        return None
+    if choice == 1:
+        return rng.choice([[], {}, [[]], {"type": []}, [1, 2], [1, 2, 3, 4]])
+    if choice == 2:
+        return rng.choice([True, False])
+    if choice == 3:
+        return rng.choice([0, -1, -0.0, 1e-320, 5e-324, -1e308, 1e308, 3.4e38, 2**64, 2**31, -2**31 - 1])
+    if choice == 4:
+        return rng.choice(_WEIRD_STRINGS)
+    if choice == 5:
+        return float(rng.choice(["nan", "inf", "-inf"]))
+    if choice == 6:
+        return [float("nan"), 1.0, 2.0]
+    if choice == 7:
+        return [1e308, 1e308, 1e308]
+    if choice == 8:
+        return rng.uniform(-1e6, 1e6)
+    if choice == 9:
+        return rng.randint(-5, 100_000)
+    if choice == 10:
+        return {"type": rng.choice(["", "sphere", "map", "diffuse", "mesh", "constant", 7])}
+    if choice == 11:
+        return [[[[[]]]]]
+    if choice == 12:
+        return "$HUGE_INT$"  # replaced in the text by a 400-digit integer
+    return [0, 0, 0]
+
+
+def _paths(value, prefix=()):
+    """Every (path, value) in a parsed JSON document."""
+    yield prefix, value
+    if isinstance(value, dict):
+        for key, item in value.items():
+            yield from _paths(item, prefix + (key,))
+    elif isinstance(value, list):
+        for index, item in enumerate(value):
+            yield from _paths(item, prefix + (index,))
+
+
+def _parent(doc, path):
+    for key in path[:-1]:
+        doc = doc[key]
+    return doc
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Corrupting bytes
+# ---------------------------------------------------------------------------------------------------------
+def _truncate(data: bytes, rng: random.Random) -> bytes:
+    return data[:rng.randrange(len(data))] if data else data
+
+
+def _flip_bytes(data: bytes, rng: random.Random) -> bytes:
+    if not data:
+        return data
+    out = bytearray(data)
+    for _ in range(rng.randint(1, 8)):
+        out[rng.randrange(len(out))] = rng.randrange(256)
+    return bytes(out)
+
+
+def _insert_bytes(data: bytes, rng: random.Random) -> bytes:
+    at = rng.randrange(len(data) + 1)
+    junk = bytes(rng.randrange(256) for _ in range(rng.randint(1, 16)))
+    return data[:at] + junk + data[at:]
+
+
+def _corrupt_bytes(data: bytes, rng: random.Random) -> tuple[str, bytes]:
+    kind = rng.choice(("truncated", "bytes flipped", "bytes inserted"))
+    corrupt = {"truncated": _truncate, "bytes flipped": _flip_bytes, "bytes inserted": _insert_bytes}[kind]
+    return kind, corrupt(data, rng)
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Native scenes
+# ---------------------------------------------------------------------------------------------------------
+def _shipped_files(name: str) -> dict[str, bytes]:
+    folder = REPO / "scenes" / name
+    return {p.name: p.read_bytes() for p in folder.iterdir() if p.is_file() and p.suffix != ".py"}
+
+
+def _native_text(doc) -> bytes:
+    text = json.dumps(doc, indent=1, allow_nan=True)
+    return text.replace('"$HUGE_INT$"', _HUGE_INT_TEXT).encode()
+
+
+def _mutate_native_value(doc, rng: random.Random) -> str:
+    path, _ = rng.choice([p for p in _paths(doc) if p[0] and p[0][0] != "lenslab_scene"])
+    parent = _parent(doc, path)
+    action = rng.randrange(4)
+    where = ".".join(map(str, path))
+    if action == 0 and isinstance(parent, dict):
+        del parent[path[-1]]
+        return f"{where} deleted"
+    if action == 1 and isinstance(parent, dict):
+        parent[rng.choice(_WEIRD_STRINGS[:6])] = _weird_json_value(rng)
+        return f"an unknown key beside {where}"
+    value = _weird_json_value(rng)
+    parent[path[-1]] = value
+    return f"{where} = {json.dumps(value, allow_nan=True)[:60]}"
+
+
+def _deep_nodes(doc, depth: int) -> bytes:
+    """The scene with one chain of nodes ``depth`` deep, written as text (json.dumps itself recurses)."""
+    leaf = '{"name": "leaf", "shape": {"type": "sphere", "radius": 0.1}, "material": "", "children": []}'
+    chain = '{"name": "level", "children": [' * depth + leaf + "]}" * depth
+    doc["nodes"] = "$NODES$"
+    return _native_text(doc).replace(b'"$NODES$"', b"[" + chain.encode() + b"]")
+
+
+def native_case(rng: random.Random) -> Case:
+    name = rng.choice(NATIVE_SCENES)
+    files = _shipped_files(name)
+    doc = json.loads(files["scene.json"])
+    kind = rng.randrange(12)
+    if kind <= 5:
+        what = " and ".join(_mutate_native_value(doc, rng) for _ in range(rng.randint(1, 2)))
+        files["scene.json"] = _native_text(doc)
+    elif kind == 6:
+        what, files["scene.json"] = _corrupt_bytes(files["scene.json"], rng)
+    elif kind == 7:
+        depth = rng.choice((300, 5_000, 100_000))
+        files["scene.json"] = b"[" * depth + b"]" * depth
+        what = f"{depth} nested ["
+    elif kind == 8:
+        depth = rng.choice((250, 1_200, 3_000))
+        files["scene.json"] = _deep_nodes(doc, depth)
+        what = f"a node tree {depth} deep"
+    elif kind == 9:
+        what = _broken_mesh(doc, files, rng)
+        files["scene.json"] = _native_text(doc)
+    elif kind == 10:
+        what = _broken_texture(doc, files, rng)
+        files["scene.json"] = _native_text(doc)
+    else:
+        text = files["scene.json"].decode()
+        numbers = list(re.finditer(r"-?\d+\.?\d*", text))
+        if not numbers:
+            return native_case(rng)
+        number = rng.choice(numbers)
+        replacement = rng.choice(["NaN", "Infinity", "-Infinity", _HUGE_INT_TEXT, "1e400", "-0", "9" * 5000,
+                                  "1e-320", "3.4e38"])
+        files["scene.json"] = (text[:number.start()] + replacement + text[number.end():]).encode()
+        what = f"a number in the text replaced by {replacement[:20]}"
+    return Case(f"{name}: {what}", files, "scene.json")
+
+
+# Meshes: a small PLY or OBJ, broken in one of the ways exporters break them.
+_PLY_HEADER = ("ply\nformat ascii 1.0\nelement vertex {v}\nproperty float x\nproperty float y\nproperty float z\n"
+               "element face {f}\nproperty list uchar int vertex_indices\nend_header\n")
+
+
+def _mesh_text(rng: random.Random) -> tuple[str, str, bytes]:
+    kind = rng.randrange(9)
+    if kind == 0:
+        return "a PLY face past the vertex count", "m.ply", (_PLY_HEADER.format(v=3, f=1) +
+                                                           "0 0 0\n1 0 0\n0 1 0\n3 0 1 99\n").encode()
+    if kind == 1:
+        return "a PLY with a negative face index", "m.ply", (_PLY_HEADER.format(v=3, f=1) +
+                                                           "0 0 0\n1 0 0\n0 1 0\n3 0 -5 2\n").encode()
+    if kind == 2:
+        return "a PLY whose header claims more than it holds", "m.ply", (_PLY_HEADER.format(v=300, f=100) +
+                                                                       "0 0 0\n1 0 0\n").encode()
+    if kind == 3:
+        return "a PLY with NaN vertices", "m.ply", (_PLY_HEADER.format(v=3, f=1) +
+                                                  "nan 0 0\n1 inf 0\n0 1 0\n3 0 1 2\n").encode()
+    if kind == 4:
+        return "an OBJ face past the vertex count", "m.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99\n"
+    if kind == 5:
+        return "an OBJ face with index 0", "m.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n"
+    if kind == 6:
+        return "an OBJ with huge coordinates", "m.obj", b"v 3.4e38 0 0\nv -3.4e38 0 0\nv 0 1e300 0\nf 1 2 3\n"
+    if kind == 7:
+        return "an OBJ with an MTL whose Ke is NaN", "m.obj", (b"mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                                                             b"usemtl glow\nf 1 2 3\n")
+    return "an empty OBJ", "m.obj", b"# nothing\n"
+
+
+def _broken_mesh(doc, files: dict[str, bytes], rng: random.Random) -> str:
+    what, name, data = _mesh_text(rng)
+    files[name] = data
+    files["m.mtl"] = b"newmtl glow\nKd 0.5 0.5 0.5\nKe nan inf 1\nKs 1e999 0 0\nNs -5\n"
+    doc.setdefault("nodes", []).append({"name": "broken mesh", "shape": {"type": "mesh", "file": name},
+                                        "material": "", "children": []})
+    return what
+
+
+def _broken_texture(doc, files: dict[str, bytes], rng: random.Random) -> str:
+    image = files.get("studio.exr") or (REPO / "scenes/product_shot/studio.exr").read_bytes()
+    how, image = _corrupt_bytes(image, rng)
+    files["studio.exr"] = image
+    doc["environment"] = {"type": "map", "file": "studio.exr", "strength": 1.0}
+    return f"an environment map {how}"
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Mitsuba XML scenes
+# ---------------------------------------------------------------------------------------------------------
+def _mitsuba_sources() -> list[Path]:
+    return sorted(p for folder in MITSUBA_SCENES for p in folder.glob("*.xml"))
+
+
+_XML_VALUES = ["", "nan", "inf", "-inf", "-1", "0", "1e-320", "1e400", _HUGE_INT_TEXT, "abc", "1,2", "1 2 3 4 5",
+               "$missing", "true", "\x1b[2J", "a" * 300, "0 0 0", "-0"]
+
+
+def _mutate_xml_tree(root: ET.Element, rng: random.Random) -> str:
+    elements = list(root.iter())
+    element = rng.choice(elements)
+    action = rng.randrange(7)
+    if action <= 2 and element.attrib:
+        key = rng.choice(sorted(element.attrib))
+        if action == 0:
+            del element.attrib[key]
+            return f"<{element.tag}> without its {key}"
+        element.attrib[key] = rng.choice(_XML_VALUES)
+        return f"<{element.tag} {key}='{element.attrib[key][:20]}'>"
+    if action == 3 and element is not root:
+        parent = next(p for p in root.iter() if element in list(p))
+        parent.remove(element)
+        return f"<{element.tag}> removed"
+    if action == 4:
+        element.tag = rng.choice(["bogus", "shape", "float", "ref", "include", "default", "transform"])
+        return f"an element renamed <{element.tag}>"
+    if action == 5 and element is not root:
+        parent = next(p for p in root.iter() if element in list(p))
+        parent.append(copy.deepcopy(element))
+        return f"<{element.tag}> duplicated"
+    element.append(ET.Element(rng.choice(["float", "rgb", "integer", "point", "matrix", "string", "boolean"]),
+                              {"name": rng.choice(["radius", "fov", "to_world", "reflectance", "value", "x"]),
+                               "value": rng.choice(_XML_VALUES)}))
+    return f"a property added to <{element.tag}>"
+
+
+_XML_TRICKS = {
+    "billion laughs": ('<?xml version="1.0"?>\n<!DOCTYPE s [<!ENTITY a "aaaaaaaaaa">'
+                       '<!ENTITY b "&a;&a;&a;&a;&a;&a;&a;&a;&a;&a;"><!ENTITY c "&b;&b;&b;&b;&b;&b;&b;&b;&b;&b;">'
+                       '<!ENTITY d "&c;&c;&c;&c;&c;&c;&c;&c;&c;&c;"><!ENTITY e "&d;&d;&d;&d;&d;&d;&d;&d;&d;&d;">'
+                       '<!ENTITY f "&e;&e;&e;&e;&e;&e;&e;&e;&e;&e;"><!ENTITY g "&f;&f;&f;&f;&f;&f;&f;&f;&f;&f;">]>\n'
+                       '<scene version="3.0.0"><string name="x" value="&g;"/></scene>\n'),
+    "an external entity": ('<?xml version="1.0"?>\n<!DOCTYPE s [<!ENTITY x SYSTEM "file:///etc/passwd">]>\n'
+                           '<scene version="3.0.0"><string name="x" value="&x;"/></scene>\n'),
+    "a bogus encoding": '<?xml version="1.0" encoding="bogus"?>\n<scene version="3.0.0"/>\n',
+    "defaults that double": ('<scene version="3.0.0">' + '<default name="p0" value="ab"/>' +
+                             "".join(f'<default name="p{i}" value="$p{i - 1}$p{i - 1}"/>' for i in range(1, 29)) +
+                             '<integer name="x" value="$p28"/></scene>\n'),
+    "an include of itself": '<scene version="3.0.0"><include filename="scene.xml"/></scene>\n',
+    "shapes nested 1000 deep": ('<scene version="3.0.0">' + '<shape type="sphere">' * 1000 +
+                                '</shape>' * 1000 + '</scene>\n'),
+    "a property with no value": ('<scene version="3.0.0"><sensor type="perspective"><float name="fov"/>'
+                                 '</sensor></scene>\n'),
+    "ext_ior of 0": ('<scene version="3.0.0"><shape type="sphere"><bsdf type="dielectric">'
+                     '<float name="ext_ior" value="0"/></bsdf></shape></scene>\n'),
+    "alpha_u of -1": ('<scene version="3.0.0"><shape type="sphere"><bsdf type="roughconductor">'
+                      '<float name="alpha_u" value="-1"/><float name="alpha_v" value="0.1"/></bsdf></shape>'
+                      '</scene>\n'),
+    "a huge translate": ('<scene version="3.0.0"><shape type="sphere"><transform name="to_world">'
+                         '<translate x="3.4e38"/></transform></shape></scene>\n'),
+    "a NaN matrix": ('<scene version="3.0.0"><shape type="cube"><transform name="to_world">'
+                     '<matrix value="1 0 0 0 0 nan 0 0 0 0 1 0 0 0 0 1"/></transform></shape></scene>\n'),
+    "a version 0 scene": '<scene version="0.0.1"><shape type="sphere"/></scene>\n',
+    "not a scene": '<?xml version="1.0"?>\n<html><body/></html>\n',
+}
+
+
+def mitsuba_case(rng: random.Random) -> Case:
+    if rng.random() < 0.15:
+        trick = rng.choice(sorted(_XML_TRICKS))
+        return Case(f"Mitsuba: {trick}", {"scene.xml": _XML_TRICKS[trick].encode()}, "scene.xml")
+    source = rng.choice(_mitsuba_sources())
+    files = {p.name: p.read_bytes() for p in source.parent.iterdir()
+             if p.is_file() and p.suffix in (".exr", ".ply", ".obj", ".png")}
+    data = source.read_bytes()
+    if rng.random() < 0.25:
+        how, data = _corrupt_bytes(data, rng)
+        what = how
+    else:
+        root = ET.fromstring(data)
+        what = " and ".join(_mutate_xml_tree(root, rng) for _ in range(rng.randint(1, 2)))
+        data = ET.tostring(root)
+    files["scene.xml"] = data
+    return Case(f"{source.name}: {what}", files, "scene.xml")
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Command-line values
+# ---------------------------------------------------------------------------------------------------------
+_CLI_VALUES = ["0", "-1", "nan", "inf", "1e400", _HUGE_INT_TEXT, "", "abc", "\x1b[2J", "1/0", "f/0", "0x10"]
+_CLI_OPTIONS = ["--spp", "--width", "--f-stop", "--focal-length", "--focus-distance", "--seed", "--max-depth",
+                "--time-limit", "--exposure", "--iso", "--shutter", "--coc", "--blades", "--anamorphic", "--lens"]
+
+
+def cli_case(rng: random.Random) -> Case:
+    files = _shipped_files("cornell_box")
+    option, value = rng.choice(_CLI_OPTIONS), rng.choice(_CLI_VALUES)
+    return Case(f"cornell_box: {option} {value[:20]!r}", files, "scene.json", [option, value])
+
+
+def generate(count: int, seed: int) -> list[Case]:
+    rng = random.Random(seed)
+    makers = [native_case] * 5 + [mitsuba_case] * 4 + [cli_case]
+    return [rng.choice(makers)(rng) for _ in range(count)]
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Running a case and judging what came out
+# ---------------------------------------------------------------------------------------------------------
+def write_case(case: Case, folder: Path) -> Path:
+    if folder.exists():
+        shutil.rmtree(folder)
+    folder.mkdir(parents=True)
+    for name, data in case.files.items():
+        (folder / name).write_bytes(data)
+    return folder / case.scene
+
+
+def _arguments(case: Case, scene: Path, output: Path) -> list[str]:
+    args = [str(scene), "--headless", "-o", str(output), *RENDER_ARGS]
+    if case.extra_args:  # the case's own value of an option wins over the default one
+        option = case.extra_args[0]
+        if option in args:
+            index = args.index(option)
+            del args[index:index + 2]
+        args += case.extra_args
+    return args
+
+
+class _Hung(BaseException):
+    pass
+
+
+def _raise_hung(signum, frame):
+    raise _Hung()
+
+
+def run_in_process(case: Case, folder: Path) -> Outcome:
+    """Run ``lenslab.cli.main`` on the case in this process, its stderr captured; an exception that escapes
+    is a traceback the user would have seen."""
+    from lenslab.cli import main
+
+    scene = write_case(case, folder)
+    output = folder / "out.png"
+    stderr = io.StringIO()
+    start = time.perf_counter()
+    previous = signal.signal(signal.SIGALRM, _raise_hung)
+    signal.alarm(CASE_SECONDS)
+    try:
+        with contextlib.redirect_stderr(stderr), contextlib.redirect_stdout(io.StringIO()):
+            status = main(_arguments(case, scene, output))
+    except _Hung:
+        return Outcome(case, None, stderr.getvalue(), time.perf_counter() - start, f"hung over {CASE_SECONDS} s")
+    except BaseException as exc:  # noqa: BLE001 - anything escaping main is a traceback for the user
+        import traceback
+
+        return Outcome(case, None, stderr.getvalue() + "".join(traceback.format_exception(exc)[-6:]),
+                       time.perf_counter() - start,
+                       f"traceback: {type(exc).__name__}: {str(exc)[:200]}")
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
+    return judge(Outcome(case, status, stderr.getvalue(), time.perf_counter() - start), output)
+
+
+def run_in_subprocess(case: Case, folder: Path) -> Outcome:
+    scene = write_case(case, folder)
+    output = folder / "out.png"
+    start = time.perf_counter()
+    try:
+        done = subprocess.run([sys.executable, "-m", "lenslab", *_arguments(case, scene, output)],
+                              capture_output=True, text=True, errors="replace", timeout=CASE_SECONDS,
+                              env={**os.environ, "PYTHONPATH": str(REPO / "app")})
+    except subprocess.TimeoutExpired:
+        return Outcome(case, None, "", time.perf_counter() - start, f"hung over {CASE_SECONDS} s")
+    return judge(Outcome(case, done.returncode, done.stderr, time.perf_counter() - start), output)
+
+
+def judge(outcome: Outcome, output: Path) -> Outcome:
+    """Fill in ``outcome.problem``: what about the run broke the contract, if anything."""
+    lines = outcome.stderr.splitlines()
+    if "Traceback (most recent call last)" in outcome.stderr:
+        outcome.problem = "a traceback on stderr"
+    elif any(_CONTROL.search(line) for line in lines):
+        outcome.problem = "a control character on stderr"
+    elif any(len(line) > MAX_ERROR_LINE for line in lines):
+        outcome.problem = f"a line over {MAX_ERROR_LINE} characters"
+    elif outcome.status == 0:
+        outcome.problem = _judge_image(output, expect_size=not outcome.case.extra_args)
+    else:
+        errors = [line for line in lines if line.startswith("lenslab: error: ")]
+        others = [line for line in lines if not line.startswith(("lenslab: error: ", "lenslab: warning: "))]
+        if len(errors) != 1 or others:
+            outcome.problem = f"{len(errors)} error lines and {len(others)} other lines"
+        elif "internal error" in errors[0]:
+            outcome.problem = "an internal error (a case a reader missed)"
+        elif not _names_a_file(errors[0], outcome.case):
+            outcome.problem = "the error names no file"
+        elif errors[0].count(f"{output.parent / outcome.case.scene}: ") > 1:
+            outcome.problem = "the scene file is named twice"
+        elif output.exists():
+            outcome.problem = "an image was written although the render failed"
+    return outcome
+
+
+def _names_a_file(line: str, case: Case) -> bool:
+    if case.extra_args:  # a command-line value: the option is what to name
+        return case.extra_args[0] in line or "argument" in line
+    return any(name in line for name in case.files)
+
+
+def _judge_image(output: Path, expect_size: bool) -> str:
+    import numpy as np
+
+    from lenslab.render.film import read_image
+
+    if not output.is_file():
+        return "exit 0 without an image"
+    pixels, _ = read_image(output)
+    if expect_size and pixels.shape[:2] != (8, 8):
+        return f"an image of {pixels.shape[1]} x {pixels.shape[0]}, not 8 x 8"
+    if not np.all(np.isfinite(pixels)):
+        return "an image with non-finite pixels"
+    return ""
+
+
+def main(argv: list[str] | None = None) -> int:
+    import argparse
+    import tempfile
+
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--cases", type=int, default=300)
+    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--subprocess", action="store_true", help="one process per case, as a user runs it")
+    parser.add_argument("--show", action="store_true", help="print every case, not only the failures")
+    parser.add_argument("--only", type=int, help="run just this case of the sequence, and print all of its stderr")
+    args = parser.parse_args(argv)
+    sys.path.insert(0, str(REPO / "app"))
+    run = run_in_subprocess if args.subprocess else run_in_process
+    failures, slowest = 0, []
+    with tempfile.TemporaryDirectory() as tmp:
+        for index, case in enumerate(generate(args.cases, args.seed)):
+            if args.only is not None and index != args.only:
+                continue
+            outcome = run(case, Path(tmp) / "case")
+            slowest.append((outcome.seconds, case.what))
+            if args.only is not None:
+                print(outcome.stderr)
+            if outcome.problem or args.show:
+                failures += bool(outcome.problem)
+                last = outcome.stderr.strip().splitlines()[-1:] or [""]
+                print(f"[{index}] {case.what[:120]!r}: {outcome.problem or 'ok'} (exit {outcome.status}, "
+                      f"{outcome.seconds:.1f} s)\n      {last[0][:300]!r}", flush=True)
+    slowest.sort(reverse=True)
+    print(f"{args.cases} cases, {failures} broke the contract; slowest: "
+          + "; ".join(f"{s:.1f} s {w[:60]!r}" for s, w in slowest[:3]))
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
