@@ -182,11 +182,59 @@ def _deep_nodes(doc, depth: int) -> bytes:
     return _native_text(doc).replace(b'"$NODES$"', b"[" + chain.encode() + b"]")
 
 
+def _extreme_number(doc, rng: random.Random) -> str:
+    """A number where a number belongs, but at or past the edge of sense: zero, tiny, huge, negative."""
+    numbers = [(path, value) for path, value in _paths(doc) if path and path[0] != "lenslab_scene"
+               and isinstance(value, (int, float)) and not isinstance(value, bool)]
+    path, value = rng.choice(numbers)
+    new = rng.choice([0, -0.0, 1e-30, 1e-9, -1, -1e9, 1e9, 1e29, 1e31, 65536, 2**31, 0.5, value * 1e6,
+                      value * -1, 16384, 16385])
+    _parent(doc, path)[path[-1]] = new
+    return f"{'.'.join(map(str, path))} = {new}"
+
+
+_LONG_NAME = "n" * 300
+
+
+def _broken_file_reference(doc, files: dict[str, bytes], rng: random.Random) -> str:
+    """A file the scene names, broken: a name too long for the file system, a folder, a corrupt image."""
+    kind = rng.randrange(6)
+    if kind == 0:
+        doc.setdefault("nodes", []).append({"name": "long", "shape": {"type": "mesh", "file": _LONG_NAME + ".obj"}})
+        return "a mesh file name of 300 characters"
+    if kind == 1:
+        doc["environment"] = {"type": "map", "file": _LONG_NAME + ".exr"}
+        return "an environment map name of 300 characters"
+    if kind == 2:
+        files["folder.obj/placeholder"] = b""
+        doc.setdefault("nodes", []).append({"name": "dir", "shape": {"type": "mesh", "file": "folder.obj"}})
+        return "a mesh file that is a folder"
+    material = next(iter(doc.get("materials") or {}), None)
+    image = (REPO / "scenes/product_shot/studio.exr").read_bytes()
+    how, image = _corrupt_bytes(image, rng) if kind < 5 else ("whole", image)
+    files["texture.exr"] = image
+    if kind == 3 and material and doc["materials"][material].get("type") in ("diffuse", "plastic"):
+        doc["materials"][material]["albedo_texture"] = {"type": "image", "file": "texture.exr"}
+        return f"a texture {how}"
+    doc["camera"]["aperture_image"] = "texture.exr" if kind != 5 else _LONG_NAME + ".png"
+    return f"an aperture image {how}" if kind != 5 else "an aperture image name of 300 characters"
+
+
 def native_case(rng: random.Random) -> Case:
     name = rng.choice(NATIVE_SCENES)
     files = _shipped_files(name)
     doc = json.loads(files["scene.json"])
-    kind = rng.randrange(12)
+    kind = rng.randrange(15)
+    if kind == 12:
+        what = _extreme_number(doc, rng)
+        files["scene.json"] = _native_text(doc)
+        return Case(f"{name}: {what}", files, "scene.json")
+    if kind == 13:
+        what = _broken_file_reference(doc, files, rng)
+        files["scene.json"] = _native_text(doc)
+        return Case(f"{name}: {what}", files, "scene.json")
+    if kind == 14:
+        return Case(f"{name}: a folder without a scene", {"notes.txt": b"hello"}, ".")
     if kind <= 5:
         what = " and ".join(_mutate_native_value(doc, rng) for _ in range(rng.randint(1, 2)))
         files["scene.json"] = _native_text(doc)
@@ -365,6 +413,12 @@ _CLI_OPTIONS = ["--spp", "--width", "--f-stop", "--focal-length", "--focus-dista
 
 
 def cli_case(rng: random.Random) -> Case:
+    if rng.random() < 0.3:
+        source = rng.choice(_mitsuba_sources())
+        value = rng.choice(_XML_VALUES + ["$x", "$$", "\\$"])
+        files = {p.name: p.read_bytes() for p in source.parent.iterdir() if p.suffix in (".exr", ".ply", ".obj")}
+        return Case(f"{source.name}: -D {value[:20]!r}", {**files, "scene.xml": source.read_bytes()}, "scene.xml",
+                    ["-D", f"{rng.choice(['spp', 'res', 'x', ''])}={value}"])
     files = _shipped_files("cornell_box")
     option, value = rng.choice(_CLI_OPTIONS), rng.choice(_CLI_VALUES)
     return Case(f"cornell_box: {option} {value[:20]!r}", files, "scene.json", [option, value])
@@ -384,6 +438,7 @@ def write_case(case: Case, folder: Path) -> Path:
         shutil.rmtree(folder)
     folder.mkdir(parents=True)
     for name, data in case.files.items():
+        (folder / name).parent.mkdir(parents=True, exist_ok=True)
         (folder / name).write_bytes(data)
     return folder / case.scene
 
@@ -466,7 +521,7 @@ def judge(outcome: Outcome, output: Path) -> Outcome:
             outcome.problem = f"{len(errors)} error lines and {len(others)} other lines"
         elif "internal error" in errors[0]:
             outcome.problem = "an internal error (a case a reader missed)"
-        elif not _names_a_file(errors[0], outcome.case):
+        elif not _names_a_file(errors[0], outcome.case, output.parent):
             outcome.problem = "the error names no file"
         elif errors[0].count(f"{output.parent / outcome.case.scene}: ") > 1:
             outcome.problem = "the scene file is named twice"
@@ -475,10 +530,12 @@ def judge(outcome: Outcome, output: Path) -> Outcome:
     return outcome
 
 
-def _names_a_file(line: str, case: Case) -> bool:
-    if case.extra_args:  # a command-line value: the option is what to name
-        return case.extra_args[0] in line or "argument" in line
-    return any(name in line for name in case.files)
+def _names_a_file(line: str, case: Case, folder: Path) -> bool:
+    """The line names the scene, a file of the case (perhaps one too long to show whole), or for a value
+    given on the command line, its option."""
+    if case.extra_args and (case.extra_args[0] in line or "argument" in line):
+        return True
+    return any(name in line for name in case.files) or str(folder) in line
 
 
 def _judge_image(output: Path, expect_size: bool) -> str:

@@ -153,17 +153,25 @@ def test_broken_scene_exits_with_file_and_key(tmp_path, capsys):
     assert not (tmp_path / "x.png").exists()
 
 
-def test_missing_gl_driver_is_one_line_with_the_packages_to_install(tmp_path, monkeypatch, capsys):
+@pytest.mark.parametrize("failure, package", [
+    ("libEGL.so.1: cannot open shared object file: No such file or directory", "libegl1"),
+    ("libEGL.so not loaded", "libegl1"),  # moderngl's own words
+    ("libGL.so not loaded", "libgl1"),
+    ("libOpenGL.so.0 not loaded", "libopengl0"),
+])
+def test_missing_gl_driver_is_one_line_with_the_packages_to_install(tmp_path, monkeypatch, capsys, failure,
+                                                                    package):
     import moderngl
 
     def no_egl(**kwargs):
-        raise Exception("libEGL.so.1: cannot open shared object file: No such file or directory")
+        raise Exception(failure)
 
     monkeypatch.setattr(moderngl, "create_context", no_egl)
     status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.png")
     assert status == 1
     assert err.count("\n") == 1
-    assert "no EGL library" in err and "apt-get install libegl1 libgl1-mesa-dri libegl-mesa0" in err
+    assert f"is missing: on Debian/Ubuntu `apt-get install {package}`" in err
+    assert "apt-get install libegl1 libgl1 libopengl0 libegl-mesa0 libgl1-mesa-dri" in err
     status, _, err = run_cli(capsys, "--info")
     assert status == 1 and "apt-get install" in err
 
@@ -444,3 +452,22 @@ def test_the_listed_presets_are_the_shipped_ones(capsys):
     assert status == 0 and not err and len(lines) == 1 + len(load_sensor_presets())
     assert all(line.startswith(sensor.name + " ") for line, sensor in zip(lines[1:], load_sensor_presets()))
     assert "Full frame" in out and "36 x 24 mm" in out and "1.00x" in out
+
+
+def test_info_with_an_output_says_it_renders_nothing(capsys, tmp_path):
+    status, _, err = run_cli(capsys, "cornell_box", "--info", "--headless", "-o", tmp_path / "c.png")
+    assert status == 2 and "--info prints the device and exits without rendering" in err
+    assert not (tmp_path / "c.png").exists()
+
+
+def test_png_only_options_on_an_exr_are_each_named(renderer, capsys, tmp_path):
+    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "c.exr", "--spp", "1", "--width",
+                             "8", "--height", "8", "--tone-map", "filmic", "--exposure", "1")
+    assert status == 0
+    assert "--tone-map applies to PNG only" in err and "--exposure applies to PNG only" in err
+
+
+def test_a_folder_without_a_scene_is_called_a_folder(capsys, tmp_path):
+    (tmp_path / "notes.txt").write_text("hello")
+    status, _, err = run_cli(capsys, tmp_path, "--headless", "-o", tmp_path / "c.png")
+    assert status == 1 and f"{tmp_path}: a folder with no scene.json in it" in err

@@ -56,3 +56,51 @@ def test_wheel_in_a_fresh_virtualenv_renders_from_any_directory(renderer, wheel,
     result = subprocess.run([str(python), "-c", code], cwd=elsewhere, capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr
     assert (elsewhere / "out.png").is_file()
+
+
+def _declared_closure() -> set[str]:
+    """The distributions a plain ``pip install lenslab`` brings: pyproject's dependencies and, recursively,
+    what each of them requires without extras."""
+    import importlib.metadata as metadata
+    import re
+
+    try:
+        import tomllib
+    except ImportError:  # Python 3.10
+        import tomli as tomllib
+
+    def name(requirement: str) -> str:
+        return re.split(r"[\s\[<>=!~;(]", requirement.strip(), maxsplit=1)[0].lower().replace("_", "-")
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+    pending = [name(r) for r in project["dependencies"] if "python_version" not in r or sys.version_info < (3, 11)]
+    closure: set[str] = set()
+    while pending:
+        dist = pending.pop()
+        if dist in closure:
+            continue
+        closure.add(dist)
+        try:
+            requires = metadata.requires(dist) or []
+        except metadata.PackageNotFoundError:
+            continue
+        pending += [name(r) for r in requires if "extra ==" not in r]
+    return closure
+
+
+def test_a_plain_install_declares_every_package_a_render_imports(tmp_path):
+    """What trimesh imports for smooth normals (scipy) is nowhere in its own requirements: without it in ours,
+    a plain install printed 'unable to use sparse matrix' and a ModuleNotFoundError on product_shot."""
+    code = (
+        "import sys, json, importlib.metadata as md; from lenslab.cli import main; "
+        "status = main(['product_shot', '--headless', '-o', 'p.png', '--spp', '1', '--width', '8', '--height', '8']); "
+        "owners = md.packages_distributions(); "
+        "print(json.dumps(sorted({d for m in list(sys.modules) for d in owners.get(m.split('.')[0], [])})))"
+    )
+    result = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr
+    import json
+
+    imported = {d.lower().replace("_", "-") for d in json.loads(result.stdout.strip().splitlines()[-1])}
+    undeclared = imported - _declared_closure() - {"lenslab", "pip", "setuptools", "pytest", "pytest-qt"}
+    assert not undeclared, f"imported by a render but not brought by a plain install: {sorted(undeclared)}"

@@ -40,3 +40,12 @@ def one_line(text: object) -> str:
     line = _CONTROL.sub(_escape, str(text))
     words = [shorten(word, LONGEST_WORD) for word in line.split(" ")]
     return shorten(" ".join(words), LONGEST_LINE)
+
+
+def describe_os_error(exc: OSError) -> str:
+    """``path: what went wrong`` for an error of the operating system: Python's own text ("[Errno 36] File
+    name too long: '...'") puts the file last, in quotes, and the errno first."""
+    if exc.filename is None or not exc.strerror:
+        return str(exc)
+    text = f"{exc.filename}: {exc.strerror}"
+    return text if exc.filename2 is None else f"{text} ({exc.filename2})"

@@ -8,6 +8,7 @@ storage-block limit and owns the buffers until :meth:`GpuScene.release`.
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Sequence
@@ -182,7 +183,7 @@ def _environment_uniforms(environment: Environment, textures: TextureTable, scen
         try:
             rgb = read_texture_image(path, "linear")
         except OSError as exc:
-            message = str(exc) if path.exists() else f"{path}: environment map not found"
+            message = str(exc) if os.path.exists(path) else f"{path}: environment map not found"
             textures.warnings.append(f"{message}; lighting with a dim magenta sky instead")
             uniforms["env_radiance"] = MISSING_SKY
             return uniforms, infinite_light_power(4.0 * math.pi * _luminance(MISSING_SKY), scene_radius)

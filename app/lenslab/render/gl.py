@@ -19,9 +19,19 @@ REQUIRED_GL = 430  # compute shaders and shader storage buffers
 
 # One line a user can act on, for the commonest way this fails on a fresh Linux machine.
 INSTALL_HINT = (
-    "install an EGL-capable OpenGL driver: on Debian/Ubuntu `apt-get install libegl1 libgl1-mesa-dri libegl-mesa0` "
-    "(Mesa llvmpipe works without a GPU), or the NVIDIA driver on a GPU machine"
+    "install an EGL-capable OpenGL driver: on Debian/Ubuntu `apt-get install libegl1 libgl1 libopengl0 "
+    "libegl-mesa0 libgl1-mesa-dri` (Mesa llvmpipe works without a GPU), or the NVIDIA driver on a GPU machine"
 )
+#: The Debian/Ubuntu package of each library moderngl loads by name (glvnd's dispatch libraries).
+LIBRARY_PACKAGES = {"libEGL": "libegl1", "libGL": "libgl1", "libOpenGL": "libopengl0"}
+
+
+def _missing_library(text: str) -> str | None:
+    """'libEGL.so not loaded' (moderngl's words for a library it cannot open): which package brings it."""
+    for library, package in LIBRARY_PACKAGES.items():
+        if re.search(rf"\b{library}\.so[.\d]*(:? not loaded|: cannot open)", text):
+            return f"{library}.so is missing: on Debian/Ubuntu `apt-get install {package}`"
+    return None
 
 
 class GLUnavailable(RuntimeError):
@@ -51,6 +61,9 @@ def create_context(device_index: int | None = None):
         text = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         if "device index" in text:
             raise GLUnavailable(f"no such GPU: {text}") from None
+        missing = _missing_library(text)
+        if missing:
+            raise GLUnavailable(f"no OpenGL through EGL ({missing}); {INSTALL_HINT}") from None
         if "libEGL" in text or "eglGetProcAddress" in text or "cannot open" in text.lower():
             raise GLUnavailable(f"no EGL library ({text}); {INSTALL_HINT}") from None
         raise GLUnavailable(f"cannot create an OpenGL {REQUIRED_GL // 100}.{REQUIRED_GL % 100 // 10} context "

@@ -9,6 +9,7 @@ the rest of the scene.
 from __future__ import annotations
 
 import logging
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -82,7 +83,7 @@ class TextureTable:
             try:
                 rgb = read_texture_image(path, texture.color_space)
             except OSError as exc:
-                message = str(exc) if path.exists() else f"{path}: texture file not found"
+                message = str(exc) if os.path.exists(path) else f"{path}: texture file not found"
                 self.warnings.append(f"{message}; showing a magenta checkerboard instead")  # the caller reports it
                 return self._add(MISSING)
             self._add_texels(record, rgb, texture.tiles)

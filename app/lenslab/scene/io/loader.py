@@ -7,6 +7,7 @@ import os
 from pathlib import Path
 from typing import Callable
 
+from lenslab.messages import describe_os_error
 from lenslab.resources import scenes_dir
 from lenslab.scene.io.native import SCENE_SUFFIX, load_scene
 from lenslab.scene.scene import Scene, SceneError
@@ -20,13 +21,16 @@ def shipped_scene_names() -> list[str]:
 
 def resolve_scene_path(text: str | os.PathLike) -> Path:
     path = Path(text)
-    if path.is_dir():
-        path = path / SCENE_FILE_NAME
-    if path.exists():
+    if os.path.isfile(path / SCENE_FILE_NAME):
+        return path / SCENE_FILE_NAME
+    if os.path.isfile(path):
         return path
     shipped = scenes_dir() / str(text) / SCENE_FILE_NAME
-    if shipped.is_file():
+    if os.path.isfile(shipped):
         return shipped
+    if os.path.isdir(path):
+        raise SceneError(f"{path}: a folder with no {SCENE_FILE_NAME} in it (name the scene file itself, or a "
+                         f"scene's folder)")
     names = ", ".join(shipped_scene_names())
     raise SceneError(f"{text}: no such scene file (or a shipped scene: {names})")
 
@@ -40,6 +44,8 @@ def open_scene(text: str | os.PathLike, defines: dict[str, str] | None = None,
         return _open(path, defines, warn)
     except SceneError:
         raise
+    except OSError as exc:  # a file the scene names that the system will not open (a name too long, no access)
+        raise SceneError.in_file(path, describe_os_error(exc)) from None
     except RecursionError:
         raise SceneError(f"{path}: nested too deeply to read") from None
     except MemoryError:

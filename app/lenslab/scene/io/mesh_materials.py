@@ -73,7 +73,7 @@ PLACEHOLDER = Checkerboard(color_a=(1.0, 0.0, 1.0), color_b=(0.0, 0.0, 0.0), til
 def load_parts(path: Path, smooth: bool = True) -> LoadedMesh:
     """The mesh file as parts, one per material it uses; cached by path, modification times and ``smooth``."""
     path = Path(path)
-    if not path.is_file():
+    if not os.path.isfile(path):
         raise MeshLoadError(f"{path}: mesh file not found")
     path = path.resolve()
     return _load_cached(str(path), path.stat().st_mtime_ns, _sidecar_stamp(path), smooth)
@@ -376,10 +376,10 @@ class ObjMaterials:
             self._read_library(match.group(1).decode("utf-8", "replace"))
 
     def _read_library(self, value: str) -> None:
-        names = [value] if (self.path.parent / value).is_file() else value.split()
+        names = [value] if os.path.isfile(self.path.parent / value) else value.split()
         for name in names:
             library = self.path.parent / name.replace("\\", "/")
-            if not library.is_file():
+            if not os.path.isfile(library):
                 self.notes.add_file(f"material library '{name}' not found ({library}): its materials render "
                                     "with the node's material or the default grey")
                 continue
@@ -470,7 +470,7 @@ class ObjMaterials:
             return None
         path = Path(file.replace("\\", "/"))
         path = path if path.is_absolute() else folder / path
-        if not path.is_file():
+        if not os.path.isfile(path):
             note(f"{written} texture file '{file}' not found ({path}): it renders as a magenta checkerboard")
         return ImageTexture(file=str(path), color_space=color_space, tiles=tiles)
 
@@ -748,7 +748,7 @@ class GltfMaterials:
                  ) -> Path | None:
         """The external file of an image when it does not exist (noted, with what happens instead), else None."""
         path = self._external_path(image_index)
-        if path is None or path.is_file():
+        if path is None or os.path.isfile(path):
             return None
         uri = self.header["images"][image_index]["uri"]
         note(f"{role} texture file '{uri}' not found ({path}): {fallback}")

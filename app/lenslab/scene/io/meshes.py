@@ -6,6 +6,7 @@ does not re-read a large file.
 
 from __future__ import annotations
 
+import os
 from functools import lru_cache
 from pathlib import Path
 
@@ -71,7 +72,7 @@ def load_mesh_parts(path: Path, smooth: bool = True) -> LoadedMesh:
 
 def load_mesh(path: Path, smooth: bool = True) -> TriangleMesh:
     path = Path(path)
-    if not path.is_file():
+    if not os.path.isfile(path):
         raise MeshLoadError(f"{path}: mesh file not found")
     return _load_cached(str(path.resolve()), path.stat().st_mtime_ns, smooth)
 

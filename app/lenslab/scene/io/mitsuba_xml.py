@@ -225,7 +225,7 @@ class _Expander:
         if not filename:
             raise node.error("needs a filename")
         path = Path(filename) if Path(filename).is_absolute() else node.folder / filename
-        if not path.is_file():
+        if not os.path.isfile(path):
             raise node.error(f"included file not found: {path}")
         if depth + 1 >= MAX_INCLUDE_DEPTH:
             raise node.error(f"includes nested deeper than {MAX_INCLUDE_DEPTH} (an include cycle?)")
@@ -507,7 +507,7 @@ class _Importer:
         if path.is_absolute():
             return path
         for folder in [node.folder, self.root_folder, *self.search_dirs]:
-            if (folder / path).exists():
+            if os.path.exists(folder / path):
                 return folder / path
         return node.folder / path
 
@@ -631,7 +631,7 @@ class _Importer:
             pass  # converted where a shape refers to them
         elif tag == "path":
             folder = self.resolve_file(child, child.attrs.get("value", ""))
-            if not folder.is_dir():
+            if not os.path.isdir(folder):
                 raise child.error(f"folder not found: {folder}")
             self.search_dirs.insert(0, folder)
         elif tag in ("medium", "phase", "volume", "field"):
@@ -726,7 +726,7 @@ class _Importer:
         if not filename:
             raise node.error('needs a "filename"')
         path = self.resolve_file(node, filename)
-        if not path.is_file():
+        if not os.path.isfile(path):
             raise node.error(f"environment map not found: {path}")
         linear = to_world[:3, :3]
         theta = math.degrees(math.atan2(linear[0, 2], linear[0, 0]))
@@ -777,7 +777,7 @@ class _Importer:
             if not filename:
                 raise node.error('needs a "filename"')
             path = self.resolve_file(node, filename)
-            if not path.is_file():
+            if not os.path.isfile(path):
                 raise node.error(f"mesh file not found: {path}")
             smooth = not p.bool("face_normals", False)
             shape = MeshFile(file=self._scene_relative(path), smooth=smooth)
@@ -1170,7 +1170,7 @@ def load_mitsuba_scene(path: str | os.PathLike, defines: dict[str, str] | None =
     Raises :class:`SceneError` (file and line in its message) for a file Mitsuba would reject too.
     """
     path = Path(path)
-    if not path.is_file():
+    if not os.path.isfile(path):
         raise SceneError(f"{path}: no such scene file")
     folder = path.resolve().parent
     return _load(lambda ex: ex.parse_file(path), str(path), folder, path.resolve(), defines, warn)

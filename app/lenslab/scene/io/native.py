@@ -183,7 +183,7 @@ def _check_references(scene: Scene) -> None:
                 mesh_path = Path(node.shape.file)
                 if not mesh_path.is_absolute():
                     mesh_path = scene.base_dir() / mesh_path
-                if not mesh_path.is_file():
+                if not os.path.isfile(mesh_path):
                     raise _Invalid(_join(_join(node_path, "shape"), "file"), f"mesh file not found: {mesh_path}")
             visit(node.children, _join(node_path, "children"))
 

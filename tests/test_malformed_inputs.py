@@ -1,0 +1,159 @@
+"""Malformed input meets one clear line: the file named, what is wrong, a non-zero exit; never a traceback.
+
+The seeded run goes through hundreds of broken scenes made by ``tests/malformed_inputs.py``; the cases
+below it are the minimal ones of each class that once ended in a traceback or slipped through.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+from pathlib import Path
+
+import pytest
+
+from lenslab.cli import main
+from lenslab.messages import LONGEST_LINE, one_line
+from tests import malformed_inputs
+
+pytestmark = pytest.mark.gl
+CORNELL = Path(__file__).resolve().parent.parent / "scenes" / "cornell_box" / "scene.json"
+
+
+def test_a_seeded_run_of_malformed_inputs_meets_the_contract(tmp_path):
+    failures = []
+    for index, case in enumerate(malformed_inputs.generate(300, seed=2026)):
+        outcome = malformed_inputs.run_in_process(case, tmp_path / "case")
+        if outcome.problem:
+            failures.append(f"[{index}] {case.what[:100]!r}: {outcome.problem}: {outcome.stderr.strip()[-300:]!r}")
+    assert not failures, f"{len(failures)} of 300 cases broke the contract:\n" + "\n".join(failures)
+
+
+def _run(*args: str) -> tuple[int, str]:
+    stderr = io.StringIO()
+    with contextlib.redirect_stderr(stderr), contextlib.redirect_stdout(io.StringIO()):
+        status = main([*map(str, args)])
+    return status, stderr.getvalue()
+
+
+def _render(scene: Path, tmp_path: Path, *extra: str) -> tuple[int, str]:
+    return _run(scene, "--headless", "-o", tmp_path / "out.png", "--spp", "1", "--width", "8", "--height", "8",
+                *extra)
+
+
+def _cornell(tmp_path: Path, edit) -> Path:
+    doc = json.loads(CORNELL.read_text())
+    edit(doc)
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(doc))
+    return path
+
+
+def _one_error(status: int, stderr: str) -> str:
+    lines = stderr.strip().splitlines()
+    assert status == 1 and len(lines) == 1 and lines[0].startswith("lenslab: error: "), stderr
+    assert "Traceback" not in stderr
+    return lines[0]
+
+
+def _add_node(doc: dict, shape: dict) -> None:
+    doc["nodes"].append({"name": "extra", "shape": shape, "children": []})
+
+
+@pytest.mark.parametrize("mesh_name, text, expected", [
+    ("m.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+              "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 99\n",
+     "1 face index points outside the 3 vertices"),
+    ("m.obj", "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "not finite"),
+    ("m.obj", "v 3.4e38 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "beyond the 1e+30"),
+])
+def test_a_broken_mesh_is_named(tmp_path, mesh_name, text, expected):
+    (tmp_path / mesh_name).write_text(text)
+    scene = _cornell(tmp_path, lambda doc: _add_node(doc, {"type": "mesh", "file": mesh_name}))
+    line = _one_error(*_render(scene, tmp_path))
+    assert mesh_name in line and expected in line and str(scene) in line
+    assert line.count(f"{scene}: ") == 1, "the scene file is named once"
+
+
+def test_an_mtl_emission_that_is_not_a_number_is_refused(tmp_path):
+    (tmp_path / "m.obj").write_text("mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl glow\nf 1 2 3\n")
+    (tmp_path / "m.mtl").write_text("newmtl glow\nKe nan inf 1\n")
+    scene = _cornell(tmp_path, lambda doc: _add_node(doc, {"type": "mesh", "file": "m.obj"}))
+    line = _one_error(*_render(scene, tmp_path))
+    assert "m.mtl: material 'glow': Ke nan inf 1: not a finite number" in line
+
+
+@pytest.mark.parametrize("edit, expected", [
+    (lambda doc: doc["render"].update(spp=int("9" * 400)), "render.spp: a 400-digit number is too large"),
+    (lambda doc: doc.update(environment={"type": []}), "environment.type: unknown type []"),
+    (lambda doc: doc["camera"].update(focus_distance_m=float("nan")), "camera.focus_distance_m: nan is not a finite"),
+    (lambda doc: doc["nodes"][0]["transform"].update(translate=[3.4e38, 0, 0]), "is too large"),
+    (lambda doc: doc["materials"]["white"].update(albedo=[float("inf"), 0, 0]), "inf is not a finite number"),
+])
+def test_a_native_value_that_cannot_be_is_named_with_its_key(tmp_path, edit, expected):
+    scene = _cornell(tmp_path, edit)
+    line = _one_error(*_render(scene, tmp_path))
+    assert str(scene) in line and expected in line
+
+
+def test_a_node_tree_deeper_than_the_format_allows_is_refused(tmp_path):
+    node = {"name": "leaf", "shape": {"type": "sphere", "radius": 0.1}}
+    for _ in range(250):
+        node = {"name": "level", "children": [node]}
+    scene = _cornell(tmp_path, lambda doc: doc.update(nodes=[node]))
+    line = _one_error(*_render(scene, tmp_path))
+    assert "nodes: nested more than 100 deep" in line
+
+
+@pytest.mark.parametrize("text, expected", [
+    ("[" * 100_000 + "]" * 100_000, "nested too deeply to read"),
+    ('{"lenslab_scene": 2, "render": {"spp": ' + "9" * 5000 + "}}", "a number too long to read"),
+])
+def test_a_json_file_python_cannot_parse_is_named(tmp_path, text, expected):
+    scene = tmp_path / "scene.json"
+    scene.write_text(text)
+    line = _one_error(*_render(scene, tmp_path))
+    assert str(scene) in line and expected in line
+
+
+@pytest.mark.parametrize("xml, expected", [
+    ('<scene version="3.0.0"><sensor type="perspective"><float name="fov"/></sensor></scene>',
+     'line 1: <float name="fov">: missing attribute "value"'),
+    ('<?xml version="1.0" encoding="bogus"?>\n<scene version="3.0.0"/>', "unknown encoding: bogus"),
+    ('<scene version="3.0.0"><shape type="sphere"><bsdf type="dielectric"><float name="ext_ior" value="0"/>'
+     '</bsdf></shape></scene>', "an index of refraction must be positive"),
+    ('<scene version="3.0.0"><shape type="sphere"><bsdf type="roughconductor"><float name="alpha_u" value="-1"/>'
+     '<float name="alpha_v" value="0.1"/></bsdf></shape></scene>', "alpha_u must not be negative"),
+    ('<scene version="3.0.0"><shape type="sphere"><transform name="to_world"><translate x="nan"/></transform>'
+     '</shape></scene>', "could not parse a number"),
+    ('<scene version="3.0.0">' + '<shape type="sphere">' * 1000 + "</shape>" * 1000 + "</scene>",
+     "elements nested more than 100 deep"),
+    ('<scene version="3.0.0"><sensor type="perspective"><float name="fov" value="inf"/></sensor></scene>',
+     'could not parse "inf" as a finite floating point value'),
+])
+def test_a_broken_mitsuba_file_is_named_with_its_line(tmp_path, xml, expected):
+    scene = tmp_path / "scene.xml"
+    scene.write_text(xml)
+    line = _one_error(*_render(scene, tmp_path))
+    assert line.count(f"{scene}: ") == 1 and expected in line
+
+
+def test_a_file_name_too_long_for_the_file_system_is_named(tmp_path):
+    scene = _cornell(tmp_path, lambda doc: _add_node(doc, {"type": "mesh", "file": "n" * 300 + ".obj"}))
+    line = _one_error(*_render(scene, tmp_path))
+    assert str(scene) in line and "Errno" not in line and (".obj" in line)
+
+
+def test_error_lines_escape_what_a_terminal_would_obey(tmp_path):
+    scene = _cornell(tmp_path, lambda doc: doc["materials"].update({"\x1b[2J": {"type": "nonsense"}}))
+    line = _one_error(*_render(scene, tmp_path))
+    assert "\x1b" not in line and "\\x1b[2J" in line
+
+
+def test_one_line_escapes_controls_and_shortens_what_is_endless():
+    assert one_line("a\nb\x1b[31m\u202e") == "a\\nb\\x1b[31m\\u202e"
+    long = one_line("value '" + "x" * 100_000 + "' is wrong")
+    assert len(long) <= LONGEST_LINE and long.endswith("' is wrong") and "…" in long
+    path = "/home/me/" + "/".join(["folder"] * 20) + "/scene.json"
+    assert one_line(f"{path}: bad") == f"{path}: bad", "a real path stays whole"
