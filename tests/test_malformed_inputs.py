@@ -157,3 +157,16 @@ def test_one_line_escapes_controls_and_shortens_what_is_endless():
     assert len(long) <= LONGEST_LINE and long.endswith("' is wrong") and "…" in long
     path = "/home/me/" + "/".join(["folder"] * 20) + "/scene.json"
     assert one_line(f"{path}: bad") == f"{path}: bad", "a real path stays whole"
+
+
+def test_a_python_warning_is_one_warning_line(capsys):
+    import warnings
+
+    from lenslab import cli
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        cli._report_library_warnings()
+        warnings.warn("overflow encountered in multiply", RuntimeWarning)
+    err = capsys.readouterr().err
+    assert err == "lenslab: warning: RuntimeWarning: overflow encountered in multiply\n"
