@@ -13,6 +13,7 @@ import time
 
 from lenslab.batch.spec import Batch, BatchError, read_batch
 from lenslab.cli import EXIT_ERROR, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, CliError, CommandParser, number_argument
+from lenslab.messages import one_line
 
 MAX_LOCAL_WORKERS = 256
 
@@ -58,17 +59,17 @@ def main(argv: list[str]) -> int:
     try:
         return run(argv)
     except CliError as exc:
-        print(f"lenslab batch: error: {exc}", file=sys.stderr)
+        print(f"lenslab batch: error: {one_line(exc)}", file=sys.stderr)
         return exc.status
     except BatchError as exc:
-        print(f"lenslab batch: error: {exc}", file=sys.stderr)
+        print(f"lenslab batch: error: {one_line(exc)}", file=sys.stderr)
         return EXIT_ERROR
     except KeyboardInterrupt:
         print("lenslab batch: interrupted; every shot reported done is written, and running the batch again "
               "renders the rest", file=sys.stderr)
         return EXIT_INTERRUPTED
     except OSError as exc:  # the scheduler cannot be reached, a worker cannot start
-        print(f"lenslab batch: error: {' '.join(str(exc).split())}", file=sys.stderr)
+        print(f"lenslab batch: error: {one_line(' '.join(str(exc).split()))}", file=sys.stderr)
         return EXIT_ERROR
 
 
@@ -95,13 +96,14 @@ def run(argv: list[str]) -> int:
             try:
                 written = write_contact_sheet(sheet, frames)
             except (ExportError, OSError) as exc:  # the shots are written: say what is missing, not a traceback
-                print(f"lenslab batch: error: contact sheet {sheet}: {' '.join(str(exc).split())}", file=sys.stderr)
+                print(f"lenslab batch: error: contact sheet {sheet}: {one_line(' '.join(str(exc).split()))}",
+                      file=sys.stderr)
                 return EXIT_ERROR
             print(f"wrote contact sheet {written} ({len(frames)} shots)", file=sys.stderr)
     if summary.failed:
         print(f"lenslab batch: {len(summary.failed)} of {len(batch.shots)} shots failed:", file=sys.stderr)
         for shot, message in summary.failed:
-            print(f"  {shot.name}: {message}", file=sys.stderr)
+            print(f"  {one_line(shot.name)}: {one_line(message)}", file=sys.stderr)
         return EXIT_ERROR
     return EXIT_OK
 

@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 from lenslab.cli import EXIT_ERROR, EXIT_OK, EXIT_USAGE, CliError, CommandParser, number_argument
+from lenslab.messages import one_line
 from lenslab.validate.mitsuba_env import MitsubaUnavailable, load_mitsuba
 from lenslab.validate.runner import SCENE_NAMES
 
@@ -75,13 +76,13 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return run(list(sys.argv[1:] if argv is None else argv))
     except CliError as exc:
-        print(f"lenslab validate: error: {exc}", file=sys.stderr)
+        print(f"lenslab validate: error: {one_line(exc)}", file=sys.stderr)
         return exc.status
     except MitsubaUnavailable as exc:
-        print(f"lenslab validate: {exc}", file=sys.stderr)
+        print(f"lenslab validate: {one_line(exc)}", file=sys.stderr)
         return EXIT_ERROR
     except (SceneError, GLUnavailable, OSError, ValueError) as exc:
-        print(f"lenslab validate: error: {exc}", file=sys.stderr)
+        print(f"lenslab validate: error: {one_line(exc)}", file=sys.stderr)
         return EXIT_ERROR
     except KeyboardInterrupt:
         print("lenslab validate: interrupted", file=sys.stderr)
