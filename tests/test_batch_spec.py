@@ -267,3 +267,14 @@ def test_a_shot_focused_nearer_than_its_lens_fails_when_its_scene_is_opened(tmp_
         """).shots
     with pytest.raises(ValueError, match=r"nearer than the lens '85 mm f/1.4' focuses \(minimum 80.0 cm\)"):
         shot.open_scene()
+
+
+@pytest.mark.parametrize("value, expected", [
+    ("9" * 400, "f_number: a 400-digit number is too large"),
+    ("1e400", "f_number: inf is not a finite number"),
+    ("nan", "f_number: nan is not a finite number"),
+    ("9" * 5000, "a number too long to read"),
+])
+def test_a_number_no_camera_has_is_one_error_line(tmp_path, value, expected):
+    with pytest.raises(BatchError, match=expected):
+        batch(tmp_path, f'[[shots]]\nscene = "cornell_box"\noutput = "a.png"\nf_number = {value}\n')

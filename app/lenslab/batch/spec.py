@@ -144,6 +144,8 @@ def _decode(text: str, path: Path) -> dict:
             document = json.loads(text)
         except (json.JSONDecodeError, RecursionError) as exc:
             raise BatchError(f"{path}: not valid JSON ({exc})") from None
+        except ValueError as exc:  # an integer of more digits than Python converts
+            raise BatchError(f"{path}: a number too long to read ({str(exc).split(';')[0]})") from None
     elif suffix == ".toml":
         try:
             import tomllib
@@ -153,6 +155,8 @@ def _decode(text: str, path: Path) -> dict:
             document = tomllib.loads(text)
         except (tomllib.TOMLDecodeError, RecursionError) as exc:
             raise BatchError(f"{path}: not valid TOML ({exc})") from None
+        except ValueError as exc:  # an integer of more digits than Python converts
+            raise BatchError(f"{path}: a number too long to read ({str(exc).split(';')[0]})") from None
     else:
         raise BatchError(f"{path}: unknown batch file type '{path.suffix}' (use .toml or .json)")
     if not isinstance(document, dict):
@@ -208,10 +212,13 @@ def _scalar(key: str, value, where: str):
           isinstance(value, (int, float)) and not isinstance(value, bool))
     if not ok:
         raise BatchError(f"{where}: {key}: expected {_kind_name(kind)}, not {_shown(value)}")
+    if isinstance(value, float) and not math.isfinite(value):
+        raise BatchError(f"{where}: {key}: {value} is not a finite number")
+    if kind in (int, float) and abs(value) > 1e30:  # exact for an integer of any length: no float to overflow
+        shown = f"a {len(str(abs(value)))}-digit number" if isinstance(value, int) else f"{value:g}"
+        raise BatchError(f"{where}: {key}: {shown} is too large")
     if kind is float:
         value = float(value)
-        if not math.isfinite(value):
-            raise BatchError(f"{where}: {key}: {value} is not a finite number")
     return value
 
 
