@@ -273,7 +273,11 @@ _PLY_HEADER = ("ply\nformat ascii 1.0\nelement vertex {v}\nproperty float x\npro
 
 
 def _mesh_text(rng: random.Random) -> tuple[str, str, bytes]:
-    kind = rng.randrange(9)
+    kind = rng.randrange(10)
+    if kind == 9:
+        return "an OBJ with NaN normals and texture coordinates", "m.obj", (
+            b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn nan 0 1\nvn 0 0 1\nvn 0 0 1\nvt inf 0\nvt 1 0\nvt 0 1\n"
+            b"f 1/1/1 2/2/2 3/3/3\n")
     if kind == 0:
         return "a PLY face past the vertex count", "m.ply", (_PLY_HEADER.format(v=3, f=1) +
                                                            "0 0 0\n1 0 0\n0 1 0\n3 0 1 99\n").encode()

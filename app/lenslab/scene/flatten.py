@@ -174,6 +174,10 @@ def flatten_scene(scene: Scene, mesh_loader=None) -> FlatScene:
     def cat(parts, shape, dtype):
         return np.concatenate(parts).astype(dtype) if parts else np.zeros(shape, dtype)
 
+    triangle_node = cat(tri_node, (0,), np.int32)
+    for what, parts in (("normals", tri_normals), ("texture coordinates", tri_uvs)):
+        _check_finite_attribute(what, parts, triangle_node, nodes)
+
     return FlatScene(
         triangles=cat(tris, (0, 3, 3), np.float32),
         triangle_normals=cat(tri_normals, (0, 3, 3), np.float32),
@@ -183,7 +187,7 @@ def flatten_scene(scene: Scene, mesh_loader=None) -> FlatScene:
         sphere_material=np.asarray(sph_mat, np.int32),
         materials=materials,
         material_names=material_names,
-        prim_node=np.concatenate([cat(tri_node, (0,), np.int32), np.asarray(sph_node, np.int32)]),
+        prim_node=np.concatenate([triangle_node, np.asarray(sph_node, np.int32)]),
         nodes=nodes,
         warnings=tuple(warnings),
     )
@@ -208,3 +212,17 @@ def _check_finite_material(name: str, material: Material) -> None:
         numbers = value if isinstance(value, tuple) else (value,)
         if any(isinstance(v, float) and not abs(v) <= LARGEST_WORLD_COORDINATE for v in numbers):
             raise SceneError(f"material '{name}': {f.name} {value} is not a finite number")
+
+
+def _check_finite_attribute(what: str, parts: list[np.ndarray], triangle_node: np.ndarray, nodes: list[Node]) -> None:
+    """A mesh file's own normals (OBJ ``vn``) and texture coordinates (``vt``) are read as written: name the
+    node of the first triangle whose value is not a finite number, before it reaches the GPU as a NaN."""
+    if not parts:
+        return
+    values = np.concatenate(parts)
+    bad = ~np.isfinite(values.reshape(len(values), -1)).all(axis=1)
+    if bad.any():
+        node = nodes[int(triangle_node[int(np.argmax(bad))])]
+        count = int(np.count_nonzero(bad))
+        raise SceneError(f"node '{node.name}': {count} {'triangle has' if count == 1 else 'triangles have'} {what} "
+                         "that are not finite numbers")
