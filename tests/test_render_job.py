@@ -80,3 +80,29 @@ def test_the_written_file_carries_the_camera_and_the_samples(renderer, tmp_path)
 def test_nonsense_limits_are_refused(renderer, bad):
     with pytest.raises(ValueError):
         RenderJob(renderer, open_scene("cornell_box"), **bad)
+
+
+def test_a_time_limit_that_ends_inside_a_pass_of_many_dispatches_finishes_that_pass(renderer, tmp_path, monkeypatch):
+    """Issue 12: at 4096 x 4096 a pass takes many dispatches, and a time limit that ended after the first few
+    wrote "0 spp" with 0.5% of the pixels lit. Forced here on a small image with dispatches of a few pixels."""
+    from lenslab.render.tracer import RenderSession
+
+    dispatches = []
+    dispatch = RenderSession._dispatch
+
+    def counted(self, pixels, samples):
+        dispatches.append((self.samples_per_pixel, pixels))
+        dispatch(self, pixels, samples)
+
+    monkeypatch.setattr(RenderSession, "_dispatch", counted)
+    job = RenderJob(renderer, small_scene(width=136, height=128), time_limit=1e-4, dispatch_seconds=1e-6)
+    try:
+        job.run()
+        path = job.write(tmp_path / "short.exr")
+        first_pass = [pixels for spp, pixels in dispatches if spp == 0]
+        assert len(first_pass) > 3 and sum(first_pass) == 136 * 128  # the pass was split, and all of it was run
+        assert job.samples_per_pixel >= 1 and job.overran_time_limit > 0
+        assert np.all(job.session.accumulation()[..., 3] >= 1)
+    finally:
+        job.release()
+    assert read_image(path)[1]["lenslab:SamplesPerPixel"] == job.samples_per_pixel

@@ -10,16 +10,21 @@ import argparse
 import contextlib
 import logging
 import os
+import signal
 import sys
+import threading
 import time
+import warnings
 from pathlib import Path
 
 from lenslab import __version__
-from lenslab.messages import one_line
+from lenslab.messages import describe_os_error, one_line
 from lenslab.scene.fields import declared_choices, declared_range
 
 EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 HEADLESS_DISPATCH_SECONDS = 0.25
+#: With stderr not a terminal (a log), a line of progress this often, so that a long render shows it is alive.
+PROGRESS_LINE_SECONDS = 10.0
 
 
 class CliError(Exception):
@@ -196,7 +201,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="tame fireflies: cap the radiance one sample may add (biased; 0 = off, the default)")
     p.add_argument("--exposure", type=number_argument(float, -30, 30), default=0.0, metavar="STOPS",
                    help="PNG only: brighten (+) or darken (-) by this many stops")
-    p.add_argument("--tone-map", choices=("clamp", "reinhard", "filmic"), default="clamp",
+    p.add_argument("--tone-map", choices=("clamp", "reinhard", "filmic"),
                    help="PNG only: how radiance above 1 is brought into the displayable range (default: clamp; the "
                         "studio shows and exports filmic unless told otherwise)")
     p.add_argument("-D", dest="defines", action="append", default=[], metavar="NAME=VALUE",
@@ -303,14 +308,35 @@ def _loading_status(console, text: str):
     return console.status(text) if console is not None else contextlib.nullcontext()
 
 
+def _progress_lines(every_seconds: float):
+    """``on_progress`` for a render without a progress bar (stderr is a log, not a terminal): a line every
+    ``every_seconds`` of rendering, with the samples, the time and the speed, so a long render shows it is alive."""
+    next_line_at = every_seconds
+
+    def report(progress) -> None:
+        nonlocal next_line_at
+        if progress.elapsed_seconds < next_line_at:
+            return
+        next_line_at = progress.elapsed_seconds + every_seconds
+        samples = (f"{progress.samples_per_pixel} of {progress.target_spp} spp" if progress.target_spp else
+                   f"{progress.samples_per_pixel} spp")
+        limit = f" of {progress.time_limit:g} s" if progress.time_limit else " s"
+        print(f"lenslab: rendering: {samples} after {progress.elapsed_seconds:.0f}{limit} "
+              f"({progress.samples_per_second / 1e6:.2f} M samples/s)", file=sys.stderr, flush=True)
+
+    return report
+
+
 def render_headless(args) -> int:
     from lenslab.render.job import RenderJob
     from lenslab.render.tracer import Renderer
     from lenslab.scene.scene import SceneError
 
     output = _check_output(args.output)
-    if args.exposure and output.suffix.lower() == ".exr":
-        _warn("--exposure applies to PNG only: an EXR keeps the linear radiance")
+    if output.suffix.lower() == ".exr":
+        for option, given in (("--exposure", bool(args.exposure)), ("--tone-map", args.tone_map is not None)):
+            if given:
+                _warn(f"{option} applies to PNG only: an EXR keeps the linear radiance")
     overrides = scene_overrides(args)
     console = _terminal_console()
     loading_start = time.perf_counter()
@@ -331,6 +357,7 @@ def render_headless(args) -> int:
                       f"{time.perf_counter() - loading_start:.1f} s", highlight=False)
     for warning in session.warnings:
         _warn(warning)
+    log_progress = _progress_lines(PROGRESS_LINE_SECONDS) if console is None else None
     with _progress_display() as bar:
         task = bar.add_task("render", total=job.target_spp or job.time_limit, status="")
 
@@ -338,12 +365,16 @@ def render_headless(args) -> int:
             done = progress.samples_per_pixel if job.target_spp else min(progress.elapsed_seconds, job.time_limit)
             bar.update(task, completed=done, status=f"{progress.samples_per_pixel} spp, "
                                                     f"{progress.samples_per_second / 1e6:.2f} M samples/s")
+            if log_progress is not None:
+                log_progress(progress)
 
         job.run(on_progress=show)
     if job.overran_time_limit > 0:
         _warn(f"the time limit ended before every pixel had a sample: the first pass was finished "
               f"{job.overran_time_limit:.1f} s later")
-    job.write(output, exposure_stops=args.exposure, tone_map=args.tone_map)
+    # Once the image is whole and about to take its name, a stop signal could only misreport it.
+    job.write(output, exposure_stops=args.exposure, tone_map=args.tone_map or "clamp",
+              before_rename=_ignore_stop_signals)
     print(f"wrote {output} ({session.width}x{session.height}, {job.samples_per_pixel} spp, "
           f"{job.elapsed_seconds:.1f} s)", file=sys.stderr)
     job.release()
@@ -381,10 +412,15 @@ def run(argv: list[str] | None = None) -> int:
     if args.list_lenses or args.list_sensors:
         return _print_presets("lenses" if args.list_lenses else "sensors")
     if args.info:
+        if args.headless or args.output:
+            raise CliError("--info prints the device and exits without rendering: leave out --headless and -o, "
+                           "or --info", EXIT_USAGE)
         return _print_info(args.device)
     if args.headless:
         if not args.scene:
             raise CliError("--headless needs a scene to render", EXIT_USAGE)
+        if argv is None:  # the process's own command
+            _stop_on_sigterm_as_on_ctrl_c()
         return render_headless(args)
     from lenslab.gui.app import run_studio  # only the studio imports Qt
 
@@ -404,11 +440,41 @@ def _report_library_warnings() -> None:
     logger = logging.getLogger("lenslab")
     if not any(isinstance(h, _WarningLine) for h in logger.handlers):
         logger.addHandler(_WarningLine(logging.WARNING))
+    warnings.showwarning = _show_python_warning
+
+
+def _show_python_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """A Python warning (numpy's "overflow encountered in multiply") as one warning line: not Python's two,
+    whose second is a line of some library's source, meaningless to whoever is rendering."""
+    _warn(f"{category.__name__}: {message}")
+
+
+def _stop_on_sigterm_as_on_ctrl_c() -> None:
+    """SIGTERM (``kill``, a service manager, a render farm's time-out) stops a command that writes files as Ctrl-C
+    does: it raises KeyboardInterrupt, so the temporary file is removed and the exit is "interrupted; nothing was
+    written", status 130 for either signal. Only for the process's own command (main() without argv: a caller's
+    signals are its own), and not for the studio, which Qt's event loop would keep from hearing it. A SIGTERM the
+    process was started ignoring stays ignored."""
+    if threading.current_thread() is threading.main_thread() and \
+            signal.getsignal(signal.SIGTERM) == signal.SIG_DFL:
+        signal.signal(signal.SIGTERM, signal.default_int_handler)
+
+
+def _ignore_stop_signals() -> None:
+    """Ignore SIGINT and SIGTERM for the rest of the command, where it has made SIGTERM Ctrl-C's: called as the
+    image takes its name, after which a stop could only misreport a written file (as "nothing was written", or as
+    a traceback from the process's exit)."""
+    if threading.current_thread() is threading.main_thread() and \
+            signal.getsignal(signal.SIGTERM) is signal.default_int_handler:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
 
 
 def main(argv: list[str] | None = None) -> int:
     args_list = sys.argv[1:] if argv is None else list(argv)
     _report_library_warnings()
+    if argv is None and args_list[:1] in (["validate"], ["batch"]):  # the process's own command
+        _stop_on_sigterm_as_on_ctrl_c()
     if args_list[:1] == ["validate"]:
         from lenslab.validate.cli import main as validate_main
 
@@ -435,7 +501,7 @@ def main(argv: list[str] | None = None) -> int:
         print("lenslab: interrupted; nothing was written", file=sys.stderr)
         return EXIT_INTERRUPTED
     except OSError as exc:
-        _error(exc)
+        _error(describe_os_error(exc))
         return EXIT_ERROR
     except Exception as exc:  # a bug of ours: one line for the user, the traceback on request
         if os.environ.get("LENSLAB_DEBUG"):

@@ -2,17 +2,19 @@
 
 EXR holds the linear radiance as float32 RGB with the camera's settings as metadata (standard Exif names
 where they exist); PNG holds a display-referred 8-bit sRGB picture. Files are written to a temporary name
-beside the target and renamed into place, so an export is whole or absent, never half-written.
+beside the target, checked, and renamed into place (lenslab.atomic), so an export is whole or absent, never
+half-written.
 """
 
 from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
-from lenslab.atomic import atomic_path
+from lenslab.atomic import atomic_path, write_failure_reason
 from lenslab.color import linear_to_srgb
 
 EXPORT_SUFFIXES = (".exr", ".png")
@@ -73,13 +75,14 @@ MATRIX_ATTRIBUTES = ("worldtocamera", "worldtoNDC")
 
 
 def write_image(path: str | os.PathLike, linear: np.ndarray, metadata: dict[str, object] | None = None,
-                *, sensor_exposure: float = 1.0, exposure_stops: float = 0.0, tone_map_operator: str = "clamp") -> Path:
-    """Write ``linear`` (H, W, 3) to an .exr (linear float) or .png (sRGB, tone mapped), atomically.
+                *, sensor_exposure: float = 1.0, exposure_stops: float = 0.0, tone_map_operator: str = "clamp",
+                before_rename: Callable[[], None] | None = None) -> Path:
+    """Write ``linear`` (H, W, 3) to an .exr (linear float) or .png (sRGB, tone mapped), whole or not at all.
 
     ``sensor_exposure`` multiplies the radiance first, in both: the camera's physical exposure, part of the
     capture. ``exposure_stops`` and the tone map are the PNG's display look. An EXR carries Rec. 709
     chromaticities and the camera matrices; a PNG carries Exif (its eXIf chunk: f-number, exposure time, ISO,
-    focal length) and LensLab's own values as text chunks."""
+    focal length) and LensLab's own values as text chunks. ``before_rename``: see lenslab.atomic.atomic_path."""
     import OpenImageIO as oiio  # imported here: only exporting needs it
 
     path = Path(path)
@@ -110,16 +113,78 @@ def write_image(path: str | os.PathLike, linear: np.ndarray, metadata: dict[str,
         else:
             spec.attribute(key, value if not isinstance(value, bool) else int(value))
 
-    with atomic_path(path) as tmp:
-        out = oiio.ImageOutput.create(str(tmp))
-        if out is None or not out.open(str(tmp), spec):
-            raise ExportError(f"{path}: cannot open for writing ({oiio.geterror() or (out and out.geterror())})")
-        ok = out.write_image(pixels)
-        error = out.geterror()
-        out.close()
-        if not ok:
-            raise ExportError(f"{path}: write failed ({error})")
+    return write_pixels(path, pixels, spec, before_rename=before_rename)
+
+
+def write_pixels(path: str | os.PathLike, pixels: np.ndarray, spec, *,
+                 before_rename: Callable[[], None] | None = None) -> Path:
+    """Write ``pixels`` as the OpenImageIO ``spec`` describes them to ``path`` (its suffix names the format),
+    whole or not at all: every failure the library reports is an ExportError naming ``path`` with the system's
+    reason, and so is a file that was not written whole although no failure was reported."""
+    path = Path(path)
+    with atomic_path(path, before_rename=before_rename) as tmp:
+        _encode(tmp, path, pixels, spec)
+        _check_whole(tmp, path, spec)
     return path
+
+
+def _encode(tmp: Path, path: Path, pixels: np.ndarray, spec) -> None:
+    import OpenImageIO as oiio
+
+    out = oiio.ImageOutput.create(str(tmp))
+    if out is None:
+        raise ExportError(f"{path}: cannot write ({oiio.geterror()})")
+    if not out.open(str(tmp), spec):
+        raise ExportError(f"{path}: cannot open for writing ({_reason(tmp, out.geterror())})")
+    try:
+        written = out.write_image(pixels)
+    finally:
+        closed = out.close()  # also when interrupted: the temporary file is removed next, and must be closed
+    # A write that fails part-way may still return True, saying so only in the error text (PNG on a full disk).
+    errors = out.geterror()
+    if not (written and closed) or errors:
+        raise ExportError(f"{path}: cannot write the image ({_reason(tmp, errors)})")
+
+
+#: A PNG ends with its IEND chunk: no data, its type, and that type's CRC.
+PNG_END = b"\x00\x00\x00\x00IEND\xaeB`\x82"
+
+
+def _check_whole(tmp: Path, path: Path, spec) -> None:
+    """Read back what shows a file whole, where that is cheap: a library that buffers its last writes can lose
+    them as the file closes and report nothing (a full disk left a small image at 0 bytes)."""
+    problem = _incompleteness(tmp, spec)
+    if problem is not None:
+        raise ExportError(f"{path}: cannot write the image ({write_failure_reason(tmp) or problem})")
+
+
+def _incompleteness(tmp: Path, spec) -> str | None:
+    """Why the image file ``tmp`` is not whole, or None: its end is where the format puts it (a PNG's last chunk,
+    an EXR's last scanline, which lies at the file's end and is found through the offsets at its start)."""
+    import OpenImageIO as oiio
+
+    size = tmp.stat().st_size
+    if size == 0:
+        return "nothing reached the disk"
+    if tmp.suffix.lower() == ".png":
+        with open(tmp, "rb") as file:
+            file.seek(max(0, size - len(PNG_END)))
+            return None if file.read() == PNG_END else "the file ends early"
+    image = oiio.ImageInput.open(str(tmp))
+    if image is None:
+        return f"cannot read it back: {oiio.geterror()}"
+    try:
+        last = image.read_scanline(spec.y + spec.height - 1, 0, oiio.FLOAT)
+        errors = image.geterror()
+    finally:
+        image.close()
+    return None if last is not None and not errors else "the file ends early"
+
+
+def _reason(tmp: Path, library_errors: str) -> str:
+    """The system's reason a write failed if it can say, else the library's first line."""
+    lines = library_errors.strip().splitlines()
+    return write_failure_reason(tmp) or (lines[0] if lines else "no reason given")
 
 
 def _as_text(value: object) -> str:

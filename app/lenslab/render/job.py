@@ -16,6 +16,7 @@ import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
@@ -124,14 +125,16 @@ class RenderJob:
     def metadata(self) -> dict[str, object]:
         return image_metadata(self.scene, self.session.samples_per_pixel, self.session.frame)
 
-    def write(self, path: str | os.PathLike, *, exposure_stops: float = 0.0, tone_map: str = "clamp") -> Path:
+    def write(self, path: str | os.PathLike, *, exposure_stops: float = 0.0, tone_map: str = "clamp",
+              before_rename: Callable[[], None] | None = None) -> Path:
         """Write the finished image with its metadata (.exr linear, .png tone mapped), whole or not at all. A
-        camera in the physical exposure mode exposes both (docs/architecture.md, "Exposure")."""
+        camera in the physical exposure mode exposes both (docs/architecture.md, "Exposure"). ``before_rename``
+        runs once the file is whole, just before it takes the name (lenslab.atomic.atomic_path)."""
         from lenslab.render.film import write_image
 
         metadata = self.metadata()
         return write_image(path, self.image(), metadata, sensor_exposure=metadata["lenslab:ExposureScale"],
-                           exposure_stops=exposure_stops, tone_map_operator=tone_map)
+                           exposure_stops=exposure_stops, tone_map_operator=tone_map, before_rename=before_rename)
 
     def release(self) -> None:
         self.session.release()
