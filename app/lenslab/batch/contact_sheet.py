@@ -9,7 +9,6 @@ from pathlib import Path
 
 import numpy as np
 
-from lenslab.atomic import atomic_path
 from lenslab.optics import format_camera_settings
 from lenslab.render import film
 
@@ -81,12 +80,7 @@ def write_contact_sheet(path: str | Path, frames: list[Frame], *, thumbnail_widt
     path.parent.mkdir(parents=True, exist_ok=True)
     spec = oiio.ImageSpec(width, height, 3, oiio.UINT8)
     spec.attribute("oiio:ColorSpace", "sRGB")
-    with atomic_path(path) as tmp:
-        out = oiio.ImageOutput.create(str(tmp))
-        if out is None or not out.open(str(tmp), spec) or not out.write_image(pixels):
-            raise film.ExportError(f"{path}: cannot write the contact sheet ({oiio.geterror()})")
-        out.close()
-    return path
+    return film.write_pixels(path, pixels, spec)
 
 
 def _columns(count: int, cell_w: int, cell_h: int) -> int:

@@ -49,11 +49,10 @@ def markdown_table(rows: list[tuple[str, ...]], header: tuple[str, ...] = HEADER
 def _write_png(path: Path, rgb8: np.ndarray) -> None:
     import OpenImageIO as oiio
 
+    from lenslab.render.film import write_pixels
+
     spec = oiio.ImageSpec(rgb8.shape[1], rgb8.shape[0], 3, oiio.UINT8)
-    out = oiio.ImageOutput.create(str(path))
-    out.open(str(path), spec)
-    out.write_image(np.ascontiguousarray(rgb8))
-    out.close()
+    write_pixels(path, np.ascontiguousarray(rgb8), spec)  # whole or not at all, as every image LensLab writes
 
 
 def display(linear: np.ndarray) -> np.ndarray:
