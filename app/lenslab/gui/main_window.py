@@ -44,6 +44,7 @@ from lenslab.gui.properties import PropertyEditor
 from lenslab.gui.scene_tree import SceneTreeView, node_context_menu
 from lenslab.gui.viewport import Viewport
 from lenslab.gui.worker import VIEWPORT_DISPATCH_SECONDS
+from lenslab.messages import one_line
 from lenslab.optics import format_camera_settings, format_distance
 from lenslab.optics.exposure import format_shutter
 from lenslab.render.film import TONE_MAPS
@@ -677,7 +678,7 @@ class MainWindow(QMainWindow):
             path = resolve_scene_path(text)
             scene = open_scene(text)
         except (SceneError, OSError) as exc:
-            QMessageBox.critical(self, "Cannot open scene", str(exc))
+            QMessageBox.critical(self, "Cannot open scene", one_line(exc))
             return False
         self.doc.replace(scene, path)
         if not is_shipped(path):

@@ -32,6 +32,8 @@ from pathlib import Path
 import numpy as np
 from PySide6.QtCore import QThread, Signal
 
+from lenslab.messages import one_line
+
 PREVIEW_DIVISOR = 4  # the preview pass renders at 1/4 of the width and height
 PREVIEW_MIN_PIXELS = 256 * 256  # images smaller than this skip the preview pass
 # The viewport's dispatches aim at a display frame: an edit is seen within one, and on a GPU that traces a
@@ -613,5 +615,5 @@ class _Export:
 
 
 def _one_line(exc: BaseException) -> str:
-    text = str(exc).strip().splitlines()
-    return text[0] if text else type(exc).__name__
+    """The studio shows an error as the command line prints it (lenslab.messages): one line, shortened."""
+    return one_line(str(exc).strip() or type(exc).__name__)
