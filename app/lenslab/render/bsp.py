@@ -55,6 +55,20 @@ triangle crossing one corner of a node does not drag the whole node into the nex
 drops the reference entirely when the triangle's box crosses the plane but the triangle does not.
 Spheres, and all primitives when no triangles are given, are clipped as boxes.
 
+Bounded work
+------------
+Some inputs make every split copy references without end: ten coplanar disks of 4,096 thin fan triangles
+all meeting at one centre (issue 12) grew by 40% per level, 32 M references at depth 23 from 41 k triangles,
+and the build died of memory. So the tree holds at most ``reference_budget(N)`` references, about
+``REFS_PER_PRIM_LIMIT`` per primitive plus ``REFS_FLOOR`` and fewer where memory is short (checked before
+the build allocates anything large). Each level counts the references its splits would add (the binned SAH
+knows how many references each child gets); while they fit in what is left of the budget they all go ahead,
+and when they do not, the splits that save the most SAH cost per added reference go ahead and the rest
+become leaves. A leaf is always a correct answer, only a slower one: the tree degrades, it never fails.
+Splits that add no reference (empty cuts, clean partitions) are never held back. Per level the work is
+bounded by the budget and the depth by ``max_depth_limit``, so the whole build is too. Shipped scenes stay
+far below the budget (``marbles_on_sand``: 4.4 references per triangle) and build the same tree as before.
+
 Large levels are cut into runs of whole nodes handled by worker threads (numpy releases the GIL in
 its loops); the result does not depend on the number of threads. Finally the level-order tree is
 renumbered depth first with prefix sums over subtree sizes.
@@ -76,6 +90,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from lenslab.render.gpu_layout import KD_LEAF as LEAF  # the two low bits of nodes[i, 1] of a leaf (axes: 0-2)
+from lenslab.render.limits import SceneTooLarge, available_memory_bytes, format_bytes
 
 # Default SAH constants, in units of one traversal step.
 #
@@ -96,6 +111,17 @@ INTERSECTION_COST = 1.5
 EMPTY_BONUS = 0.3
 LEAF_PRIMS = 6
 
+# The reference budget (see "Bounded work"): REFS_PER_PRIM_LIMIT per primitive plus REFS_FLOOR. Twice the
+# 4.4 per triangle of a million-triangle terrain (scenes/marbles_on_sand), so real scenes never meet it; the
+# floor lets small scenes split freely, and a million references build in about a second.
+REFS_PER_PRIM_LIMIT = 8
+REFS_FLOOR = 1 << 20
+# Peak memory of the build per reference of the budget: a level's references (32 bytes each), the indices,
+# masks and clipped bounds of their partition, the next level's copy, the SAH's keys and the leaves' runs.
+# Measured with tracemalloc: 206 bytes on ten coplanar disks of 4,096 segments (the budget reached, nearly
+# every reference clipped at every level), 140 on marbles_on_sand's million triangles; rounded up.
+BUILD_BYTES_PER_REF = 256
+
 MIN_REFS_PER_THREAD = 100_000  # smaller levels are not worth handing to threads
 MIN_EXTENT = np.float32(1e-30)  # nodes thinner than this are not split along that axis
 
@@ -115,12 +141,33 @@ class KdTree:
     empty_leaf_count: int
     refs_per_prim: float  # R / N
     sah_cost: float  # expected cost of a ray through the root, in traversal-step units
+    reference_limit: int  # the budget the build honoured (see "Bounded work")
+    budget_leaves: int  # nodes the SAH would have split that became leaves to stay within it (0: none)
     params: dict = field(default_factory=dict, compare=False)
 
 
 def default_depth_limit(prim_count: int) -> int:
     """The depth cap: ``min(40, round(8 + 1.3 log2 N))``. The GPU stack is sized from it."""
     return int(min(40, round(8 + 1.3 * math.log2(max(prim_count, 1)))))
+
+
+def reference_budget(prim_count: int, memory_bytes: int | None = None) -> int:
+    """The most references a tree of ``prim_count`` primitives may hold: ``REFS_PER_PRIM_LIMIT`` per primitive
+    plus ``REFS_FLOOR``, or what ``memory_bytes`` holds at ``BUILD_BYTES_PER_REF`` each when that is less.
+
+    Raises SceneTooLarge when the memory cannot hold even one reference per primitive: no tree fits then.
+    """
+    wanted = REFS_PER_PRIM_LIMIT * prim_count + REFS_FLOOR
+    if memory_bytes is None:
+        return wanted
+    fits = int(memory_bytes // BUILD_BYTES_PER_REF)
+    if fits < prim_count:
+        raise SceneTooLarge(
+            f"building the kd-tree of {prim_count:,} primitives needs at least "
+            f"{format_bytes(prim_count * BUILD_BYTES_PER_REF)} of memory, and {format_bytes(memory_bytes)} "
+            "is available; simplify the meshes or free memory"
+        )
+    return min(wanted, fits)
 
 
 def build_kdtree(
@@ -134,6 +181,8 @@ def build_kdtree(
     min_bins: int = 4,
     leaf_prims: int = LEAF_PRIMS,
     max_depth_limit: int | None = None,
+    max_refs: int | None = None,
+    memory_bytes: int | None = None,
     threads: int | None = None,
 ) -> KdTree:
     """Build an SAH kd-tree over primitives given by their boxes.
@@ -147,6 +196,10 @@ def build_kdtree(
         equal bin per reference, at least ``min_bins`` and at most ``max_bins``.
     leaf_prims: a node with this many references or fewer becomes a leaf without evaluating the SAH.
     max_depth_limit: depth cap (root = 0); ``default_depth_limit(N)`` when None.
+    max_refs: the most references the tree may hold (at least N); ``reference_budget(N, memory_bytes)``
+        when None. Splits that would pass it become leaves (see "Bounded work").
+    memory_bytes: what the build may allocate; the memory available now (``limits.available_memory_bytes``)
+        when None. SceneTooLarge when it cannot hold even the references of an unsplit tree.
     threads: worker threads (numpy releases the GIL in its loops); default: the usable CPU cores.
     """
     start = time.perf_counter()
@@ -163,9 +216,15 @@ def build_kdtree(
         raise ValueError("max_depth_limit must lie in [0, 64]")
     if not 2 <= min_bins <= max_bins:
         raise ValueError("need 2 <= min_bins <= max_bins")
+    if memory_bytes is None:
+        memory_bytes = available_memory_bytes()
+    limit = reference_budget(prim_count, memory_bytes) if max_refs is None else int(max_refs)
+    if limit < prim_count:
+        raise ValueError(f"max_refs ({limit:,}) must be at least the number of primitives ({prim_count:,})")
     costs = _Costs(float(traversal_cost), float(intersection_cost), float(empty_bonus))
     workers = _worker_count(threads)
     params = _Params(costs, int(leaf_prims), int(min_bins), int(max_bins), depth_limit, workers)
+    budget = _RefBudget(limit, prim_count)
 
     root = root_bounds(prim_bounds)
     refs = _Refs(
@@ -176,7 +235,7 @@ def build_kdtree(
     )
 
     with ThreadPoolExecutor(params.workers) if params.workers > 1 else nullcontext() as pool:
-        levels = _build_levels(refs, root, triangles, params, pool)
+        levels = _build_levels(refs, root, triangles, params, budget, pool)
 
     nodes, prim_refs = _flatten(levels)
     leaf_counts = np.concatenate([lv.counts[lv.is_leaf] for lv in levels])
@@ -192,6 +251,8 @@ def build_kdtree(
         empty_leaf_count=int(np.count_nonzero(leaf_counts == 0)),
         refs_per_prim=len(prim_refs) / max(prim_count, 1),
         sah_cost=_tree_sah_cost(levels, root, costs),
+        reference_limit=limit,
+        budget_leaves=budget.leaves_made,
         params=dict(
             traversal_cost=costs.traversal,
             intersection_cost=costs.intersection,
@@ -203,11 +264,13 @@ def build_kdtree(
     )
 
 
-def _build_levels(refs: _Refs, root: np.ndarray, triangles, params: _Params, pool) -> list[_Level]:
+def _build_levels(refs: _Refs, root: np.ndarray, triangles, params: _Params, budget: _RefBudget,
+                  pool) -> list[_Level]:
     """The build proper: one iteration per tree level, each a few whole-array passes.
 
     ``refs`` always holds the references of the current level's nodes that are not leaves yet; the
-    references of a leaf go to its level's ``leaf_chunks`` as soon as the leaf is known.
+    references of a leaf go to its level's ``leaf_chunks`` as soon as the leaf is known. ``budget``
+    turns splits into leaves where their new references would pass the reference budget.
     """
     costs = params.costs
     counts = np.array([len(refs)])
@@ -225,8 +288,10 @@ def _build_levels(refs: _Refs, root: np.ndarray, triangles, params: _Params, poo
             in_part = refs.slice(r0, r1, node_offset=k0)
             return _best_splits(in_part, level.lo[:, k0:k1], level.hi[:, k0:k1], params)
 
-        cost, level.axis, level.split = (np.concatenate(c) for c in zip(*_map(pool, best_splits, parts)))
+        best = zip(*_map(pool, best_splits, parts))
+        cost, level.axis, level.split, child_refs = (np.concatenate(c) for c in best)
         level.is_leaf |= ~(cost < costs.intersection * level.counts)
+        level.is_leaf |= budget.held_back(level, cost, child_refs, costs)
         if level.is_leaf.all():
             level.leaf_chunks.append((refs.node, refs.prim))
             return levels
@@ -239,6 +304,7 @@ def _build_levels(refs: _Refs, root: np.ndarray, triangles, params: _Params, poo
             return _PartSplit(refs.slice(part[2], part[3]), level, child, next_counts, triangles)
 
         splits = _map(pool, split_part, parts)
+        budget.spend(int(next_counts.sum()) - int(level.counts[~level.is_leaf].sum()))
         next_is_leaf = params.forced_leaves(next_counts, len(levels))
         remaining = np.array(_map(pool, lambda split: split.drop_leaf_refs(next_is_leaf), splits))
         # All parts' below references first, then all above ones: the next level in node order.
@@ -336,6 +402,44 @@ class _Params:
         return (counts <= self.leaf_prims) | (depth >= self.depth_limit)
 
 
+class _RefBudget:
+    """What is left of the reference budget (see "Bounded work") as the levels are built.
+
+    ``used`` counts the references the tree holds so far: those of the leaves made and of the nodes still
+    open, one per primitive at the root. A level's splits add what their children get beyond their own.
+    """
+
+    def __init__(self, limit: int, prim_count: int):
+        self.limit = limit
+        self.used = prim_count
+        self.leaves_made = 0  # nodes made leaves to stay within the budget
+
+    def held_back(self, level: _Level, cost, child_refs, costs: _Costs) -> np.ndarray:
+        """Which nodes of the level become leaves rather than split, so that the new references fit.
+
+        Splits that add none always go ahead. When those that add some overrun what is left, they go
+        ahead in order of SAH cost saved (weighted by the node's area, the chance a ray visits it) per
+        added reference while they fit; the rest are held back.
+        """
+        added = np.where(level.is_leaf, 0, np.rint(child_refs).astype(np.int64) - level.counts)
+        adds = np.flatnonzero(added > 0)
+        room = self.limit - self.used
+        held = np.zeros(len(added), bool)
+        if int(added[adds].sum()) <= room:
+            return held
+        area = _half_area((level.hi - level.lo)[:, adds].astype(np.float64))
+        saving = (costs.intersection * level.counts[adds] - cost[adds]) * area
+        order = adds[np.argsort(-saving / added[adds], kind="stable")]
+        fits = np.cumsum(added[order]) <= room  # a prefix: every entry adds at least one reference
+        held[order[~fits]] = True
+        self.leaves_made += int(np.count_nonzero(held))
+        return held
+
+    def spend(self, added: int) -> None:
+        """Count the references a level's partition added (exact; the binned counts can be off by a few)."""
+        self.used += added
+
+
 class _Refs:
     """The primitive references of one level, grouped by node (``node`` is non-decreasing).
 
@@ -385,7 +489,8 @@ class _Level:
 def _best_splits(refs: _Refs, node_lo, node_hi, params: _Params):
     """Binned SAH for every node (boxes ``node_lo``, ``node_hi``, (3, K)) of a level at once.
 
-    Returns per node the best split's cost (inf where there is none), axis and position.
+    Returns per node the best split's cost (inf where there is none), axis, position, and how many
+    references its two children get together (more than the node's where references straddle the plane).
     """
     costs = params.costs
     node_count = node_lo.shape[1]
@@ -400,6 +505,7 @@ def _best_splits(refs: _Refs, node_lo, node_hi, params: _Params):
     axis_cost = np.full((3, node_count), np.inf, np.float32)
     axis_bin = np.zeros((3, node_count), np.int64)
     axis_empty = np.zeros((3, node_count), np.int8)
+    axis_children = np.zeros((3, node_count), np.float32)
     for axis in range(3):
         e = extent[axis]
         splittable = e > MIN_EXTENT
@@ -416,8 +522,9 @@ def _best_splits(refs: _Refs, node_lo, node_hi, params: _Params):
             with np.errstate(invalid="ignore"):
                 side = u * v * inv_area[nodes]
                 spread = np.where(splittable[nodes], e[nodes] * (u + v) * inv_area[nodes], np.nan)
-            cost, bin_, empty = _cheapest_planes(group, starts, ends, side, spread, costs.empty_bonus)
+            cost, bin_, empty, children = _cheapest_planes(group, starts, ends, side, spread, costs.empty_bonus)
             axis_cost[axis, nodes], axis_bin[axis, nodes], axis_empty[axis, nodes] = cost, bin_, empty
+            axis_children[axis, nodes] = children
 
     axis = np.argmin(np.where(np.isnan(axis_cost), np.inf, axis_cost), axis=0)  # first axis on ties
     nodes = np.arange(node_count)
@@ -428,7 +535,7 @@ def _best_splits(refs: _Refs, node_lo, node_hi, params: _Params):
     inside = (split > lo) & (split < hi) & (slots.bins > 1) & np.isfinite(best)
     cost = costs.traversal + costs.intersection * best.astype(np.float64)
     split = _snap_empty_cuts(refs, axis, split, axis_empty[axis, nodes], lo, hi, slots.refs_per_node)
-    return np.where(inside, cost, np.inf), axis.astype(np.int8), split
+    return np.where(inside, cost, np.inf), axis.astype(np.int8), split, axis_children[axis, nodes]
 
 
 def _snap_empty_cuts(refs: _Refs, axis, split, empty, lo, hi, refs_per_node):
@@ -502,7 +609,8 @@ class _Slots:
 
 def _cheapest_planes(group: _SlotGroup, starts, ends, side, spread, empty_bonus):
     """Best plane of every node of a group along one axis: (relative cost, bin below the plane,
-    1 or 2 where the plane leaves the below or the above side empty, else 0).
+    1 or 2 where the plane leaves the below or the above side empty, else 0, references of the two
+    children together).
 
     The relative cost is ``(cost - C_trav) / C_isect``, i.e. ``P_below n_below + P_above n_above``
     (times ``1 - empty_bonus`` when one side is empty), NaN where the axis cannot be split. With e
@@ -513,7 +621,7 @@ def _cheapest_planes(group: _SlotGroup, starts, ends, side, spread, empty_bonus)
     bins = group.bins
     if bins < 2:
         nothing = np.zeros(len(group.nodes), np.int64)
-        return np.full(len(group.nodes), np.nan, np.float32), nothing, nothing.astype(np.int8)
+        return np.full(len(group.nodes), np.nan, np.float32), nothing, nothing.astype(np.int8), nothing
     # Running sums over the bins: references starting at or below bin b are below the plane after
     # it, those ending above bin b are above it. Exact in float32 (per-node counts).
     n_below = group.block(starts)
@@ -537,8 +645,9 @@ def _cheapest_planes(group: _SlotGroup, starts, ends, side, spread, empty_bonus)
     for b in range(bins - 2, -1, -1):
         np.copyto(at, b, where=x[b] == cheapest)
     columns = np.arange(len(at))
-    empty = np.where(n_below[at, columns] == 0, 1, np.where(n_above[at, columns] == 0, 2, 0))
-    return cheapest, at, empty.astype(np.int8)
+    below, above = n_below[at, columns], n_above[at, columns]
+    empty = np.where(below == 0, 1, np.where(above == 0, 2, 0))
+    return cheapest, at, empty.astype(np.int8), below + above
 
 
 def _bin_histogram(coord, origin, scale, first, slot_count) -> np.ndarray:

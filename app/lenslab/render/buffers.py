@@ -19,6 +19,7 @@ from lenslab.render.bsp import KdTree, build_kdtree
 from lenslab.render.fresnel import internal_diffuse_reflectance, rough_internal_reflectance, rough_reflectance_table
 from lenslab.render.environment import EnvironmentDistribution, environment_power, infinite_light_power
 from lenslab.render.gl import make_current
+from lenslab.render.limits import SceneTooLarge, format_bytes  # SceneTooLarge: raised here, imported from here
 from lenslab.render.gpu_layout import (ENV_CONSTANT, ENV_MAP, GEOMETRY_BINDING, GEOMETRY_ROWS,
                                        IMAGE_DATA_BINDING, KD_NODES_BINDING, LIGHT_AREA, LIGHT_CHOICE_BINDING,
                                        LIGHT_ENVIRONMENT, LIGHT_PLACES, LIGHT_POINT, LIGHT_ROWS, LIGHT_SUN,
@@ -42,14 +43,6 @@ BINDINGS = {"kd_nodes": KD_NODES_BINDING, "prim_refs": PRIM_REFS_BINDING, "geome
             "image_data": IMAGE_DATA_BINDING}
 UNIFORM_BINDINGS = {"light_choice": LIGHT_CHOICE_BINDING}  # uniform blocks (glsl/lights.glsl's LightPlaces)
 MISSING_SKY = (0.2, 0.0, 0.2)  # what a scene whose environment map cannot be read is lit by
-
-
-class SceneTooLarge(RuntimeError):
-    """The scene's buffers exceed what the GL device allows in one storage block."""
-
-
-def _size(nbytes: int) -> str:
-    return f"{nbytes / 2**20:.1f} MiB" if nbytes >= 2**20 else f"{nbytes / 2**10:.0f} KiB"
 
 
 def _luminance(rgb) -> float:
@@ -201,6 +194,13 @@ def _environment_uniforms(environment: Environment, textures: TextureTable, scen
     raise TypeError(f"no GPU packing for environment type {type(environment).__name__}")
 
 
+def _reference_budget_warning(kdtree: KdTree) -> str:
+    """What a user should hear when the kd-tree met its reference budget (render/bsp.py, "Bounded work")."""
+    return (f"the kd-tree reached its limit of {kdtree.reference_limit:,} primitive references "
+            f"({kdtree.refs_per_prim:.0f} per primitive; geometry piled up in one place, such as coplanar copies "
+            "of a shape, makes every split copy them): the image is right but renders more slowly")
+
+
 @dataclass(frozen=True)
 class PackedScene:
     """Everything the trace kernel reads about the scene, as arrays and uniform values."""
@@ -323,7 +323,8 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
         **env_uniforms,
         **sun_uniforms,
     }
-    return PackedScene(arrays, uniforms, kdtree, n_prim, tuple(textures.warnings))
+    tree_warnings = [_reference_budget_warning(kdtree)] if kdtree.budget_leaves else []
+    return PackedScene(arrays, uniforms, kdtree, n_prim, (*tree_warnings, *textures.warnings))
 
 
 class GpuScene:
@@ -334,8 +335,8 @@ class GpuScene:
         if too_big:
             name, size = max(too_big.items(), key=lambda item: item[1])
             raise SceneTooLarge(
-                f"the scene needs {_size(size)} of {name.replace('_', ' ')} in one storage buffer, "
-                f"more than this GL device allows ({_size(max_block_bytes)}); "
+                f"the scene needs {format_bytes(size)} of {name.replace('_', ' ')} in one storage buffer, "
+                f"more than this GL device allows ({format_bytes(max_block_bytes)}); "
                 + ("use smaller image textures or environment map" if name == "image_data" else
                    f"simplify the meshes ({packed.uniforms['triangle_count']:,} triangles now)")
             )

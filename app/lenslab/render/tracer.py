@@ -27,6 +27,7 @@ from lenslab.render.buffers import GpuScene, pack_scene
 from lenslab.render.features import GENERAL, KernelFeatures, scene_features
 from lenslab.render.gpu_layout import (ACCUMULATION_BINDING, APERTURE_TABLE_UNIT, DISPLAY_BINDING, SPLAT_IMAGE_BINDING, TONE_MAP_CLAMP,
                                       TONE_MAP_FILMIC, TONE_MAP_REINHARD)
+from lenslab.render.limits import SceneTooLarge, available_memory_bytes, format_bytes
 from lenslab.render.sobol import glsl_array_literal
 from lenslab.scene.camera import CameraFrame, ThinLensCamera
 from lenslab.scene.scene import RenderSettings, Scene
@@ -43,6 +44,15 @@ SPLAT_LAYERS_BYTES = 32 << 20
 SPLAT_MAX_LAYERS = 64  # samples per pixel in one splatted pass
 SPLAT_GATHER_TERMS = 1 << 22  # neighbour terms per splat.comp dispatch, to keep it short on any device
 SAMPLE_INDEX_LIMIT = 1 << 32  # the kernel's sample index is a 32-bit unsigned integer
+# The image's memory. Each pixel's running sum and weight take ACCUMULATION_BYTES_PER_PIXEL in one storage
+# buffer; reading the finished image back and writing it takes HOST_BYTES_PER_PIXEL of the machine's memory
+# at its peak (measured: 90 bytes a pixel writing a 2048 x 2048 PNG on llvmpipe, whose buffers are host
+# memory too; 39 for an EXR), rounded up.
+ACCUMULATION_BYTES_PER_PIXEL = 16
+HOST_BYTES_PER_PIXEL = 96
+# Mesa's llvmpipe advertises storage blocks of 128 MiB but binds any buffer it can make whole, and a Gallium
+# buffer's size is a 32-bit number: 4 GiB less 16 bytes work, 4 GiB fails with "cannot map the buffer".
+LLVMPIPE_BUFFER_BYTES = (1 << 32) - 1
 
 
 def in_context(method):
@@ -62,6 +72,7 @@ class Renderer:
     def __init__(self, device_index: int | None = None, ctx=None):
         self.ctx = ctx if ctx is not None else gl.create_context(device_index)
         self.limits = gl.device_limits(self.ctx)
+        self.largest_buffer_bytes = largest_storage_buffer(self.ctx.info["GL_RENDERER"], self.limits)
         self._programs: dict[tuple, object] = {}
         self._declared: dict[int, tuple[str, frozenset[str]]] = {}  # id(program): (shader, uniforms declared)
 
@@ -112,6 +123,46 @@ class Renderer:
         self._programs.clear()
         self._declared.clear()
         self.ctx.release()
+
+
+def largest_storage_buffer(renderer_name: str, limits: gl.DeviceLimits) -> int:
+    """The largest storage buffer a kernel can bind whole on this device: the GL limit on one storage block,
+    which llvmpipe does not hold to (see LLVMPIPE_BUFFER_BYTES)."""
+    if "llvmpipe" in renderer_name:
+        return max(limits.max_storage_block_bytes, LLVMPIPE_BUFFER_BYTES)
+    return limits.max_storage_block_bytes
+
+
+def check_image_size(width: int, height: int, largest_buffer_bytes: int, memory_bytes: int | None) -> None:
+    """Refuse, in one line, an image whose accumulation buffer the device cannot bind or whose read-back the
+    machine's memory (``memory_bytes`` available, None: unknown) cannot hold, saying the largest image of
+    the same shape that fits."""
+    pixels = width * height
+    most_pixels = largest_buffer_bytes // ACCUMULATION_BYTES_PER_PIXEL
+    needs = f"needs {ACCUMULATION_BYTES_PER_PIXEL * pixels:,} bytes of accumulation buffer"
+    holder, holds = "this device", f"the largest storage buffer it binds is {largest_buffer_bytes:,} bytes"
+    if memory_bytes is not None and memory_bytes // HOST_BYTES_PER_PIXEL < most_pixels:
+        most_pixels = memory_bytes // HOST_BYTES_PER_PIXEL
+        needs = f"needs {format_bytes(HOST_BYTES_PER_PIXEL * pixels)} of memory ({HOST_BYTES_PER_PIXEL} bytes a pixel)"
+        holder, holds = "this machine", f"{format_bytes(memory_bytes)} of memory is available"
+    if pixels <= most_pixels:
+        return
+    fit_width, fit_height = largest_image_within(width, height, most_pixels)
+    raise SceneTooLarge(f"a {width} x {height} image {needs}; {holder} holds at most {fit_width} x {fit_height} "
+                        f"({holds})")
+
+
+def largest_image_within(width: int, height: int, most_pixels: int) -> tuple[int, int]:
+    """The largest image of (about) the shape width : height with at most ``most_pixels`` pixels."""
+    scale = math.sqrt(most_pixels / (width * height))
+    # At least a pixel each way: a strip too thin to scale down keeps its one row (or column) and gets shorter.
+    fit_width, fit_height = max(1, int(width * scale)), max(1, int(height * scale))
+    while fit_width * fit_height > most_pixels:  # rounding or that one pixel made it too large: trim the longer side
+        if fit_width >= fit_height:
+            fit_width -= 1
+        else:
+            fit_height -= 1
+    return fit_width, fit_height
 
 
 def camera_uniforms(frame: CameraFrame) -> dict[str, object]:
@@ -212,6 +263,9 @@ class RenderSession:
     def set_scene(self, scene: Scene, *, width: int | None = None, height: int | None = None,
                   settings: RenderSettings | None = None) -> None:
         """Upload a (new or edited) scene and restart accumulation."""
+        width = int(width or scene.camera.resolution[0])
+        height = int(height or scene.camera.resolution[1])
+        self._check_image_size(width, height)  # before the kd-tree build: an image too large is refused at once
         self.scene = scene
         self.settings = settings or scene.render
         self.flat_scene = scene.flatten()
@@ -223,8 +277,7 @@ class RenderSession:
         if self._gpu_scene is not None:
             self._gpu_scene.release()
         self._gpu_scene = gpu_scene
-        self.width = int(width or scene.camera.resolution[0])
-        self.height = int(height or scene.camera.resolution[1])
+        self.width, self.height = width, height
         self.features = scene_features(packed) if self.specialise else GENERAL
         self.program = self._trace_program(self.settings.sampler)
         self.set_camera(scene.camera)
@@ -243,6 +296,10 @@ class RenderSession:
             self.program = self._trace_program(settings.sampler)
         self.settings = settings
         self.reset()
+
+    def _check_image_size(self, width: int, height: int) -> None:
+        """Refuse an image this device or machine cannot hold (check_image_size), before allocating for it."""
+        check_image_size(width, height, self.renderer.largest_buffer_bytes, available_memory_bytes())
 
     @property
     def splat_layers(self) -> int:
@@ -272,10 +329,11 @@ class RenderSession:
     def reset(self) -> None:
         """Discard the accumulated samples (after any edit)."""
         pixels = self.width * self.height
-        if self._accumulation is None or self._accumulation.size != pixels * 16:
+        if self._accumulation is None or self._accumulation.size != pixels * ACCUMULATION_BYTES_PER_PIXEL:
+            self._check_image_size(self.width, self.height)  # the studio resizes the image through here
             if self._accumulation is not None:
                 self._accumulation.release()
-            self._accumulation = self.ctx.buffer(reserve=pixels * 16)
+            self._accumulation = self.ctx.buffer(reserve=pixels * ACCUMULATION_BYTES_PER_PIXEL)
         self._accumulation.clear()
         layers = self.splat_layers
         if layers and (self._splat_samples is None or self._splat_samples.size != 16 * pixels * layers):

@@ -167,11 +167,20 @@ def _camel_to_underscore(name: str) -> str:
     return re.sub(r"(?<=[a-z])([A-Z]+)", lambda m: "_" + m.group(1).lower(), name)
 
 
+# Bounds on $param substitution (issue 12). A <default> may use the parameters before it, so a file of a
+# kilobyte can double a value 28 times (p2 = "$p1$p1", p3 = "$p2$p2" ...: 134 M characters). Real scenes
+# substitute numbers and file names; an attribute of a megabyte, or 16 M characters substituted in all,
+# is a file built to exhaust memory.
+MAX_EXPANDED_VALUE_CHARS = 1 << 20
+MAX_SUBSTITUTED_CHARS = 1 << 24
+
+
 class _Expander:
     """Substitution, defaults, includes and ids, in document order, as Mitsuba's parser does."""
 
     def __init__(self, defines: dict[str, str]):
         self.params: dict[str, str] = dict(defines)
+        self.substituted_chars = 0  # characters inserted by substitution so far, in the whole document
         self.used: set[str] = set()
         self.ids: dict[str, XNode] = {}
         self.files: list[Path] = []
@@ -188,6 +197,7 @@ class _Expander:
                     if pos > 0 and value[pos - 1] == "\\":
                         pos = value.find(token, pos + len(token))
                         continue
+                    self._check_room(node, attr, key, len(value) - len(token))
                     value = value[:pos] + self.params[key] + value[pos + len(token):]
                     self.used.add(key)
                     pos = value.find(token, pos + len(self.params[key]))
@@ -195,6 +205,20 @@ class _Expander:
             if match:
                 raise SceneError(f"{node.file}: line {node.line}: <{node.tag}>: undefined parameter ${match.group(1)}")
             node.attrs[attr] = value.replace("\\$", "$")
+
+    def _check_room(self, node: XNode, attr: str, key: str, rest: int) -> None:
+        """Refuse, before building it, a substitution of ``$key`` into a value of ``rest`` other characters
+        that would pass the bounds above: one line naming the file, the line, the parameter and the bound."""
+        inserted = len(self.params[key])
+        self.substituted_chars += inserted
+        if rest + inserted > MAX_EXPANDED_VALUE_CHARS:
+            problem = f'makes "{attr}" longer than {MAX_EXPANDED_VALUE_CHARS:,} characters'
+        elif self.substituted_chars > MAX_SUBSTITUTED_CHARS:
+            problem = f"brings the substituted text past {MAX_SUBSTITUTED_CHARS:,} characters in all"
+        else:
+            return
+        raise SceneError(f"{node.file}: line {node.line}: <{node.tag}>: ${key} {problem} "
+                         "(a parameter that doubles itself?)")
 
     def expand(self, node: XNode, depth: int) -> list[XNode]:
         """The node as it stands after expansion: [] for a <default>, an included file's elements for an
