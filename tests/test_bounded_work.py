@@ -212,7 +212,8 @@ def test_the_cli_refuses_16384_square_before_building_anything(renderer, tmp_pat
     status, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.png", "--spp", "1",
                           "--width", "16384", "--height", "16384")
     assert status == 1
-    assert err.startswith("lenslab: error: a 16384 x 16384 image needs ") and "holds at most" in err
+    assert err.startswith("lenslab: error: ") and "cornell_box/scene.json: a 16384 x 16384 image needs " in err
+    assert "holds at most" in err
     assert err.count("\n") == 1 and not (tmp_path / "x.png").exists()
 
 
@@ -240,3 +241,30 @@ def test_a_session_refuses_up_front_and_on_resize(renderer, monkeypatch):
             session.reset()
     finally:
         session.release()
+
+
+def test_a_relief_too_large_is_refused_before_it_is_made(capsys, tmp_path, monkeypatch):
+    from lenslab.scene.shapes import Relief
+
+    def never(self):
+        raise AssertionError("the relief's mesh was made before its size was checked")
+
+    monkeypatch.setattr(Relief, "mesh", never)
+    scene = tmp_path / "sand.json"
+    scene.write_text(json.dumps({"lenslab_scene": 2, "nodes": [
+        {"name": "sand", "shape": {"type": "relief", "resolution": [8192, 8192]}}]}))
+    status, err = run_cli(capsys, scene, "--headless", "-o", tmp_path / "x.png", "--spp", "1")
+    assert status == 1 and err.count("\n") == 1
+    assert f"{scene}: the shapes made in code (node 'sand' the most) make 134,184,962 triangles" in err
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_the_triangle_limit_is_the_device_s_or_the_machine_s_whichever_is_less():
+    from lenslab.render.tracer import GPU_BYTES_PER_TRIANGLE, HOST_BYTES_PER_TRIANGLE, check_triangle_count
+
+    block = 1000 * GPU_BYTES_PER_TRIANGLE
+    check_triangle_count(1000, "has", block, None)
+    with pytest.raises(SceneTooLarge, match="has 1,001 triangles; the GL device's largest storage buffer .* at most 1,000"):
+        check_triangle_count(1001, "has", block, None)
+    with pytest.raises(SceneTooLarge, match="has 1,000 triangles; this machine's .* available memory can build at most 999"):
+        check_triangle_count(1000, "has", block, 999 * HOST_BYTES_PER_TRIANGLE)

@@ -329,6 +329,7 @@ def _progress_lines(every_seconds: float):
 
 def render_headless(args) -> int:
     from lenslab.render.job import RenderJob
+    from lenslab.render.limits import SceneTooLarge
     from lenslab.render.tracer import Renderer
     from lenslab.scene.scene import SceneError
 
@@ -347,7 +348,7 @@ def render_headless(args) -> int:
         with _loading_status(console, "building the kd-tree and compiling the kernel"):
             job = RenderJob(renderer, scene, spp=args.spp, time_limit=args.time_limit,
                             dispatch_seconds=HEADLESS_DISPATCH_SECONDS)
-    except (SceneError, ValueError) as exc:  # found only when the scene is packed for the GPU: name its file
+    except (SceneError, SceneTooLarge, ValueError) as exc:  # found only when the scene is packed: name its file
         raise SceneError.in_file(scene.source_path or args.scene, exc) from None
     session = job.session
     if console is not None:

@@ -25,11 +25,12 @@ from lenslab.optics.aperture import APERTURE_KINDS, Aperture
 from lenslab.render import film, gl
 from lenslab.render.buffers import GpuScene, pack_scene
 from lenslab.render.features import GENERAL, KernelFeatures, scene_features
-from lenslab.render.gpu_layout import (ACCUMULATION_BINDING, APERTURE_TABLE_UNIT, DISPLAY_BINDING, SPLAT_IMAGE_BINDING, TONE_MAP_CLAMP,
-                                      TONE_MAP_FILMIC, TONE_MAP_REINHARD)
+from lenslab.render.gpu_layout import (ACCUMULATION_BINDING, APERTURE_TABLE_UNIT, DISPLAY_BINDING, SHADING_ROWS,
+                                      SPLAT_IMAGE_BINDING, TONE_MAP_CLAMP, TONE_MAP_FILMIC, TONE_MAP_REINHARD)
 from lenslab.render.limits import SceneTooLarge, available_memory_bytes, format_bytes
 from lenslab.render.sobol import glsl_array_literal
 from lenslab.scene.camera import CameraFrame, ThinLensCamera
+from lenslab.scene.flatten import made_triangles
 from lenslab.scene.scene import RenderSettings, Scene
 
 LOCAL_SIZE_X = 32  # GPU-NOTES: 32x1 work groups traversed the kd-tree fastest on llvmpipe
@@ -50,6 +51,12 @@ SAMPLE_INDEX_LIMIT = 1 << 32  # the kernel's sample index is a 32-bit unsigned i
 # memory too; 39 for an EXR), rounded up.
 ACCUMULATION_BYTES_PER_PIXEL = 16
 HOST_BYTES_PER_PIXEL = 96
+#: A triangle's bytes in the largest of the scene's storage buffers (buffers.py's shading rows).
+GPU_BYTES_PER_TRIANGLE = SHADING_ROWS * 16
+#: And in this machine's memory while the scene is flattened, packed and its kd-tree built: the float64 and
+#: float32 copies of corners, normals and uvs, the packed rows, and about four kd-tree references at up to
+#: 256 bytes each at the build's peak (render/bsp.py): rounded up from marbles_on_sand's million triangles.
+HOST_BYTES_PER_TRIANGLE = 1536
 # Mesa's llvmpipe advertises storage blocks of 128 MiB but binds any buffer it can make whole, and a Gallium
 # buffer's size is a 32-bit number: 4 GiB less 16 bytes work, 4 GiB fails with "cannot map the buffer".
 LLVMPIPE_BUFFER_BYTES = (1 << 32) - 1
@@ -150,6 +157,19 @@ def check_image_size(width: int, height: int, largest_buffer_bytes: int, memory_
     fit_width, fit_height = largest_image_within(width, height, most_pixels)
     raise SceneTooLarge(f"a {width} x {height} image {needs}; {holder} holds at most {fit_width} x {fit_height} "
                         f"({holds})")
+
+
+def check_triangle_count(count: int, what: str, largest_block_bytes: int, memory_bytes: int | None) -> None:
+    """Refuse, in one line, more triangles than the device's largest storage buffer holds (GpuScene's limit)
+    or than this machine's memory (``memory_bytes`` available, None: unknown) can flatten and build a tree for."""
+    limits = [(largest_block_bytes // GPU_BYTES_PER_TRIANGLE,
+               f"the GL device's largest storage buffer ({format_bytes(largest_block_bytes)}) holds")]
+    if memory_bytes is not None:
+        limits.append((memory_bytes // HOST_BYTES_PER_TRIANGLE,
+                       f"this machine's {format_bytes(memory_bytes)} of available memory can build"))
+    most, holder = min(limits)
+    if count > most:
+        raise SceneTooLarge(f"{what} {count:,} triangles; {holder} at most {most:,}")
 
 
 def largest_image_within(width: int, height: int, most_pixels: int) -> tuple[int, int]:
@@ -266,9 +286,15 @@ class RenderSession:
         width = int(width or scene.camera.resolution[0])
         height = int(height or scene.camera.resolution[1])
         self._check_image_size(width, height)  # before the kd-tree build: an image too large is refused at once
+        # Triangles made in code (a relief of 8192 x 8192 vertices is 134 M) are counted before they are made,
+        # and those of mesh files once read, before the kd-tree build: a scene too large is refused at once.
+        made, largest = made_triangles(scene)
+        self._check_triangle_count(made, f"the shapes made in code (node '{largest}' the most) make")
+        flat_scene = scene.flatten()
+        self._check_triangle_count(flat_scene.triangle_count, "the scene has")
         self.scene = scene
         self.settings = settings or scene.render
-        self.flat_scene = scene.flatten()
+        self.flat_scene = flat_scene
         packed = pack_scene(self.flat_scene, scene.environment, base_dir=scene.base_dir(), lights=scene.lights,
                             environment_importance=self.environment_importance)
         # What the render survives but the user should hear about: unmapped mesh materials, missing textures.
@@ -296,6 +322,9 @@ class RenderSession:
             self.program = self._trace_program(settings.sampler)
         self.settings = settings
         self.reset()
+
+    def _check_triangle_count(self, count: int, what: str) -> None:
+        check_triangle_count(count, what, self.renderer.limits.max_storage_block_bytes, available_memory_bytes())
 
     def _check_image_size(self, width: int, height: int) -> None:
         """Refuse an image this device or machine cannot hold (check_image_size), before allocating for it."""

@@ -91,6 +91,14 @@ def _relief_mesh(*fields) -> TriangleMesh:
     return Relief(*fields).mesh()
 
 
+def made_triangles(scene: Scene) -> tuple[int, str]:
+    """How many triangles the shapes made in code (rectangles, disks, boxes, reliefs) will have, counted
+    without making them (mesh files are not read here), and which node makes the most ("" for none)."""
+    counts = [(node.shape.triangle_count, node.name) for node, _ in scene.walk()
+              if isinstance(node.shape, (Rectangle, Disk, Box, Relief))]
+    return sum(count for count, _ in counts), max(counts)[1] if counts else ""
+
+
 def flatten_scene(scene: Scene, mesh_loader=None) -> FlatScene:
     if mesh_loader is None:
         from lenslab.scene.io.meshes import load_mesh_parts as mesh_loader

@@ -47,6 +47,8 @@ class Rectangle(Shape):
     type_name: ClassVar[str] = "rectangle"
     size: tuple[float, float] = field(default=(1.0, 1.0), metadata={"range": (1e-9, 1e9), "doc": "width, height in metres"})
 
+    triangle_count: ClassVar[int] = 2
+
     def mesh(self) -> TriangleMesh:
         w, h = self.size[0] / 2, self.size[1] / 2
         vertices = np.array([[-w, -h, 0], [w, -h, 0], [w, h, 0], [-w, h, 0]], dtype=float)
@@ -62,6 +64,10 @@ class Disk(Shape):
     type_name: ClassVar[str] = "disk"
     radius: float = field(default=0.5, metadata={"range": (1e-9, 1e9), "doc": "metres"})
     segments: int = field(default=128, metadata={"range": (3, 4096), "doc": "edges of the polygon that stands in for it"})
+
+    @property
+    def triangle_count(self) -> int:
+        return int(self.segments)
 
     def mesh(self) -> TriangleMesh:
         # A polygon with the disk's area (not inscribed in it), so that an emitting disk keeps its power.
@@ -81,6 +87,7 @@ class Box(Shape):
 
     type_name: ClassVar[str] = "box"
     size: tuple[float, float, float] = field(default=(1.0, 1.0, 1.0), metadata={"range": (1e-9, 1e9)})
+    triangle_count: ClassVar[int] = 12
 
     def mesh(self) -> TriangleMesh:
         corners = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)])
@@ -108,6 +115,12 @@ class Relief(Shape):
     octaves: int = field(default=5, metadata={"range": (1, 16), "doc": "layers of ever finer detail"})
     resolution: tuple[int, int] = field(default=(256, 256), metadata={"range": (2, 8192), "doc": "vertices along X and Y"})
     seed: int = field(default=0, metadata={"range": (0, 2**31 - 1), "doc": "which landscape"})
+
+    @property
+    def triangle_count(self) -> int:
+        """Known before the mesh is made (which at 8192 x 8192 would take minutes and tens of GB)."""
+        nx, ny = (int(n) for n in self.resolution)
+        return 2 * (nx - 1) * (ny - 1)
 
     def mesh(self) -> TriangleMesh:
         nx, ny = (int(n) for n in self.resolution)
