@@ -172,3 +172,26 @@ def test_a_python_warning_is_one_warning_line(capsys):
         warnings.warn("overflow encountered in multiply", RuntimeWarning)
     err = capsys.readouterr().err
     assert err == "lenslab: warning: RuntimeWarning: overflow encountered in multiply\n"
+
+
+def test_an_image_cut_short_is_named_and_nothing_else_reaches_stderr(tmp_path):
+    """OpenImageIO reads a truncated EXR in part and, unless its error is fetched, prints it from C++ as the
+    buffer is destroyed: the environment map's warning must be the only word about it."""
+    import shutil
+    import subprocess
+    import sys
+
+    for source in (CORNELL.parent.parent / "product_shot").iterdir():
+        shutil.copy(source, tmp_path)
+    studio = tmp_path / "studio.exr"
+    studio.write_bytes(studio.read_bytes()[: studio.stat().st_size * 2 // 3])
+    from lenslab.render.textures import read_texture_image
+
+    with pytest.raises(OSError, match="studio.exr: cannot read texture"):
+        read_texture_image(studio)
+    done = subprocess.run([sys.executable, "-m", "lenslab", tmp_path / "scene.json", "--headless", "-o",
+                           tmp_path / "out.png", "--spp", "1", "--width", "8", "--height", "8"],
+                          capture_output=True, text=True, timeout=120)
+    lines = done.stderr.splitlines()
+    assert done.returncode == 0 and all(line.startswith(("lenslab: ", "wrote ")) for line in lines), done.stderr
+    assert any(f"{studio}: cannot read texture" in line and "magenta sky" in line for line in lines)

@@ -201,7 +201,10 @@ def read_image(path: str | os.PathLike) -> tuple[np.ndarray, dict[str, object]]:
     try:
         spec = image.spec()
         pixels = image.read_image(format=oiio.FLOAT)
+        errors = image.geterror()
         metadata = {attr.name: attr.value for attr in spec.extra_attribs}
     finally:
         image.close()
+    if pixels is None or errors:  # a file cut short reads in part, and says so only in the error text
+        raise ExportError(f"{path}: cannot read ({(errors.strip().splitlines() or ['no pixels'])[0]})")
     return np.asarray(pixels, dtype=np.float32), metadata

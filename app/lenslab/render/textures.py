@@ -40,7 +40,10 @@ def read_texture_image(path: Path, color_space: str = "auto") -> np.ndarray:
         roi = oiio.ROI(0, max(1, round(spec.width * scale)), 0, max(1, round(spec.height * scale)), 0, 1, 0, spec.nchannels)
         image = oiio.ImageBufAlgo.resize(image, roi=roi)
         log.warning("%s: %dx%d texture reduced to %dx%d", path, spec.width, spec.height, roi.width, roi.height)
-    pixels = np.asarray(image.get_pixels(oiio.FLOAT), dtype=np.float32)
+    pixels = image.get_pixels(oiio.FLOAT)
+    if image.has_error or pixels is None:  # a file cut short reads in part, and says so only here
+        raise OSError(f"{path}: cannot read texture ({_first_line(image.geterror()) or 'no pixels'})")
+    pixels = np.asarray(pixels, dtype=np.float32)
     if pixels.ndim == 2:
         pixels = pixels[..., None]
     channels = pixels.shape[2]
@@ -53,6 +56,11 @@ def read_texture_image(path: Path, color_space: str = "auto") -> np.ndarray:
         log.warning("%s: %d texel%s NaN or infinite: read as black", path, bad, " is" if bad == 1 else "s are")
         rgb = np.where(np.isfinite(rgb), rgb, 0.0)
     return np.ascontiguousarray(rgb, dtype=np.float32)
+
+
+def _first_line(text: str) -> str:
+    lines = text.strip().splitlines()
+    return lines[0] if lines else ""
 
 
 @dataclass

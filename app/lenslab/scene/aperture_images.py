@@ -37,7 +37,11 @@ def _read(path: str, stamp: int) -> np.ndarray:
     image = oiio.ImageBuf(path)
     if image.has_error or image.spec().width == 0:
         raise ValueError(f"{path}: cannot read the aperture image ({image.geterror() or 'unknown format'})")
-    pixels = np.asarray(image.get_pixels(oiio.FLOAT), dtype=np.float64)
+    pixels = image.get_pixels(oiio.FLOAT)
+    if image.has_error or pixels is None:  # a file cut short reads in part, and says so only here
+        reason = (image.geterror().strip().splitlines() or ["no pixels"])[0]
+        raise ValueError(f"{path}: cannot read the aperture image ({reason})")
+    pixels = np.asarray(pixels, dtype=np.float64)
     if str(image.spec().format) not in ("half", "float", "double"):  # 8 and 16-bit files hold sRGB-encoded values
         pixels = srgb_to_linear(np.clip(pixels, 0.0, 1.0))
     if pixels.ndim == 2:
