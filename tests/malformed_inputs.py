@@ -466,6 +466,24 @@ def _raise_hung(signum, frame):
     raise _Hung()
 
 
+@contextlib.contextmanager
+def _c_level_stderr(into: io.StringIO):
+    """What libraries print from C or C++ onto file descriptor 2 (OpenImageIO, Mesa), added to ``into``:
+    a user sees it as they see Python's own lines."""
+    import tempfile
+
+    with tempfile.TemporaryFile() as capture:
+        saved = os.dup(2)
+        os.dup2(capture.fileno(), 2)
+        try:
+            yield
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            capture.seek(0)
+            into.write(capture.read().decode("utf-8", "replace"))
+
+
 def run_in_process(case: Case, folder: Path) -> Outcome:
     """Run ``lenslab.cli.main`` on the case in this process, its stderr captured; an exception that escapes
     is a traceback the user would have seen."""
@@ -478,7 +496,7 @@ def run_in_process(case: Case, folder: Path) -> Outcome:
     previous = signal.signal(signal.SIGALRM, _raise_hung)
     signal.alarm(CASE_SECONDS)
     try:
-        with contextlib.redirect_stderr(stderr), contextlib.redirect_stdout(io.StringIO()):
+        with contextlib.redirect_stderr(stderr), contextlib.redirect_stdout(io.StringIO()), _c_level_stderr(stderr):
             status = main(_arguments(case, scene, output))
     except _Hung:
         return Outcome(case, None, stderr.getvalue(), time.perf_counter() - start, f"hung over {CASE_SECONDS} s")
