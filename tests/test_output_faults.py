@@ -481,10 +481,12 @@ def test_a_render_logged_to_a_file_prints_progress_lines(renderer, tmp_path, cap
 
     args = ["cornell_box", "--headless", "-o", tmp_path / "x.png", "--spp", "3", "--width", "16", "--height", "16"]
     status, err = run_cli(capsys, *args)  # stderr is not a terminal here: a log
-    assert status == 0 and "rendering:" not in err  # a render shorter than the interval: no line
+    assert status == 0 and "rendering:" not in err and "loaded:" not in err  # shorter than the interval: no line
     monkeypatch.setattr(lenslab.cli, "PROGRESS_LINE_SECONDS", 0.0)
     status, err = run_cli(capsys, *args)
     lines = err.splitlines()
     assert status == 0 and lines[-1].startswith("wrote ")
+    assert re.fullmatch(r"lenslab: loaded: 36 triangles, 0 spheres; kd-tree of \d+ nodes built in [0-9.]+ s; "
+                        r"ready to sample after [0-9.]+ s", lines.pop(0)), err  # the load, as long as a slice
     assert lines[:-1] and all(re.fullmatch(r"lenslab: rendering: [0-3] of 3 spp after \d+ s \([0-9.]+ M samples/s\)",
                                            line) for line in lines[:-1]), err

@@ -351,11 +351,14 @@ def render_headless(args) -> int:
     except (SceneError, SceneTooLarge, ValueError) as exc:  # found only when the scene is packed: name its file
         raise SceneError.in_file(scene.source_path or args.scene, exc) from None
     session = job.session
+    ready_after = time.perf_counter() - loading_start
+    flat, tree = session.flat_scene, session.kdtree
+    loaded = (f"{flat.triangle_count:,} triangles, {flat.sphere_count:,} spheres; kd-tree of {len(tree.nodes):,} "
+              f"nodes built in {tree.build_seconds:.1f} s; ready to sample after {ready_after:.1f} s")
     if console is not None:
-        flat, tree = session.flat_scene, session.kdtree
-        console.print(f"{flat.triangle_count:,} triangles, {flat.sphere_count:,} spheres; kd-tree of {len(tree.nodes):,} "
-                      f"nodes built in {tree.build_seconds:.1f} s; ready to sample after "
-                      f"{time.perf_counter() - loading_start:.1f} s", highlight=False)
+        console.print(loaded, highlight=False)
+    elif ready_after >= PROGRESS_LINE_SECONDS:  # a log that was silent this long says what took the time
+        print(f"lenslab: loaded: {loaded}", file=sys.stderr)
     for warning in session.warnings:
         _warn(warning)
     log_progress = _progress_lines(PROGRESS_LINE_SECONDS) if console is None else None
