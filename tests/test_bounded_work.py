@@ -17,7 +17,7 @@ import pytest
 from lenslab.cli import main
 from lenslab.render.bsp import (BUILD_BYTES_PER_REF, REFS_FLOOR, REFS_PER_PRIM_LIMIT, build_kdtree,
                                 reference_budget)
-from lenslab.render.limits import SceneTooLarge
+from lenslab.limits import SceneTooLarge
 from lenslab.render.tracer import (LLVMPIPE_BUFFER_BYTES, check_image_size, largest_image_within,
                                    largest_storage_buffer)
 from lenslab.scene.io.loader import open_scene

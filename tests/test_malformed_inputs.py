@@ -11,6 +11,7 @@ import io
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from lenslab.cli import main
@@ -187,11 +188,33 @@ def test_an_image_cut_short_is_named_and_nothing_else_reaches_stderr(tmp_path):
     studio.write_bytes(studio.read_bytes()[: studio.stat().st_size * 2 // 3])
     from lenslab.render.textures import read_texture_image
 
-    with pytest.raises(OSError, match="studio.exr: cannot read texture"):
+    with pytest.raises(OSError, match="studio.exr: cannot read the image"):
         read_texture_image(studio)
     done = subprocess.run([sys.executable, "-m", "lenslab", tmp_path / "scene.json", "--headless", "-o",
                            tmp_path / "out.png", "--spp", "1", "--width", "8", "--height", "8"],
                           capture_output=True, text=True, timeout=120)
     lines = done.stderr.splitlines()
     assert done.returncode == 0 and all(line.startswith(("lenslab: ", "wrote ")) for line in lines), done.stderr
-    assert any(f"{studio}: cannot read texture" in line and "magenta sky" in line for line in lines)
+    assert any(f"{studio}: cannot read the image" in line and "magenta sky" in line for line in lines)
+
+
+def test_an_image_that_claims_too_many_pixels_is_refused_from_its_header(tmp_path, monkeypatch):
+    """A PNG of a few kilobytes may claim 60000 x 60000 pixels and decode into gigabytes: read its header only."""
+    import OpenImageIO as oiio
+
+    from lenslab import image_files
+
+    bomb = tmp_path / "bomb.png"
+    out = oiio.ImageOutput.create(str(bomb))
+    out.open(str(bomb), oiio.ImageSpec(4000, 3000, 1, oiio.UINT8))
+    out.write_image(np.zeros((3000, 4000, 1), np.uint8))
+    out.close()
+    monkeypatch.setattr("lenslab.limits.MAX_SOURCE_PIXELS", 1000 * 1000)  # small enough to test with a small file
+
+    def never(*args):
+        raise AssertionError("the pixels were decoded")
+
+    monkeypatch.setattr(oiio.ImageBuf, "get_pixels", never)
+    with pytest.raises(OSError, match=r"bomb.png: cannot read the image \(4000 x 3000 pixels, more than the "
+                                      r"1,000,000 LensLab reads\)"):
+        image_files.read_pixels(bomb)

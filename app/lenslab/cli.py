@@ -329,7 +329,7 @@ def _progress_lines(every_seconds: float):
 
 def render_headless(args) -> int:
     from lenslab.render.job import RenderJob
-    from lenslab.render.limits import SceneTooLarge
+    from lenslab.limits import SceneTooLarge
     from lenslab.render.tracer import Renderer
     from lenslab.scene.scene import SceneError
 

@@ -90,7 +90,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from lenslab.render.gpu_layout import KD_LEAF as LEAF  # the two low bits of nodes[i, 1] of a leaf (axes: 0-2)
-from lenslab.render.limits import SceneTooLarge, available_memory_bytes, format_bytes
+from lenslab.limits import SceneTooLarge, available_memory_bytes, format_bytes
 
 # Default SAH constants, in units of one traversal step.
 #

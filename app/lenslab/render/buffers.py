@@ -19,7 +19,7 @@ from lenslab.render.bsp import KdTree, build_kdtree
 from lenslab.render.fresnel import internal_diffuse_reflectance, rough_internal_reflectance, rough_reflectance_table
 from lenslab.render.environment import EnvironmentDistribution, environment_power, infinite_light_power
 from lenslab.render.gl import make_current
-from lenslab.render.limits import SceneTooLarge, format_bytes  # SceneTooLarge: raised here, imported from here
+from lenslab.limits import SceneTooLarge, format_bytes  # SceneTooLarge: raised here, imported from here
 from lenslab.render.gpu_layout import (ENV_CONSTANT, ENV_MAP, GEOMETRY_BINDING, GEOMETRY_ROWS,
                                        IMAGE_DATA_BINDING, KD_NODES_BINDING, LIGHT_AREA, LIGHT_CHOICE_BINDING,
                                        LIGHT_ENVIRONMENT, LIGHT_PLACES, LIGHT_POINT, LIGHT_ROWS, LIGHT_SUN,

@@ -16,6 +16,7 @@ import numpy as np
 
 from lenslab.atomic import atomic_path, write_failure_reason
 from lenslab.color import linear_to_srgb
+from lenslab.limits import image_too_large
 
 EXPORT_SUFFIXES = (".exr", ".png")
 TONE_MAPS = ("clamp", "reinhard", "filmic")
@@ -200,6 +201,9 @@ def read_image(path: str | os.PathLike) -> tuple[np.ndarray, dict[str, object]]:
         raise ExportError(f"{path}: cannot read ({oiio.geterror()})")
     try:
         spec = image.spec()
+        too_large = image_too_large(spec.width, spec.height, spec.nchannels)
+        if too_large:
+            raise ExportError(f"{path}: cannot read ({too_large})")
         pixels = image.read_image(format=oiio.FLOAT)
         errors = image.geterror()
         metadata = {attr.name: attr.value for attr in spec.extra_attribs}

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from lenslab.color import srgb_to_linear
+from lenslab.image_files import read_pixels
 from lenslab.render.gpu_layout import TEXELS_FLOAT, TEXELS_HALF, TEXTURE_CHECKER, TEXTURE_IMAGE, TEXTURE_ROWS
 from lenslab.scene.textures import Checkerboard, ImageTexture, InlineImageTexture, Texture
 
@@ -24,31 +25,17 @@ log = logging.getLogger("lenslab.textures")
 HALF_MAX = 65504.0
 MAX_SIDE = 4096  # larger images are downsampled: one storage buffer holds all texels
 MISSING = Checkerboard(color_a=(1.0, 0.0, 1.0), color_b=(0.0, 0.0, 0.0), tiles=(16.0, 16.0))
-FLOAT_FORMATS = ("half", "float", "double")
 
 
 def read_texture_image(path: Path, color_space: str = "auto") -> np.ndarray:
     """(H, W, 3) float32 linear RGB. Raises OSError naming the file when it cannot be read."""
-    import OpenImageIO as oiio
-
-    image = oiio.ImageBuf(str(path))
-    if image.has_error or image.spec().width == 0:
-        raise OSError(f"{path}: cannot read texture ({image.geterror() or 'unknown format'})")
-    spec = image.spec()
-    if max(spec.width, spec.height) > MAX_SIDE:
-        scale = MAX_SIDE / max(spec.width, spec.height)
-        roi = oiio.ROI(0, max(1, round(spec.width * scale)), 0, max(1, round(spec.height * scale)), 0, 1, 0, spec.nchannels)
-        image = oiio.ImageBufAlgo.resize(image, roi=roi)
-        log.warning("%s: %dx%d texture reduced to %dx%d", path, spec.width, spec.height, roi.width, roi.height)
-    pixels = image.get_pixels(oiio.FLOAT)
-    if image.has_error or pixels is None:  # a file cut short reads in part, and says so only here
-        raise OSError(f"{path}: cannot read texture ({_first_line(image.geterror()) or 'no pixels'})")
-    pixels = np.asarray(pixels, dtype=np.float32)
-    if pixels.ndim == 2:
-        pixels = pixels[..., None]
+    pixels, is_float = read_pixels(path)
+    height, width = pixels.shape[:2]
+    if max(width, height) > MAX_SIDE:
+        pixels = _reduced(pixels, MAX_SIDE / max(width, height))
+        log.warning("%s: %dx%d texture reduced to %dx%d", path, width, height, pixels.shape[1], pixels.shape[0])
     channels = pixels.shape[2]
     rgb = np.repeat(pixels[..., :1], 3, axis=2) if channels < 3 else pixels[..., :3]
-    is_float = str(spec.format) in FLOAT_FORMATS
     if color_space == "srgb" or (color_space == "auto" and not is_float):
         rgb = srgb_to_linear(np.clip(rgb, 0.0, 1.0))
     if not np.isfinite(rgb).all():  # NaN or infinity in a float file: black, or every path that sees it is lost
@@ -58,9 +45,14 @@ def read_texture_image(path: Path, color_space: str = "auto") -> np.ndarray:
     return np.ascontiguousarray(rgb, dtype=np.float32)
 
 
-def _first_line(text: str) -> str:
-    lines = text.strip().splitlines()
-    return lines[0] if lines else ""
+def _reduced(pixels: np.ndarray, scale: float) -> np.ndarray:
+    """``pixels`` resampled to ``scale`` of their size, with OpenImageIO's filtered resize."""
+    import OpenImageIO as oiio
+
+    height, width, channels = pixels.shape
+    roi = oiio.ROI(0, max(1, round(width * scale)), 0, max(1, round(height * scale)), 0, 1, 0, channels)
+    reduced = oiio.ImageBufAlgo.resize(oiio.ImageBuf(np.ascontiguousarray(pixels)), roi=roi)
+    return np.asarray(reduced.get_pixels(oiio.FLOAT), dtype=np.float32).reshape(roi.height, roi.width, channels)
 
 
 @dataclass

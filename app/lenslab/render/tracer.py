@@ -27,7 +27,7 @@ from lenslab.render.buffers import GpuScene, pack_scene
 from lenslab.render.features import GENERAL, KernelFeatures, scene_features
 from lenslab.render.gpu_layout import (ACCUMULATION_BINDING, APERTURE_TABLE_UNIT, DISPLAY_BINDING, SHADING_ROWS,
                                       SPLAT_IMAGE_BINDING, TONE_MAP_CLAMP, TONE_MAP_FILMIC, TONE_MAP_REINHARD)
-from lenslab.render.limits import SceneTooLarge, available_memory_bytes, format_bytes
+from lenslab.limits import SceneTooLarge, available_memory_bytes, format_bytes
 from lenslab.render.sobol import glsl_array_literal
 from lenslab.scene.camera import CameraFrame, ThinLensCamera
 from lenslab.scene.flatten import made_triangles

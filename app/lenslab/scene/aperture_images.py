@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from lenslab.color import srgb_to_linear
+from lenslab.image_files import read_pixels
 
 
 def resolve(name: str, base_dir: Path | None) -> Path:
@@ -32,20 +33,13 @@ def read_aperture_image(name: str, base_dir: Path | None = None) -> np.ndarray:
 
 @lru_cache(maxsize=8)
 def _read(path: str, stamp: int) -> np.ndarray:
-    import OpenImageIO as oiio
-
-    image = oiio.ImageBuf(path)
-    if image.has_error or image.spec().width == 0:
-        raise ValueError(f"{path}: cannot read the aperture image ({image.geterror() or 'unknown format'})")
-    pixels = image.get_pixels(oiio.FLOAT)
-    if image.has_error or pixels is None:  # a file cut short reads in part, and says so only here
-        reason = (image.geterror().strip().splitlines() or ["no pixels"])[0]
-        raise ValueError(f"{path}: cannot read the aperture image ({reason})")
-    pixels = np.asarray(pixels, dtype=np.float64)
-    if str(image.spec().format) not in ("half", "float", "double"):  # 8 and 16-bit files hold sRGB-encoded values
+    try:
+        pixels, is_float = read_pixels(path)
+    except OSError as exc:  # the callers' errors are ValueErrors, naming the camera's key
+        raise ValueError(str(exc)) from None
+    pixels = pixels.astype(np.float64)
+    if not is_float:  # 8 and 16-bit files hold sRGB-encoded values
         pixels = srgb_to_linear(np.clip(pixels, 0.0, 1.0))
-    if pixels.ndim == 2:
-        pixels = pixels[..., None]
     channels = pixels.shape[2]
     if channels in (2, 4):  # alpha is the transmission
         transmission = pixels[..., -1]

@@ -59,7 +59,7 @@ from pathlib import Path
 import numpy as np
 
 from lenslab.color import srgb_to_linear
-
+from lenslab.image_files import read_pixels
 from lenslab.scene.io.meshes import LoadedMesh, MeshLoadError, MeshPart, check_geometry
 from lenslab.scene.materials import Conductor, Dielectric, Diffuse, Emissive, Material, Plastic
 from lenslab.scene.shapes import TriangleMesh
@@ -239,13 +239,7 @@ def roughness_from_phong(ns: float) -> float:
 
 def read_image(path: Path) -> np.ndarray:
     """(H, W, C) float32 as stored (0..1 for 8/16-bit files), row 0 at the top. Raises OSError."""
-    import OpenImageIO as oiio
-
-    image = oiio.ImageBuf(str(path))
-    if image.has_error or image.spec().width == 0:
-        raise OSError(f"cannot read {path.name} ({image.geterror() or 'unknown format'})")
-    pixels = np.asarray(image.get_pixels(oiio.FLOAT), dtype=np.float32)
-    return pixels[..., None] if pixels.ndim == 2 else pixels
+    return read_pixels(path)[0]
 
 
 def read_image_bytes(data: bytes, suffix: str) -> np.ndarray:

@@ -71,3 +71,21 @@ def _address_space_room() -> int | None:
     except (OSError, ValueError, IndexError):
         pass
     return None
+
+
+#: The most pixels an image file may hold to be read at all (a 16K x 8K panorama): its header is read first,
+#: so a PNG of a few kilobytes that claims 60000 x 60000 pixels (a decompression bomb) is refused before it
+#: is decoded into gigabytes.
+MAX_SOURCE_PIXELS = 16384 * 8192
+
+
+def image_too_large(width: int, height: int, channels: int) -> str | None:
+    """Why an image file of this size is not to be read (None: it may be), from its header alone: more pixels
+    than MAX_SOURCE_PIXELS, or more than the memory available can decode (as float, with a copy to spare)."""
+    if width * height > MAX_SOURCE_PIXELS:
+        return f"{width} x {height} pixels, more than the {MAX_SOURCE_PIXELS:,} LensLab reads"
+    needed = 2 * width * height * max(channels, 1) * 4
+    memory = available_memory_bytes()
+    if memory is not None and needed > memory:
+        return f"{width} x {height} pixels need {format_bytes(needed)} to read, more than the {format_bytes(memory)} available"
+    return None
