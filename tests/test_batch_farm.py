@@ -19,6 +19,16 @@ from tests.test_batch_spec import batch as write_batch  # writes shots.toml in a
 
 pytestmark = pytest.mark.gl
 
+#: Four shots that each take a few seconds: long enough to interrupt the batch between two of them.
+FOUR_SLOW_SHOTS = """
+    [[shots]]
+    scene = "cornell_box"
+    output = "f{f_number}.exr"
+    width = 64
+    spp = 200
+    f_number = [1.4, 2, 2.8, 4]
+"""
+
 
 @pytest.fixture(scope="module")
 def client(renderer):  # the renderer fixture skips where there is no GL at all
@@ -192,14 +202,7 @@ def test_a_local_worker_leaves_ctrl_c_to_the_batch():
 
 
 def test_ctrl_c_keeps_every_finished_shot_and_the_next_run_renders_the_rest(tmp_path, renderer):
-    (tmp_path / "shots.toml").write_text("""
-        [[shots]]
-        scene = "cornell_box"
-        output = "f{f_number}.exr"
-        width = 64
-        spp = 200
-        f_number = [1.4, 2, 2.8, 4]
-    """)
+    (tmp_path / "shots.toml").write_text(FOUR_SLOW_SHOTS)
     command = [sys.executable, "-m", "lenslab", "batch", str(tmp_path / "shots.toml"), "--workers", "1"]
     # A new session, signalled as a whole: Ctrl-C on a terminal reaches the Dask worker processes too.
     batch = subprocess.Popen(command, stderr=subprocess.PIPE, text=True, start_new_session=True)

@@ -28,6 +28,7 @@ import pytest
 from lenslab.atomic import STALE_AFTER_SECONDS, TEMPORARY_NAME, WriteFailed, atomic_path, remove_stale_temporaries
 from lenslab.cli import main
 from lenslab.render.film import ExportError, read_image, write_image
+from tests.test_batch_farm import FOUR_SLOW_SHOTS
 
 POSIX_ONLY = pytest.mark.skipif(os.name != "posix", reason="POSIX signals, file-size limits and mounts")
 SUBPROCESS_SECONDS = 180
@@ -424,14 +425,7 @@ def test_a_command_called_in_process_leaves_the_callers_signal_handlers_alone(re
 @POSIX_ONLY
 @pytest.mark.gl
 def test_a_batch_stopped_by_sigterm_keeps_its_written_shots_and_says_so(renderer, tmp_path):
-    (tmp_path / "shots.toml").write_text("""
-        [[shots]]
-        scene = "cornell_box"
-        output = "f{f_number}.exr"
-        width = 64
-        spp = 200
-        f_number = [1.4, 2, 2.8, 4]
-    """)
+    (tmp_path / "shots.toml").write_text(FOUR_SLOW_SHOTS)
     batch = subprocess.Popen([sys.executable, "-m", "lenslab", "batch", "shots.toml", "--workers", "1"], cwd=tmp_path,
                              stderr=subprocess.PIPE, text=True)
     first = None
