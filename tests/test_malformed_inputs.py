@@ -124,6 +124,7 @@ def test_a_json_file_python_cannot_parse_is_named(tmp_path, text, expected):
     ('<scene version="3.0.0"><sensor type="perspective"><float name="fov"/></sensor></scene>',
      'line 1: <float name="fov">: missing attribute "value"'),
     ('<?xml version="1.0" encoding="bogus"?>\n<scene version="3.0.0"/>', "unknown encoding: bogus"),
+    ('<?xml version="1.0" encoding="utf-32"?>\n<scene version="3.0.0"/>', "cannot read the file's encoding"),
     ('<scene version="3.0.0"><shape type="sphere"><bsdf type="dielectric"><float name="ext_ior" value="0"/>'
      '</bsdf></shape></scene>', "an index of refraction must be positive"),
     ('<scene version="3.0.0"><shape type="sphere"><bsdf type="roughconductor"><float name="alpha_u" value="-1"/>'
@@ -218,3 +219,38 @@ def test_an_image_that_claims_too_many_pixels_is_refused_from_its_header(tmp_pat
     with pytest.raises(OSError, match=r"bomb.png: cannot read the image \(4000 x 3000 pixels, more than the "
                                       r"1,000,000 LensLab reads\)"):
         image_files.read_pixels(bomb)
+
+
+def _png_claiming(width: int, height: int) -> bytes:
+    """A one-pixel grey PNG whose header claims another size (zero, or a decompression bomb's)."""
+    import struct
+    import zlib
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+    header = struct.pack(">IIBBBBB", width, height, 8, 0, 0, 0, 0)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(b"\x00\x80"))
+            + chunk(b"IEND", b""))
+
+
+def test_what_an_image_library_prints_from_c_stays_off_stderr(tmp_path):
+    """libpng prints "libpng error: Invalid IHDR data" itself; OpenImageIO says the same in its error text."""
+    import subprocess
+    import sys
+
+    image = tmp_path / "zero.png"
+    image.write_bytes(_png_claiming(0, 0))
+    done = subprocess.run([sys.executable, "-m", "lenslab", "cornell_box", "--headless", "-o", tmp_path / "out.png",
+                           "--aperture-image", image, "--spp", "1", "--width", "8", "--height", "8"],
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 1 and done.stderr.count("\n") == 1, done.stderr
+    assert done.stderr.startswith("lenslab: error: ") and f"{image}: cannot read the image" in done.stderr
+
+
+def test_a_batch_s_names_reach_the_terminal_escaped(tmp_path, capsys):
+    (tmp_path / "b.toml").write_text('[[shots]]\nname = "\\u001b[2Jwiped"\nscene = "cornell_box"\n'
+                                     'output = "\\u001b[31m{index}.png"\n')
+    assert main(["batch", str(tmp_path / "b.toml"), "--dry-run"]) == 0
+    out = capsys.readouterr().out
+    assert "\x1b" not in out and "\\x1b[2Jwiped: " in out and "\\x1b[31m1.png" in out

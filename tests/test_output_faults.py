@@ -484,3 +484,23 @@ def test_a_render_logged_to_a_file_prints_progress_lines(renderer, tmp_path, cap
                         r"ready to sample after [0-9.]+ s", lines.pop(0)), err  # the load, as long as a slice
     assert lines[:-1] and all(re.fullmatch(r"lenslab: rendering: [0-3] of 3 spp after \d+ s \([0-9.]+ M samples/s\)",
                                            line) for line in lines[:-1]), err
+
+
+@pytest.mark.gl
+def test_a_time_limit_up_before_the_first_pass_says_so_at_once(renderer, tmp_path, capsys, monkeypatch):
+    import lenslab.cli
+
+    import lenslab.render.job
+
+    # Many dispatches to one pass, and a report after each: the pass outlasts the first report, as a large
+    # image's does at the default slices.
+    monkeypatch.setattr(lenslab.cli, "HEADLESS_DISPATCH_SECONDS", 1e-4)
+    monkeypatch.setattr(lenslab.render.job, "REPORT_SECONDS", 1e-4)
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.png", "--width", "256", "--height",
+                          "256", "--time-limit", "0.001")
+    lines = err.splitlines()
+    notice = [i for i, line in enumerate(lines) if "is up before every pixel has a sample" in line]
+    assert status == 0 and len(notice) == 1, err
+    assert lines[notice[0]] == ("lenslab: warning: the time limit (0.001 s) is up before every pixel has a sample: "
+                                "finishing the first pass (65,536 samples) before stopping")
+    assert "the first pass was finished" in lines[notice[0] + 1] and lines[-1].startswith("wrote ")

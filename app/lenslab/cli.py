@@ -362,10 +362,12 @@ def render_headless(args) -> int:
     for warning in session.warnings:
         _warn(warning)
     log_progress = _progress_lines(PROGRESS_LINE_SECONDS) if console is None else None
+    first_pass_late = _first_pass_notice(session.width * session.height)
     with _progress_display() as bar:
         task = bar.add_task("render", total=job.target_spp or job.time_limit, status="")
 
         def show(progress) -> None:
+            first_pass_late(progress)
             done = progress.samples_per_pixel if job.target_spp else min(progress.elapsed_seconds, job.time_limit)
             bar.update(task, completed=done, status=f"{progress.samples_per_pixel} spp, "
                                                     f"{progress.samples_per_second / 1e6:.2f} M samples/s")
@@ -379,11 +381,31 @@ def render_headless(args) -> int:
     # Once the image is whole and about to take its name, a stop signal could only misreport it.
     job.write(output, exposure_stops=args.exposure, tone_map=args.tone_map or "clamp",
               before_rename=_ignore_stop_signals)
-    print(f"wrote {output} ({session.width}x{session.height}, {job.samples_per_pixel} spp, "
-          f"{job.elapsed_seconds:.1f} s)", file=sys.stderr)
+    print(one_line(f"wrote {output} ({session.width}x{session.height}, {job.samples_per_pixel} spp, "
+                   f"{job.elapsed_seconds:.1f} s)"), file=sys.stderr)
     job.release()
     renderer.release()
     return EXIT_OK
+
+
+def _first_pass_notice(pixels: int):
+    """A function of each JobProgress that warns, once, when the time limit is up before every pixel has a
+    sample: the job finishes that first pass (render/job.py), and the user hears at once why it goes on rather
+    than a wait that looks like a hang (the speed of the first slices is no guide to how long it will be)."""
+    warned = False
+
+    def notice(progress) -> None:
+        nonlocal warned
+        if warned or not progress.time_limit or progress.elapsed_seconds < progress.time_limit:
+            return
+        if progress.samples_per_pixel >= 1:
+            warned = True
+            return
+        warned = True
+        _warn(f"the time limit ({progress.time_limit:g} s) is up before every pixel has a sample: finishing the "
+              f"first pass ({pixels:,} samples) before stopping")
+
+    return notice
 
 
 def _print_presets(kind: str) -> int:

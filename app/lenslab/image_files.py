@@ -9,7 +9,11 @@ fetched, OpenImageIO prints from C++ when the buffer is destroyed.
 
 from __future__ import annotations
 
+import contextlib
 import os
+import sys
+import tempfile
+import threading
 
 import numpy as np
 
@@ -23,18 +27,39 @@ def read_pixels(path: str | os.PathLike) -> tuple[np.ndarray, bool]:
     whether the file holds floating-point values). Raises OSError naming the file and why it cannot be read."""
     import OpenImageIO as oiio  # imported here: scenes without images never pay for it
 
-    image = oiio.ImageBuf(str(path))
-    if image.has_error or image.spec().width == 0:
-        raise OSError(f"{path}: cannot read the image ({_first_line(image.geterror()) or 'unknown format'})")
-    spec = image.spec()
-    too_large = image_too_large(spec.width, spec.height, spec.nchannels)
-    if too_large:
-        raise OSError(f"{path}: cannot read the image ({too_large})")
-    pixels = image.get_pixels(oiio.FLOAT)
-    if image.has_error or pixels is None:
-        raise OSError(f"{path}: cannot read the image ({_first_line(image.geterror()) or 'no pixels'})")
+    with _decoders_quiet():
+        image = oiio.ImageBuf(str(path))
+        if image.has_error or image.spec().width == 0:
+            raise OSError(f"{path}: cannot read the image ({_first_line(image.geterror()) or 'unknown format'})")
+        spec = image.spec()
+        too_large = image_too_large(spec.width, spec.height, spec.nchannels)
+        if too_large:
+            raise OSError(f"{path}: cannot read the image ({too_large})")
+        pixels = image.get_pixels(oiio.FLOAT)
+        if image.has_error or pixels is None:
+            raise OSError(f"{path}: cannot read the image ({_first_line(image.geterror()) or 'no pixels'})")
     pixels = np.asarray(pixels, dtype=np.float32)
     return (pixels[..., None] if pixels.ndim == 2 else pixels), str(spec.format) in FLOAT_FORMATS
+
+
+_quiet_lock = threading.Lock()
+
+
+@contextlib.contextmanager
+def _decoders_quiet():
+    """Keep what the format libraries print from C onto the process's stderr ("libpng error: Invalid IHDR
+    data") off it: OpenImageIO reports the same problem in its error text, which the caller puts into one line.
+    File descriptor 2 is the process's, so threads take turns; a terminal's spinner misses a frame at most."""
+    with _quiet_lock, tempfile.TemporaryFile() as swallowed:
+        if sys.stderr is not None:
+            sys.stderr.flush()
+        saved = os.dup(2)
+        os.dup2(swallowed.fileno(), 2)
+        try:
+            yield
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
 
 
 def _first_line(text: str) -> str:

@@ -99,7 +99,7 @@ def run(argv: list[str]) -> int:
                 print(f"lenslab batch: error: contact sheet {sheet}: {one_line(' '.join(str(exc).split()))}",
                       file=sys.stderr)
                 return EXIT_ERROR
-            print(f"wrote contact sheet {written} ({len(frames)} shots)", file=sys.stderr)
+            print(one_line(f"wrote contact sheet {written} ({len(frames)} shots)"), file=sys.stderr)
     if summary.failed:
         print(f"lenslab batch: {len(summary.failed)} of {len(batch.shots)} shots failed:", file=sys.stderr)
         for shot, message in summary.failed:
@@ -112,7 +112,7 @@ def _print_plan(batch: Batch, force: bool) -> None:
     for shot in batch.shots:
         state = "exists, skipped" if shot.output.exists() and not force else "to render"
         parts = f", in {shot.split} parts" if shot.split > 1 else ""
-        print(f"{shot.name}: {shot.output} ({state}{parts})")
+        print(one_line(f"{shot.name}: {shot.output} ({state}{parts})"))
 
 
 def _cluster_client(args):
@@ -173,7 +173,7 @@ class _Display:
         return self.bars.__exit__(*exc)
 
     def _line(self, text: str) -> None:
-        self.console.print(text, highlight=False, markup=False, soft_wrap=True)
+        self.console.print(one_line(text), highlight=False, markup=False, soft_wrap=True)  # names come from files
 
     def _finish(self, shot, text: str) -> None:
         self._finished += 1
@@ -202,7 +202,9 @@ class _Display:
         elif isinstance(event, ShotProgress):
             key = str(shot.output)
             if key not in self._shots:
-                self._shots[key] = self.bars.add_task(shot.name, total=1.0, status="")
+                from rich.markup import escape  # a shot's name is text, not rich's markup
+
+                self._shots[key] = self.bars.add_task(escape(one_line(shot.name)), total=1.0, status="")
             workers = f" on {len(event.workers)} workers" if len(event.workers) > 1 else ""
             self.bars.update(self._shots[key], completed=event.fraction,
                              status=f"{event.samples_per_pixel} spp, "

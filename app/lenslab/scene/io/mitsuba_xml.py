@@ -141,6 +141,10 @@ def _parse_xml(data: bytes, display: str, folder: Path) -> XNode:
         parser.Parse(data, True)
     except LookupError as exc:  # the XML declaration names an encoding Python does not know
         raise SceneError(f"{display}: line 1: {exc}") from None
+    except ValueError as exc:  # one expat does not read ("multi-byte encodings are not supported": UTF-32)
+        if isinstance(exc, SceneError):
+            raise
+        raise SceneError(f"{display}: line 1: cannot read the file's encoding ({exc})") from None
     except expat.ExpatError as exc:
         raise SceneError(
             f"{display}: line {exc.lineno} column {exc.offset + 1}: not well-formed XML ({expat.ErrorString(exc.code)})"
