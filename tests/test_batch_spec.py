@@ -278,3 +278,10 @@ def test_a_shot_focused_nearer_than_its_lens_fails_when_its_scene_is_opened(tmp_
 def test_a_number_no_camera_has_is_one_error_line(tmp_path, value, expected):
     with pytest.raises(BatchError, match=expected):
         batch(tmp_path, f'[[shots]]\nscene = "cornell_box"\noutput = "a.png"\nf_number = {value}\n')
+
+
+def test_an_output_field_wider_than_a_file_name_is_refused(tmp_path):
+    with pytest.raises(BatchError, match=r"output: '\{index:>2000000000\}.png' is not a valid name pattern \(a field "
+                                         r"2000000000 characters wide"):
+        batch(tmp_path, '[[shots]]\nscene = "cornell_box"\noutput = "{index:>2000000000}.png"\n')
+    assert batch(tmp_path, '[[shots]]\nscene = "cornell_box"\noutput = "{index:03d}.png"\n').shots[0].output.name == "001.png"

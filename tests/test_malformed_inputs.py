@@ -135,6 +135,12 @@ def test_a_json_file_python_cannot_parse_is_named(tmp_path, text, expected):
      "elements nested more than 100 deep"),
     ('<scene version="3.0.0"><sensor type="perspective"><float name="fov" value="inf"/></sensor></scene>',
      'could not parse "inf" as a finite floating point value'),
+    ('<scene version="3.0.0"><shape type="shapegroup" id="g"><shape type="instance"><ref id="g"/></shape></shape>'
+     '<shape type="instance"><ref id="g"/></shape></scene>', '<shape type="shapegroup" id="g"> instances itself'),
+    ('<scene version="3.0.0"><shape type="shapegroup" id="g0"><shape type="sphere"/></shape>'
+     + "".join(f'<shape type="shapegroup" id="g{i}">' + f'<shape type="instance"><ref id="g{i - 1}"/></shape>' * 30
+               + "</shape>" for i in range(1, 5)) + '<shape type="instance"><ref id="g4"/></shape></scene>',
+     "instances of shapegroups make more than 250,000 nodes"),
 ])
 def test_a_broken_mitsuba_file_is_named_with_its_line(tmp_path, xml, expected):
     scene = tmp_path / "scene.xml"

@@ -335,11 +335,18 @@ def _shot(number: int, index: int, values: dict, swept: list[str], folder: Path,
                 exposure=exposure, tone_map=tone_map, split=split, where=where, number=number)
 
 
+#: File systems take names of at most 255 bytes.
+MAX_FIELD_WIDTH = 255
+
+
 class _OutputFormatter(string.Formatter):
     """str.format for file names: 2.0 is written 2 and 1.4 stays 1.4 unless a format is given; text such as a
     lens's name "85 mm f/1.4" becomes 85_mm_f_1.4, safe in a file name."""
 
     def format_field(self, value, format_spec):
+        widest = max((int(digits) for digits in re.findall(r"\d+", format_spec)), default=0)  # width, precision
+        if widest > MAX_FIELD_WIDTH:  # {index:>2000000000} would fill memory, not make a name
+            raise ValueError(f"a field {widest} characters wide: a file name holds at most {MAX_FIELD_WIDTH}")
         if isinstance(value, _ShutterTime) and not format_spec:  # 1/125 s is 1_125, 0.5 s is 0.5
             from lenslab.optics.exposure import format_shutter
 
