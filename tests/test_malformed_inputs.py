@@ -260,3 +260,22 @@ def test_a_batch_s_names_reach_the_terminal_escaped(tmp_path, capsys):
     assert main(["batch", str(tmp_path / "b.toml"), "--dry-run"]) == 0
     out = capsys.readouterr().out
     assert "\x1b" not in out and "\\x1b[2Jwiped: " in out and "\\x1b[31m1.png" in out
+
+
+def test_a_texture_reduced_in_size_has_no_negative_texels(tmp_path):
+    """OpenImageIO's resize filter rings below zero beside a sharp edge: an environment map of 4097 x 1 once lit
+    a pixel with negative radiance."""
+    import OpenImageIO as oiio
+
+    from lenslab.render.textures import MAX_SIDE, read_texture_image
+
+    stripes = np.zeros((1, MAX_SIDE + 1, 3), np.float32)
+    stripes[:, ::2] = 1.0
+    stripes[:, 2000:2100] = 100.0
+    path = tmp_path / "stripes.exr"
+    out = oiio.ImageOutput.create(str(path))
+    out.open(str(path), oiio.ImageSpec(MAX_SIDE + 1, 1, 3, oiio.FLOAT))
+    out.write_image(stripes)
+    out.close()
+    texels = read_texture_image(path, "linear")
+    assert texels.shape == (1, MAX_SIDE, 3) and texels.min() >= 0.0

@@ -46,13 +46,15 @@ def read_texture_image(path: Path, color_space: str = "auto") -> np.ndarray:
 
 
 def _reduced(pixels: np.ndarray, scale: float) -> np.ndarray:
-    """``pixels`` resampled to ``scale`` of their size, with OpenImageIO's filtered resize."""
+    """``pixels`` resampled to ``scale`` of their size, with OpenImageIO's filtered resize; its filter's
+    negative lobes can ring below zero beside a sharp edge, and no colour or radiance is negative."""
     import OpenImageIO as oiio
 
     height, width, channels = pixels.shape
     roi = oiio.ROI(0, max(1, round(width * scale)), 0, max(1, round(height * scale)), 0, 1, 0, channels)
     reduced = oiio.ImageBufAlgo.resize(oiio.ImageBuf(np.ascontiguousarray(pixels)), roi=roi)
-    return np.asarray(reduced.get_pixels(oiio.FLOAT), dtype=np.float32).reshape(roi.height, roi.width, channels)
+    reduced = np.asarray(reduced.get_pixels(oiio.FLOAT), dtype=np.float32).reshape(roi.height, roi.width, channels)
+    return np.maximum(reduced, 0.0)
 
 
 @dataclass
