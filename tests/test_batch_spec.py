@@ -4,6 +4,7 @@ naming the file, the shot and the key, before anything renders."""
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -285,3 +286,15 @@ def test_an_output_field_wider_than_a_file_name_is_refused(tmp_path):
                                          r"2000000000 characters wide"):
         batch(tmp_path, '[[shots]]\nscene = "cornell_box"\noutput = "{index:>2000000000}.png"\n')
     assert batch(tmp_path, '[[shots]]\nscene = "cornell_box"\noutput = "{index:03d}.png"\n').shots[0].output.name == "001.png"
+
+
+@pytest.mark.parametrize("shot, expected", [
+    ('f_number = { from = 1.4, to = 16, steps = 1000 }\nfocus_distance = { from = 1, to = 9, steps = 1000 }\n',
+     "1000 f_number x 1000 focus_distance make 1,000,000 shots; a batch holds at most 10,000"),
+    ('output = "{index[0]}.png"\n', "is not a valid name pattern"),
+    ('output = "out\\u0000{index}.png"\n', "a file name holds no control characters"),
+])
+def test_a_batch_that_cannot_be_is_refused_before_anything_runs(tmp_path, shot, expected):
+    text = '[[shots]]\nscene = "cornell_box"\n' + shot + ('' if "output" in shot else 'output = "{index}.png"\n')
+    with pytest.raises(BatchError, match=re.escape(expected)):
+        batch(tmp_path, text)

@@ -255,11 +255,14 @@ def test_what_an_image_library_prints_from_c_stays_off_stderr(tmp_path):
 
 
 def test_a_batch_s_names_reach_the_terminal_escaped(tmp_path, capsys):
-    (tmp_path / "b.toml").write_text('[[shots]]\nname = "\\u001b[2Jwiped"\nscene = "cornell_box"\n'
-                                     'output = "\\u001b[31m{index}.png"\n')
-    assert main(["batch", str(tmp_path / "b.toml"), "--dry-run"]) == 0
+    (tmp_path / "b.json").write_text('{"shots": [{"name": "\\u001b[2Jwiped \\ud800", "scene": "cornell_box", '
+                                     '"output": "{index}.png"}]}')  # a lone surrogate: JSON allows it
+    assert main(["batch", str(tmp_path / "b.json"), "--dry-run"]) == 0
     out = capsys.readouterr().out
-    assert "\x1b" not in out and "\\x1b[2Jwiped: " in out and "\\x1b[31m1.png" in out
+    assert "\x1b" not in out and "\\x1b[2Jwiped \\ud800: " in out
+    (tmp_path / "b.toml").write_text('[[shots]]\nscene = "cornell_box"\noutput = "\\u001b[31m{index}.png"\n')
+    assert main(["batch", str(tmp_path / "b.toml"), "--dry-run"]) == 1
+    assert "output: a file name holds no control characters ('\\x1b[31m{index}.png')" in capsys.readouterr().err
 
 
 def test_a_texture_reduced_in_size_has_no_negative_texels(tmp_path):
@@ -279,3 +282,20 @@ def test_a_texture_reduced_in_size_has_no_negative_texels(tmp_path):
     out.close()
     texels = read_texture_image(path, "linear")
     assert texels.shape == (1, MAX_SIDE, 3) and texels.min() >= 0.0
+
+
+def test_a_texel_brighter_than_any_light_is_clamped_with_a_warning(tmp_path, caplog):
+    import OpenImageIO as oiio
+
+    from lenslab.render.textures import BRIGHTEST, read_texture_image
+
+    pixels = np.ones((4, 8, 3), np.float32)
+    pixels[1, 2] = 3e38  # finite in float32, but the map's power and sampling table overflow with it
+    path = tmp_path / "sky.exr"
+    out = oiio.ImageOutput.create(str(path))
+    out.open(str(path), oiio.ImageSpec(8, 4, 3, oiio.FLOAT))
+    out.write_image(pixels)
+    out.close()
+    texels = read_texture_image(path, "linear")
+    assert texels.max() == np.float32(BRIGHTEST) and texels[0, 0, 0] == 1.0
+    assert "sky.exr: 1 texel is brighter than 1e+10, beyond any light: clamped" in caplog.text

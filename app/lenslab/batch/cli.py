@@ -125,7 +125,7 @@ def _cluster_client(args):
         # DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT=5s).
         try:
             return None, Client(args.scheduler)
-        except OSError as exc:  # includes TimeoutError
+        except (OSError, ValueError) as exc:  # includes TimeoutError; ValueError: an address with no port
             raise OSError(f"cannot reach a Dask scheduler at {args.scheduler} ({exc}): is `dask scheduler` "
                           "running there, and is the address its own?") from None
     workers = args.workers or max(1, len(args.devices))

@@ -259,6 +259,10 @@ def _range(key: str, table: dict, where: str) -> list:
     return [round(v) for v in values] if _KINDS[key] is int else [round(v, 6) for v in values]
 
 
+#: More shots than a render farm gets through in a week of short renders: a sweep of sweeps gone wrong.
+MAX_SHOTS = 10_000
+
+
 def _expand(number: int, settings: dict, folder: Path, where: str) -> list[Shot]:
     """One Shot per combination of the swept keys' values, in the order the file gives them."""
     for required in ("scene", "output"):
@@ -266,6 +270,10 @@ def _expand(number: int, settings: dict, folder: Path, where: str) -> list[Shot]
             raise BatchError(f"{where}: no '{required}' (give it in the shot or in [defaults])")
     choices = {key: _values(key, raw, where) for key, raw in settings.items()}
     swept = [key for key, values in choices.items() if len(values) > 1]
+    count = math.prod(len(values) for values in choices.values())
+    if count > MAX_SHOTS:  # sweeps multiply: say so before making a million of them
+        sizes = " x ".join(f"{len(choices[key])} {key}" for key in swept)
+        raise BatchError(f"{where}: {sizes} make {count:,} shots; a batch holds at most {MAX_SHOTS:,}")
     shots = []
     for index, combination in enumerate(itertools.product(*choices.values()), start=1):
         values = dict(zip(choices, combination))
@@ -368,6 +376,8 @@ def _output_name(values: dict, index: int, where: str) -> str:
     fields["index"] = index
     if "shutter" in fields:
         fields["shutter"] = _ShutterTime(fields["shutter"])
+    if any(ord(char) < 32 or ord(char) == 127 for char in template):
+        raise BatchError(f"{where}: output: a file name holds no control characters ({template!r})")
     try:
         return _OutputFormatter().format(template, **fields)
     except KeyError as exc:
@@ -375,7 +385,7 @@ def _output_name(values: dict, index: int, where: str) -> str:
         problem = (f"this shot sets no {name}" if name in _KINDS else
                    f"unknown field {{{name}}}{_did_you_mean(str(name), [*_KINDS, 'index'])}")
         raise BatchError(f"{where}: output: '{template}' names {{{name}}}, but {problem}") from None
-    except (ValueError, IndexError) as exc:
+    except (ValueError, IndexError, TypeError, AttributeError) as exc:  # {index[0]}, {f_number.real.x}
         raise BatchError(f"{where}: output: '{template}' is not a valid name pattern ({exc})") from None
 
 

@@ -23,6 +23,8 @@ from lenslab.scene.textures import Checkerboard, ImageTexture, InlineImageTextur
 log = logging.getLogger("lenslab.textures")
 
 HALF_MAX = 65504.0
+#: The sun's disk in an HDR panorama reaches 1e5 to 1e9; a texel beyond this is a broken file, not a light.
+BRIGHTEST = 1e10
 MAX_SIDE = 4096  # larger images are downsampled: one storage buffer holds all texels
 MISSING = Checkerboard(color_a=(1.0, 0.0, 1.0), color_b=(0.0, 0.0, 0.0), tiles=(16.0, 16.0))
 
@@ -42,6 +44,11 @@ def read_texture_image(path: Path, color_space: str = "auto") -> np.ndarray:
         bad = int((~np.isfinite(rgb)).any(axis=2).sum())
         log.warning("%s: %d texel%s NaN or infinite: read as black", path, bad, " is" if bad == 1 else "s are")
         rgb = np.where(np.isfinite(rgb), rgb, 0.0)
+    if rgb.max(initial=0.0) > BRIGHTEST:  # sums over the map (its power, its sampling table) would overflow
+        bad = int((rgb > BRIGHTEST).any(axis=2).sum())
+        log.warning("%s: %d texel%s brighter than %g, beyond any light: clamped", path, bad,
+                    " is" if bad == 1 else "s are", BRIGHTEST)
+        rgb = np.minimum(rgb, BRIGHTEST)
     return np.ascontiguousarray(rgb, dtype=np.float32)
 
 
