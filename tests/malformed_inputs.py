@@ -532,7 +532,7 @@ def judge(outcome: Outcome, output: Path) -> Outcome:
         outcome.problem = "a traceback on stderr"
     elif any(_CONTROL.search(line) for line in lines):
         outcome.problem = "a control character on stderr"
-    elif any(len(line) > MAX_ERROR_LINE for line in lines):
+    elif any(len(line) > MAX_ERROR_LINE for line in lines):  # the whole line, prefix included
         outcome.problem = f"a line over {MAX_ERROR_LINE} characters"
     elif outcome.status == 0:
         outcome.problem = _judge_image(output, expect_size=not outcome.case.extra_args)

@@ -165,6 +165,8 @@ def test_one_line_escapes_controls_and_shortens_what_is_endless():
     assert one_line("a\nb\x1b[31m\u202e") == "a\\nb\\x1b[31m\\u202e"
     long = one_line("value '" + "x" * 100_000 + "' is wrong")
     assert len(long) <= LONGEST_LINE and long.endswith("' is wrong") and "…" in long
+    many = one_line(", ".join(f"'s{i}'" for i in range(5000)), prefix="lenslab: error: ")  # short words, many
+    assert len(many) == LONGEST_LINE and many.startswith("lenslab: error: 's0', ") and many.endswith("'s4999'")
     path = "/home/me/" + "/".join(["folder"] * 20) + "/scene.json"
     assert one_line(f"{path}: bad") == f"{path}: bad", "a real path stays whole"
 

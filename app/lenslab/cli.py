@@ -255,11 +255,11 @@ def parse_defines(items: list[str]) -> dict[str, str]:
 
 
 def _warn(message: str) -> None:
-    print(f"lenslab: warning: {one_line(message)}", file=sys.stderr)
+    print(one_line(message, prefix="lenslab: warning: "), file=sys.stderr)
 
 
 def _error(message: object) -> None:
-    print(f"lenslab: error: {one_line(message)}", file=sys.stderr)
+    print(one_line(message, prefix="lenslab: error: "), file=sys.stderr)
 
 
 def scene_overrides(args):

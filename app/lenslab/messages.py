@@ -34,14 +34,14 @@ def shorten(text: str, limit: int) -> str:
     return text[:head] + "…" + text[-tail:]
 
 
-def one_line(text: object) -> str:
-    """``text`` as one printable line: control characters written as escapes (ESC as \\x1b), overlong words
-    and the line itself shortened in the middle."""
+def one_line(text: object, prefix: str = "") -> str:
+    """``prefix`` and ``text`` as one printable line of at most LONGEST_LINE characters: control characters
+    written as escapes (ESC as \\x1b), overlong words and the text itself shortened in the middle."""
     line = _CONTROL.sub(_escape, str(text))
     # A lone surrogate (JSON's "\ud800") cannot be written in UTF-8 at all: written as its escape.
     line = line.encode("utf-8", "backslashreplace").decode("utf-8")
     words = [shorten(word, LONGEST_WORD) for word in line.split(" ")]
-    return shorten(" ".join(words), LONGEST_LINE)
+    return prefix + shorten(" ".join(words), LONGEST_LINE - len(prefix))
 
 
 def describe_os_error(exc: OSError) -> str:

@@ -59,17 +59,17 @@ def main(argv: list[str]) -> int:
     try:
         return run(argv)
     except CliError as exc:
-        print(f"lenslab batch: error: {one_line(exc)}", file=sys.stderr)
+        print(one_line(exc, prefix="lenslab batch: error: "), file=sys.stderr)
         return exc.status
     except BatchError as exc:
-        print(f"lenslab batch: error: {one_line(exc)}", file=sys.stderr)
+        print(one_line(exc, prefix="lenslab batch: error: "), file=sys.stderr)
         return EXIT_ERROR
     except KeyboardInterrupt:
         print("lenslab batch: interrupted; every shot reported done is written, and running the batch again "
               "renders the rest", file=sys.stderr)
         return EXIT_INTERRUPTED
     except OSError as exc:  # the scheduler cannot be reached, a worker cannot start
-        print(f"lenslab batch: error: {one_line(' '.join(str(exc).split()))}", file=sys.stderr)
+        print(one_line(' '.join(str(exc).split()), prefix="lenslab batch: error: "), file=sys.stderr)
         return EXIT_ERROR
 
 
@@ -96,14 +96,14 @@ def run(argv: list[str]) -> int:
             try:
                 written = write_contact_sheet(sheet, frames)
             except (ExportError, OSError) as exc:  # the shots are written: say what is missing, not a traceback
-                print(f"lenslab batch: error: contact sheet {sheet}: {one_line(' '.join(str(exc).split()))}",
-                      file=sys.stderr)
+                print(one_line(f"contact sheet {sheet}: {' '.join(str(exc).split())}",
+                               prefix="lenslab batch: error: "), file=sys.stderr)
                 return EXIT_ERROR
             print(one_line(f"wrote contact sheet {written} ({len(frames)} shots)"), file=sys.stderr)
     if summary.failed:
         print(f"lenslab batch: {len(summary.failed)} of {len(batch.shots)} shots failed:", file=sys.stderr)
         for shot, message in summary.failed:
-            print(f"  {one_line(shot.name)}: {one_line(message)}", file=sys.stderr)
+            print(one_line(f"{shot.name}: {message}", prefix="  "), file=sys.stderr)
         return EXIT_ERROR
     return EXIT_OK
 

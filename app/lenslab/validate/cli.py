@@ -76,13 +76,13 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return run(list(sys.argv[1:] if argv is None else argv))
     except CliError as exc:
-        print(f"lenslab validate: error: {one_line(exc)}", file=sys.stderr)
+        print(one_line(exc, prefix="lenslab validate: error: "), file=sys.stderr)
         return exc.status
     except MitsubaUnavailable as exc:
-        print(f"lenslab validate: {one_line(exc)}", file=sys.stderr)
+        print(one_line(exc, prefix="lenslab validate: "), file=sys.stderr)
         return EXIT_ERROR
     except (SceneError, GLUnavailable, OSError, ValueError) as exc:
-        print(f"lenslab validate: error: {one_line(exc)}", file=sys.stderr)
+        print(one_line(exc, prefix="lenslab validate: error: "), file=sys.stderr)
         return EXIT_ERROR
     except KeyboardInterrupt:
         print("lenslab validate: interrupted", file=sys.stderr)
