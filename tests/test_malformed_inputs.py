@@ -286,18 +286,20 @@ def test_a_texture_reduced_in_size_has_no_negative_texels(tmp_path):
     assert texels.shape == (1, MAX_SIDE, 3) and texels.min() >= 0.0
 
 
-def test_a_texel_brighter_than_any_light_is_clamped_with_a_warning(tmp_path, caplog):
+def test_a_texel_brighter_than_any_light_or_negative_is_clamped_with_a_warning(tmp_path, caplog):
     import OpenImageIO as oiio
 
     from lenslab.render.textures import BRIGHTEST, read_texture_image
 
     pixels = np.ones((4, 8, 3), np.float32)
     pixels[1, 2] = 3e38  # finite in float32, but the map's power and sampling table overflow with it
+    pixels[3, 7] = -5.0  # and no light is negative
     path = tmp_path / "sky.exr"
     out = oiio.ImageOutput.create(str(path))
     out.open(str(path), oiio.ImageSpec(8, 4, 3, oiio.FLOAT))
     out.write_image(pixels)
     out.close()
     texels = read_texture_image(path, "linear")
-    assert texels.max() == np.float32(BRIGHTEST) and texels[0, 0, 0] == 1.0
+    assert texels.max() == np.float32(BRIGHTEST) and texels.min() == 0.0 and texels[0, 0, 0] == 1.0
     assert "sky.exr: 1 texel is brighter than 1e+10, beyond any light: clamped" in caplog.text
+    assert "sky.exr: 1 texel is negative: read as 0" in caplog.text

@@ -44,6 +44,10 @@ def read_texture_image(path: Path, color_space: str = "auto") -> np.ndarray:
         bad = int((~np.isfinite(rgb)).any(axis=2).sum())
         log.warning("%s: %d texel%s NaN or infinite: read as black", path, bad, " is" if bad == 1 else "s are")
         rgb = np.where(np.isfinite(rgb), rgb, 0.0)
+    if rgb.min(initial=0.0) < 0.0:  # no colour or radiance is negative; one would subtract light from the image
+        bad = int((rgb < 0.0).any(axis=2).sum())
+        log.warning("%s: %d texel%s negative: read as 0", path, bad, " is" if bad == 1 else "s are")
+        rgb = np.maximum(rgb, 0.0)
     if rgb.max(initial=0.0) > BRIGHTEST:  # sums over the map (its power, its sampling table) would overflow
         bad = int((rgb > BRIGHTEST).any(axis=2).sum())
         log.warning("%s: %d texel%s brighter than %g, beyond any light: clamped", path, bad,
