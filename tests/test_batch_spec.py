@@ -293,8 +293,14 @@ def test_an_output_field_wider_than_a_file_name_is_refused(tmp_path):
      "1000 f_number x 1000 focus_distance make 1,000,000 shots; a batch holds at most 10,000"),
     ('output = "{index[0]}.png"\n', "is not a valid name pattern"),
     ('output = "out\\u0000{index}.png"\n', "a file name holds no control characters"),
+    ('output = "{index.__class__}.png"\n', "{index.__class__} is not a field's name"),
 ])
 def test_a_batch_that_cannot_be_is_refused_before_anything_runs(tmp_path, shot, expected):
     text = '[[shots]]\nscene = "cornell_box"\n' + shot + ('' if "output" in shot else 'output = "{index}.png"\n')
     with pytest.raises(BatchError, match=re.escape(expected)):
         batch(tmp_path, text)
+
+
+def test_an_output_name_no_file_system_can_hold_is_refused(tmp_path):
+    with pytest.raises(BatchError, match=r"output: '\\ud800.png' is not text a file name can hold"):
+        batch(tmp_path, '{"shots": [{"scene": "cornell_box", "output": "\\ud800.png"}]}', name="shots.json")

@@ -303,3 +303,36 @@ def test_a_texel_brighter_than_any_light_or_negative_is_clamped_with_a_warning(t
     assert texels.max() == np.float32(BRIGHTEST) and texels.min() == 0.0 and texels[0, 0, 0] == 1.0
     assert "sky.exr: 1 texel is brighter than 1e+10, beyond any light: clamped" in caplog.text
     assert "sky.exr: 1 texel is negative: read as 0" in caplog.text
+
+
+def test_includes_of_includes_are_counted(tmp_path, monkeypatch):
+    """No cycle, only fan-out: ten includes of ten includes, twelve deep, would be 10^12 files to read."""
+    from lenslab.scene.io import mitsuba_xml
+
+    monkeypatch.setattr(mitsuba_xml, "MAX_INCLUDES", 500)  # the same refusal, sooner
+    (tmp_path / "l0.xml").write_text('<scene version="3.0.0"><shape type="sphere"/></scene>')
+    for level in range(1, 13):
+        (tmp_path / f"l{level}.xml").write_text('<scene version="3.0.0">'
+                                                + f'<include filename="l{level - 1}.xml"/>' * 10 + "</scene>")
+    line = _one_error(*_render(tmp_path / "l12.xml", tmp_path))
+    assert "<include>: more than 500 includes in all (includes of includes multiply)" in line
+
+
+def test_a_scheduler_that_never_answers_is_given_up_on(tmp_path, capsys):
+    """A server that accepts the connection and says nothing: Dask's handshake has no deadline of its own."""
+    import socket
+    import threading
+
+    import dask
+
+    server = socket.create_server(("127.0.0.1", 0))
+    held = []
+    threading.Thread(target=lambda: held.append(server.accept()), daemon=True).start()
+    (tmp_path / "z.toml").write_text('[[shots]]\nscene = "cornell_box"\noutput = "z.png"\n')
+    address = f"tcp://127.0.0.1:{server.getsockname()[1]}"
+    with dask.config.set({"distributed.comm.timeouts.connect": "1s"}):
+        status = main(["batch", str(tmp_path / "z.toml"), "--scheduler", address])
+    server.close()
+    err = capsys.readouterr().err
+    assert status == 1 and err.count("\n") == 1, err
+    assert f"cannot reach a Dask scheduler at {address} (no answer as a Dask scheduler within 1 s)" in err

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import threading
 import time
 
 from lenslab.batch.spec import Batch, BatchError, read_batch
@@ -124,13 +125,40 @@ def _cluster_client(args):
         # How long to try is Dask's own setting (distributed.comm.timeouts.connect, e.g. the environment's
         # DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT=5s).
         try:
-            return None, Client(args.scheduler)
-        except (OSError, ValueError) as exc:  # includes TimeoutError; ValueError: an address with no port
+            return None, _connect(Client, args.scheduler)
+        except (OSError, ValueError, MemoryError) as exc:  # OSError includes TimeoutError; ValueError: no port;
+            # MemoryError: a server that is not Dask's answered, and its first bytes were read as a frame's length
             raise OSError(f"cannot reach a Dask scheduler at {args.scheduler} ({exc}): is `dask scheduler` "
                           "running there, and is the address its own?") from None
     workers = args.workers or max(1, len(args.devices))
     cluster = local_cluster(workers)
     return cluster, Client(cluster)
+
+
+def _connect(client_class, address: str):
+    """A Dask client of the scheduler at ``address``, or TimeoutError when none has answered within Dask's own
+    connect time-out (distributed.comm.timeouts.connect): a server that accepts the connection and then says
+    nothing (not a scheduler) would otherwise hold the batch for ever, since the handshake has no deadline."""
+    import dask
+    from dask.utils import parse_timedelta
+
+    seconds = parse_timedelta(dask.config.get("distributed.comm.timeouts.connect"), default="s")
+    outcome: dict = {}
+
+    def connect() -> None:
+        try:
+            outcome["client"] = client_class(address, timeout=seconds)
+        except BaseException as exc:  # handed to the waiting thread, which raises it
+            outcome["error"] = exc
+
+    attempt = threading.Thread(target=connect, name="lenslab-connect", daemon=True)
+    attempt.start()
+    attempt.join(seconds + 5)
+    if attempt.is_alive():
+        raise TimeoutError(f"no answer as a Dask scheduler within {seconds:g} s")
+    if "error" in outcome:
+        raise outcome["error"]
+    return outcome["client"]
 
 
 def _render(batch: Batch, args):

@@ -351,6 +351,11 @@ class _OutputFormatter(string.Formatter):
     """str.format for file names: 2.0 is written 2 and 1.4 stays 1.4 unless a format is given; text such as a
     lens's name "85 mm f/1.4" becomes 85_mm_f_1.4, safe in a file name."""
 
+    def get_field(self, field_name, args, kwargs):
+        if not field_name.isidentifier():  # {index[0]}, {index.__class__}: a name is made of values, not their parts
+            raise ValueError(f"{{{field_name}}} is not a field's name")
+        return super().get_field(field_name, args, kwargs)
+
     def format_field(self, value, format_spec):
         widest = max((int(digits) for digits in re.findall(r"\d+", format_spec)), default=0)  # width, precision
         if widest > MAX_FIELD_WIDTH:  # {index:>2000000000} would fill memory, not make a name
@@ -378,6 +383,10 @@ def _output_name(values: dict, index: int, where: str) -> str:
         fields["shutter"] = _ShutterTime(fields["shutter"])
     if any(ord(char) < 32 or ord(char) == 127 for char in template):
         raise BatchError(f"{where}: output: a file name holds no control characters ({template!r})")
+    try:
+        template.encode("utf-8")
+    except UnicodeEncodeError:  # a lone surrogate ("\ud800" in JSON): no file system can hold it
+        raise BatchError(f"{where}: output: {template!r} is not text a file name can hold") from None
     try:
         return _OutputFormatter().format(template, **fields)
     except KeyError as exc:

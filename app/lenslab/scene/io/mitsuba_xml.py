@@ -62,6 +62,8 @@ RGB = tuple[float, float, float]
 
 SENSOR_WIDTH_MM = 36.0  # imported cameras get a full-frame-wide sensor; the focal length carries the fov
 MAX_INCLUDE_DEPTH = 15
+#: A scene assembled from many files includes hundreds; includes of includes multiply past any real scene.
+MAX_INCLUDES = 10_000
 #: Deeper than any real scene (a shape in a shape group in an instance in the scene is four); the passes below
 #: recurse once per level, so an absurd depth is refused while parsing rather than exhausting Python's stack.
 MAX_ELEMENT_DEPTH = 100
@@ -192,6 +194,7 @@ class _Expander:
         self.used: set[str] = set()
         self.ids: dict[str, XNode] = {}
         self.files: list[Path] = []
+        self.includes = 0  # <include>s read so far, at every depth
 
     def substitute(self, node: XNode) -> None:
         keys = sorted(self.params, key=len, reverse=True)
@@ -261,6 +264,9 @@ class _Expander:
             raise node.error(f"included file not found: {path}")
         if depth + 1 >= MAX_INCLUDE_DEPTH:
             raise node.error(f"includes nested deeper than {MAX_INCLUDE_DEPTH} (an include cycle?)")
+        self.includes += 1
+        if self.includes > MAX_INCLUDES:  # ten includes of ten includes, twelve deep, is 10^12 files to read
+            raise node.error(f"more than {MAX_INCLUDES:,} includes in all (includes of includes multiply)")
         root = self.parse_file(path)
         expanded = self.expand(root, depth + 1)
         if root.tag == "scene":
