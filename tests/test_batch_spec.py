@@ -304,3 +304,8 @@ def test_a_batch_that_cannot_be_is_refused_before_anything_runs(tmp_path, shot, 
 def test_an_output_name_no_file_system_can_hold_is_refused(tmp_path):
     with pytest.raises(BatchError, match=r"output: '\\ud800.png' is not text a file name can hold"):
         batch(tmp_path, '{"shots": [{"scene": "cornell_box", "output": "\\ud800.png"}]}', name="shots.json")
+
+
+def test_a_scene_name_too_long_for_the_file_system_is_a_scene_not_found(tmp_path):
+    shots = batch(tmp_path, f'[[shots]]\nscene = "{"x" * 300}"\noutput = "a.png"\n')  # no Errno 36 while reading
+    assert shots.shots[0].scene == "x" * 300

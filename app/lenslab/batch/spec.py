@@ -25,6 +25,7 @@ import difflib
 import itertools
 import json
 import math
+import os
 import re
 import string
 from dataclasses import dataclass, field
@@ -337,7 +338,7 @@ def _shot(number: int, index: int, values: dict, swept: list[str], folder: Path,
     if not 1 <= split <= MAX_SPLIT:
         raise BatchError(f"{where}: split: {split} is out of range [1, {MAX_SPLIT}]")
     scene = values["scene"]
-    if (folder / scene).exists():  # a file beside the batch file; otherwise a shipped scene's name
+    if os.path.exists(folder / scene):  # a file beside the batch file; otherwise a shipped scene's name
         scene = str((folder / scene).resolve())
     return Shot(name=name, scene=scene, output=output, overrides=overrides, time_limit=time_limit,
                 exposure=exposure, tone_map=tone_map, split=split, where=where, number=number)
