@@ -272,38 +272,27 @@ _PLY_HEADER = ("ply\nformat ascii 1.0\nelement vertex {v}\nproperty float x\npro
                "element face {f}\nproperty list uchar int vertex_indices\nend_header\n")
 
 
-def _mesh_text(rng: random.Random) -> tuple[str, str, bytes]:
-    kind = rng.randrange(10)
-    if kind == 9:
-        return "an OBJ with NaN normals and texture coordinates", "m.obj", (
-            b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn nan 0 1\nvn 0 0 1\nvn 0 0 1\nvt inf 0\nvt 1 0\nvt 0 1\n"
-            b"f 1/1/1 2/2/2 3/3/3\n")
-    if kind == 0:
-        return "a PLY face past the vertex count", "m.ply", (_PLY_HEADER.format(v=3, f=1) +
-                                                           "0 0 0\n1 0 0\n0 1 0\n3 0 1 99\n").encode()
-    if kind == 1:
-        return "a PLY with a negative face index", "m.ply", (_PLY_HEADER.format(v=3, f=1) +
-                                                           "0 0 0\n1 0 0\n0 1 0\n3 0 -5 2\n").encode()
-    if kind == 2:
-        return "a PLY whose header claims more than it holds", "m.ply", (_PLY_HEADER.format(v=300, f=100) +
-                                                                       "0 0 0\n1 0 0\n").encode()
-    if kind == 3:
-        return "a PLY with NaN vertices", "m.ply", (_PLY_HEADER.format(v=3, f=1) +
-                                                  "nan 0 0\n1 inf 0\n0 1 0\n3 0 1 2\n").encode()
-    if kind == 4:
-        return "an OBJ face past the vertex count", "m.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99\n"
-    if kind == 5:
-        return "an OBJ face with index 0", "m.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n"
-    if kind == 6:
-        return "an OBJ with huge coordinates", "m.obj", b"v 3.4e38 0 0\nv -3.4e38 0 0\nv 0 1e300 0\nf 1 2 3\n"
-    if kind == 7:
-        return "an OBJ with an MTL whose Ke is NaN", "m.obj", (b"mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
-                                                             b"usemtl glow\nf 1 2 3\n")
-    return "an empty OBJ", "m.obj", b"# nothing\n"
+_TRIANGLE_PLY = _PLY_HEADER.format(v=3, f=1) + "0 0 0\n1 0 0\n0 1 0\n"
+#: Meshes broken the ways exporters break them: (what, file name, contents).
+_BROKEN_MESHES = [
+    ("a PLY face past the vertex count", "m.ply", (_TRIANGLE_PLY + "3 0 1 99\n").encode()),
+    ("a PLY with a negative face index", "m.ply", (_TRIANGLE_PLY + "3 0 -5 2\n").encode()),
+    ("a PLY whose header claims more than it holds", "m.ply",
+     (_PLY_HEADER.format(v=300, f=100) + "0 0 0\n1 0 0\n").encode()),
+    ("a PLY with NaN vertices", "m.ply",
+     (_PLY_HEADER.format(v=3, f=1) + "nan 0 0\n1 inf 0\n0 1 0\n3 0 1 2\n").encode()),
+    ("an OBJ face past the vertex count", "m.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99\n"),
+    ("an OBJ face with index 0", "m.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n"),
+    ("an OBJ with huge coordinates", "m.obj", b"v 3.4e38 0 0\nv -3.4e38 0 0\nv 0 1e300 0\nf 1 2 3\n"),
+    ("an OBJ with an MTL whose Ke is NaN", "m.obj", b"mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl glow\nf 1 2 3\n"),
+    ("an empty OBJ", "m.obj", b"# nothing\n"),
+    ("an OBJ with NaN normals and texture coordinates", "m.obj",
+     b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn nan 0 1\nvn 0 0 1\nvn 0 0 1\nvt inf 0\nvt 1 0\nvt 0 1\nf 1/1/1 2/2/2 3/3/3\n"),
+]
 
 
 def _broken_mesh(doc, files: dict[str, bytes], rng: random.Random) -> str:
-    what, name, data = _mesh_text(rng)
+    what, name, data = rng.choice(_BROKEN_MESHES)
     files[name] = data
     files["m.mtl"] = b"newmtl glow\nKd 0.5 0.5 0.5\nKe nan inf 1\nKs 1e999 0 0\nNs -5\n"
     doc.setdefault("nodes", []).append({"name": "broken mesh", "shape": {"type": "mesh", "file": name},
@@ -472,14 +461,13 @@ def _c_level_stderr(into: io.StringIO):
     a user sees it as they see Python's own lines."""
     import tempfile
 
+    from lenslab.image_files import c_stderr_into
+
     with tempfile.TemporaryFile() as capture:
-        saved = os.dup(2)
-        os.dup2(capture.fileno(), 2)
         try:
-            yield
+            with c_stderr_into(capture):
+                yield
         finally:
-            os.dup2(saved, 2)
-            os.close(saved)
             capture.seek(0)
             into.write(capture.read().decode("utf-8", "replace"))
 

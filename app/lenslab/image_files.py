@@ -50,16 +50,22 @@ def _decoders_quiet():
     """Keep what the format libraries print from C onto the process's stderr ("libpng error: Invalid IHDR
     data") off it: OpenImageIO reports the same problem in its error text, which the caller puts into one line.
     File descriptor 2 is the process's, so threads take turns; a terminal's spinner misses a frame at most."""
-    with _quiet_lock, tempfile.TemporaryFile() as swallowed:
-        if sys.stderr is not None:
-            sys.stderr.flush()
-        saved = os.dup(2)
-        os.dup2(swallowed.fileno(), 2)
-        try:
-            yield
-        finally:
-            os.dup2(saved, 2)
-            os.close(saved)
+    with _quiet_lock, tempfile.TemporaryFile() as swallowed, c_stderr_into(swallowed):
+        yield
+
+
+@contextlib.contextmanager
+def c_stderr_into(file):
+    """File descriptor 2, where C and C++ libraries print, written into ``file`` (an open file) for the block."""
+    if sys.stderr is not None:
+        sys.stderr.flush()
+    saved = os.dup(2)
+    os.dup2(file.fileno(), 2)
+    try:
+        yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
 
 
 def _first_line(text: str) -> str:

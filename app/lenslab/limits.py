@@ -12,6 +12,11 @@ import os
 import resource
 
 
+#: The largest magnitude any number of a scene may have (a coordinate, a colour, a setting): past it a number
+#: measures nothing, and float32 on the GPU would make it infinite or swallow every smaller one.
+LARGEST_NUMBER = 1e30
+
+
 class SceneTooLarge(RuntimeError):
     """The scene or the image needs more than this machine or GL device can hold: a storage buffer beyond
     the device's limit, a kd-tree build beyond the memory available, accumulation buffers beyond either."""

@@ -31,6 +31,7 @@ import string
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from lenslab.limits import LARGEST_NUMBER
 from lenslab.render.film import EXPORT_SUFFIXES, TONE_MAPS
 from lenslab.scene.overrides import SceneOverrides
 
@@ -215,7 +216,7 @@ def _scalar(key: str, value, where: str):
         raise BatchError(f"{where}: {key}: expected {_kind_name(kind)}, not {_shown(value)}")
     if isinstance(value, float) and not math.isfinite(value):
         raise BatchError(f"{where}: {key}: {value} is not a finite number")
-    if kind in (int, float) and abs(value) > 1e30:  # exact for an integer of any length: no float to overflow
+    if kind in (int, float) and abs(value) > LARGEST_NUMBER:  # exact for an integer of any length: no overflow
         shown = f"a {len(str(abs(value)))}-digit number" if isinstance(value, int) else f"{value:g}"
         raise BatchError(f"{where}: {key}: {shown} is too large")
     if kind is float:

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lenslab.limits import LARGEST_NUMBER
 from lenslab.scene.materials import Material
 from lenslab.scene.scene import DEFAULT_MATERIAL, Node, Scene, SceneError
 from lenslab.scene.shapes import Box, Disk, MeshFile, Rectangle, Relief, Sphere, TriangleMesh
@@ -201,14 +202,10 @@ def flatten_scene(scene: Scene, mesh_loader=None) -> FlatScene:
     )
 
 
-#: Beyond this a world-space coordinate overflows float32 on the GPU, or takes every smaller one's precision.
-LARGEST_WORLD_COORDINATE = 1e30
-
-
 def _check_in_world(values: np.ndarray, node: Node) -> None:
     """Name the node whose transform carries its geometry out of what float32 can hold (or to NaN)."""
-    if not np.isfinite(values).all() or np.abs(values).max(initial=0.0) > LARGEST_WORLD_COORDINATE:
-        raise SceneError(f"node '{node.name}': its transform puts the geometry beyond the {LARGEST_WORLD_COORDINATE:g} "
+    if not np.isfinite(values).all() or np.abs(values).max(initial=0.0) > LARGEST_NUMBER:
+        raise SceneError(f"node '{node.name}': its transform puts the geometry beyond the {LARGEST_NUMBER:g} "
                          f"a scene can hold (or makes it not a number)")
 
 
@@ -218,7 +215,7 @@ def _check_finite_material(name: str, material: Material) -> None:
     for f in dataclasses.fields(material):
         value = getattr(material, f.name)
         numbers = value if isinstance(value, tuple) else (value,)
-        if any(isinstance(v, float) and not abs(v) <= LARGEST_WORLD_COORDINATE for v in numbers):
+        if any(isinstance(v, float) and not abs(v) <= LARGEST_NUMBER for v in numbers):
             raise SceneError(f"material '{name}': {f.name} {value} is not a finite number")
 
 

@@ -14,6 +14,7 @@ import numpy as np
 
 from dataclasses import dataclass, field
 
+from lenslab.limits import LARGEST_NUMBER
 from lenslab.scene.materials import Material
 from lenslab.scene.shapes import TriangleMesh
 
@@ -39,10 +40,6 @@ class LoadedMesh:
     warnings: tuple[str, ...] = field(default=())  # what of the file's materials could not be mapped
 
 
-#: Coordinates beyond this would overflow float32 on the GPU once transformed (a metre is 1).
-LARGEST_COORDINATE = 1e30
-
-
 def check_geometry(vertices: np.ndarray, faces: np.ndarray, path: Path | str) -> None:
     """Refuse what a broken exporter writes and a renderer would index out of bounds or turn into NaN:
     faces that point past the vertices, and coordinates that are not finite or absurdly large."""
@@ -54,9 +51,9 @@ def check_geometry(vertices: np.ndarray, faces: np.ndarray, path: Path | str) ->
     if not finite.all():
         raise MeshLoadError(f"{path}: {np.count_nonzero(~finite)} vertices have coordinates that are not "
                             f"finite numbers")
-    if len(vertices) and np.abs(vertices).max() > LARGEST_COORDINATE:
+    if len(vertices) and np.abs(vertices).max() > LARGEST_NUMBER:
         raise MeshLoadError(f"{path}: coordinates up to {np.abs(vertices).max():.3g}, beyond the "
-                            f"{LARGEST_COORDINATE:g} a scene can hold")
+                            f"{LARGEST_NUMBER:g} a scene can hold")
 
 
 def load_mesh_parts(path: Path, smooth: bool = True) -> LoadedMesh:

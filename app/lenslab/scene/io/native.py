@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from lenslab.atomic import atomic_path
+from lenslab.limits import LARGEST_NUMBER
 from lenslab.scene.materials import MATERIAL_TYPES, Material
 from lenslab.scene.scene import ENVIRONMENT_TYPES, Environment, Node, Scene, SceneError
 from lenslab.scene.shapes import SHAPE_TYPES, MeshFile, Shape
@@ -69,11 +70,6 @@ def _describe(value: Any) -> str:
 # ---------------------------------------------------------------------------------------------------------
 # Reading
 # ---------------------------------------------------------------------------------------------------------
-#: Past this a number is no measurement of anything in a scene, and float32 on the GPU would make it infinite
-#: or swallow every smaller one; a field's own range is usually far tighter.
-LARGEST_NUMBER = 1e30
-
-
 def _read_number(value: Any, kind: type, path: str, meta: dict) -> float | int:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise _Invalid(path, f"expected a number, got {_describe(value)}")
