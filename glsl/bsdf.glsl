@@ -10,7 +10,10 @@
 
 vec4 material_row(int m, int row) { return materials[MATERIAL_ROWS * m + row]; }
 int material_type(int m) { return int(material_row(m, 0).w); }
-bool material_scatters(int m) { return material_type(m) != MATERIAL_EMISSIVE; }
+// The first material m holds (an Emissive's surface, a wrapper's material, a blend's first), or -1.
+int inner_material(int m) { return int(material_row(m, 2).x); }
+// Whether a hit on m scatters light: everything but a light without a surface.
+bool material_scatters(int m) { return material_type(m) != MATERIAL_EMISSIVE || inner_material(m) >= 0; }
 
 // Radiance a surface emits towards wo.
 vec3 emitted_radiance(int m, bool front_face) {
@@ -28,7 +31,8 @@ struct Bsdf {
     int type;
     vec3 color;   // diffuse albedo
     vec3 tint;    // specular tint
-    float alpha;  // GGX width; 0 = smooth
+    float alpha;  // microfacet width; 0 = smooth
+    bool beckmann; // the microfacet distribution: Beckmann, or GGX
     float eta;    // dielectrics: n_inside / n_outside, inverted when leaving; plastic: coating index
     vec3 eta3;    // conductors: complex index
     vec3 k;
@@ -37,12 +41,103 @@ struct Bsdf {
     mat3 frame;   // local shading frame: columns tangent, bitangent, normal
 };
 
+// -- Materials that hold materials (scene/materials.py) --------------------------------------------------
+// A hit on one walks down to the material that scatters: a light's surface, one of a blend's two (picked
+// with the blend's odds, which keeps the estimate unbiased, as pbrt-v4's MixMaterial), the material under a
+// mask (whose cut-out traversal already applied: mask.glsl) or under a bump or normal map, which tilt the
+// shading normal on the way. Compiled only for scenes that have such materials (HAS_NESTED_MATERIALS).
+
+// A number in [0, 1) from the hit itself, so that choosing within a blend takes no dimension of the sampler.
+float hit_hash(SurfaceHit s, int level) {
+    uvec3 p = floatBitsToUint(s.p), w = floatBitsToUint(s.wo);
+    uint h = hash_u32(p.x ^ hash_u32(p.y ^ hash_u32(p.z ^ hash_u32(w.x ^ hash_u32(w.y ^ hash_u32(w.z + uint(level)))))));
+    return float(h >> 8) * (1.0 / 16777216.0);
+}
+
+// A texture's scalar value, as Mitsuba's eval_1 reads a colour texture: its luminance.
+float texture_value(int t, vec2 uv) { return luminance(texture_rgb(t, uv)); }
+
+// d value / d(u, v) by central differences over a step small against a texel: within a texel that is the
+// bilinear filter's exact slope. The step grows with |uv| so that float spacing never swamps it. A
+// checkerboard's value is flat but for its edges, whose slope is infinite: zero, as Mitsuba's has none.
+vec2 texture_value_gradient(int t, vec2 uv) {
+    if (int(materials[texture_base + TEXTURE_ROWS * t].x) == TEXTURE_CHECKER) return vec2(0.0);
+    float h = max(6.1e-5, 1.2e-4 * max(abs(uv.x), abs(uv.y)));
+    vec2 du = vec2(h, 0.0), dv = vec2(0.0, h);
+    return vec2(texture_value(t, uv + du) - texture_value(t, uv - du),
+                texture_value(t, uv + dv) - texture_value(t, uv - dv)) / (2.0 * h);
+}
+
+// Mitsuba's bumpmap: the surface moves by the height h(u, v) along the normal, so its tangents gain the
+// height's slopes: dp/du' = dp/du projected onto the tangent plane + n dh/du (likewise v), n' = dp/du' x dp/dv',
+// on the side of the geometric normal. All in the front face's orientation.
+vec3 bumped_normal(SurfaceHit s, vec3 n, vec3 ng, int texture, float scale) {
+    vec3 dpdu, dpdv;
+    surface_tangents(s, n, dpdu, dpdv);
+    vec2 slope = scale * texture_value_gradient(texture, s.uv);
+    vec3 du = dpdu + n * (slope.x - dot(n, dpdu));
+    vec3 dv = dpdv + n * (slope.y - dot(n, dpdv));
+    vec3 bumped = cross(du, dv);
+    if (dot(bumped, bumped) <= 0.0) return n;
+    bumped = normalize(bumped);
+    return dot(bumped, ng) < 0.0 ? -bumped : bumped;
+}
+
+// Mitsuba's normalmap: the texture's (2 rgb - 1) in the shading frame whose tangent follows dp/du.
+vec3 mapped_normal(SurfaceHit s, vec3 n, int texture) {
+    vec3 dpdu, dpdv;
+    surface_tangents(s, n, dpdu, dpdv);
+    vec3 t = dpdu - n * dot(n, dpdu);
+    t = dot(t, t) > 0.0 ? normalize(t) : frame_around(n)[0];
+    vec3 c = 2.0 * texture_rgb(texture, s.uv) - 1.0;
+    vec3 mapped = c.x * t + c.y * cross(n, t) + c.z * n;
+    return dot(mapped, mapped) > 0.0 ? normalize(mapped) : n;
+}
+
+// The material that scatters at s, and its shading normal (s.ns, tilted by bump and normal maps).
+int resolve_material(SurfaceHit s, out vec3 ns) {
+    ns = s.ns;
+    int m = s.material;
+#if HAS_NESTED_MATERIALS
+    // Maps tilt the normal as the front face sees it; a hit from behind sees the mirror image (the
+    // surface looks the same from both sides, as Mitsuba's twosided).
+    vec3 n = s.front_face ? s.ns : -s.ns, ng = s.front_face ? s.ng : -s.ng;
+    bool tilted = false;
+    for (int level = 0; level < MATERIAL_NESTING; level++) {
+        vec4 r0 = material_row(m, 0);
+        int type = int(r0.w);
+        int inner = inner_material(m);
+        if (type == MATERIAL_BLEND) {
+            float weight = r0.y >= 0.0 ? texture_value(int(r0.y), s.uv) : r0.x;
+            if (hit_hash(s, level) < weight) inner = int(material_row(m, 2).y);
+        } else if (type == MATERIAL_BUMP_MAP) {
+            if (r0.y >= 0.0) n = bumped_normal(s, n, ng, int(r0.y), r0.x);
+            tilted = true;
+        } else if (type == MATERIAL_NORMAL_MAP) {
+            if (r0.y >= 0.0) n = mapped_normal(s, n, int(r0.y));
+            tilted = true;
+        } else if (type != MATERIAL_MASK && type != MATERIAL_EMISSIVE) {
+            break;
+        }
+        if (inner < 0) break;  // a light without a surface
+        m = inner;
+    }
+    if (tilted) {
+        vec3 n_front = s.front_face ? s.ns : -s.ns;
+        ns = s.front_face ? n : n - 2.0 * dot(n, n_front) * n_front;
+        if (dot(ns, s.ng) <= 0.0) ns = s.ns;  // tilted under the surface: keep the untilted normal
+    }
+#endif
+    return m;
+}
+
 // b is of material type `code`: false at compile time for types the scene lacks (features.glsl).
 bool is_type(Bsdf b, int code) { return HAS_MATERIAL(code) && b.type == code; }
 
 Bsdf bsdf_at(SurfaceHit s) {
     Bsdf b;
-    int m = s.material;
+    vec3 ns;
+    int m = resolve_material(s, ns);
     vec4 r0 = material_row(m, 0), r2 = material_row(m, 2), r3 = material_row(m, 3), r4 = material_row(m, 4);
     b.type = int(r0.w);
     b.color = r0.xyz;
@@ -53,6 +148,7 @@ Bsdf bsdf_at(SurfaceHit s) {
     b.eta = r2.x;
     b.internal_reflectance = r2.y;
     b.reflectance_table = floatBitsToInt(r2.z);
+    b.beckmann = int(material_row(m, 5).w) == MICROFACET_BECKMANN;
     if (HAS_TEXTURES != 0 && r3.w >= 0.0) b.color = texture_rgb(int(r3.w), s.uv);
     if (HAS_TEXTURES != 0 && r4.w >= 0.0) {  // roughness texture: perceptual roughness in the red channel
         float r = texture_rgb(int(r4.w), s.uv).x;
@@ -60,7 +156,7 @@ Bsdf bsdf_at(SurfaceHit s) {
     }
     if (is_type(b, MATERIAL_DIELECTRIC) && !s.front_face) b.eta = 1.0 / b.eta;
     b.alpha = b.alpha > 0.0 ? max(b.alpha, 1e-4) : 0.0;  // keep tiny roughness out of float trouble
-    b.frame = frame_around(s.ns);
+    b.frame = frame_around(ns);
     return b;
 }
 
@@ -107,8 +203,8 @@ vec3 rough_dielectric_eval(Bsdf b, vec3 wo, vec3 wi, out float pdf) {
     if (m.z < 0.0) m = -m;
     if (dot(m, wi) * wi.z < 0.0 || dot(m, wo) * wo.z < 0.0) return vec3(0.0);  // back-facing microfacet
     float f = fresnel_dielectric(dot(wo, m), b.eta);
-    float vis_pdf = ggx_visible_normal_pdf(wo, m, b.alpha);
-    float d = ggx_d(m, b.alpha), g = ggx_g(wo, wi, b.alpha);
+    float vis_pdf = microfacet_pdf(wo, m, b.alpha, b.beckmann);
+    float d = microfacet_d(m, b.alpha, b.beckmann), g = microfacet_g(wo, wi, b.alpha, b.beckmann);
     if (reflect) {
         pdf = vis_pdf / (4.0 * abs(dot(wo, m))) * f;
         return b.tint * (d * g * f / (4.0 * wo.z));
@@ -141,9 +237,9 @@ vec3 bsdf_eval(SurfaceHit s, Bsdf b, vec3 wi_world, out float pdf) {
     }
     vec3 m = normalize(wo + wi);
     if (is_type(b, MATERIAL_CONDUCTOR)) {
-        pdf = ggx_visible_normal_pdf(wo, m, b.alpha) / (4.0 * dot(wo, m));
+        pdf = microfacet_pdf(wo, m, b.alpha, b.beckmann) / (4.0 * dot(wo, m));
         vec3 f = fresnel_conductor(dot(wo, m), b.eta3, b.k);
-        return b.tint * f * (ggx_d(m, b.alpha) * ggx_g(wo, wi, b.alpha) / (4.0 * wo.z));
+        return b.tint * f * (microfacet_d(m, b.alpha, b.beckmann) * microfacet_g(wo, wi, b.alpha, b.beckmann) / (4.0 * wo.z));
     }
     if (is_type(b, MATERIAL_PLASTIC)) {
         float p_spec = plastic_specular_probability(b, wo.z);
@@ -151,8 +247,8 @@ vec3 bsdf_eval(SurfaceHit s, Bsdf b, vec3 wi_world, out float pdf) {
         pdf = (1.0 - p_spec) * wi.z * INV_PI;
         if (b.alpha > 0.0) {
             float f = fresnel_dielectric(dot(wo, m), b.eta);
-            value += vec3(f * ggx_d(m, b.alpha) * ggx_g(wo, wi, b.alpha) / (4.0 * wo.z));
-            pdf += p_spec * ggx_visible_normal_pdf(wo, m, b.alpha) / (4.0 * dot(wo, m));
+            value += vec3(f * microfacet_d(m, b.alpha, b.beckmann) * microfacet_g(wo, wi, b.alpha, b.beckmann) / (4.0 * wo.z));
+            pdf += p_spec * microfacet_pdf(wo, m, b.alpha, b.beckmann) / (4.0 * dot(wo, m));
         }
         return value;
     }
@@ -176,7 +272,7 @@ bool bsdf_sample(SurfaceHit s, Bsdf b, vec3 u, out vec3 wi_world, out vec3 weigh
         pdf = wi.z * INV_PI;
         weight = b.color;
     } else if (is_type(b, MATERIAL_CONDUCTOR)) {
-        vec3 m = b.alpha == 0.0 ? vec3(0.0, 0.0, 1.0) : ggx_sample_visible_normal(wo, b.alpha, u.xy);
+        vec3 m = b.alpha == 0.0 ? vec3(0.0, 0.0, 1.0) : microfacet_sample(wo, b.alpha, b.beckmann, u.xy);
         wi = 2.0 * dot(wo, m) * m - wo;
         if (wi.z <= 0.0) return false;
         vec3 f = b.tint * fresnel_conductor(dot(wo, m), b.eta3, b.k);
@@ -185,13 +281,13 @@ bool bsdf_sample(SurfaceHit s, Bsdf b, vec3 u, out vec3 wi_world, out vec3 weigh
             pdf = 1.0;
             weight = f;
         } else {
-            pdf = ggx_visible_normal_pdf(wo, m, b.alpha) / (4.0 * dot(wo, m));
-            weight = f * (ggx_g(wo, wi, b.alpha) / ggx_g1(wo, b.alpha));
+            pdf = microfacet_pdf(wo, m, b.alpha, b.beckmann) / (4.0 * dot(wo, m));
+            weight = f * microfacet_reflection_weight(wo, wi, m, b.alpha, b.beckmann);
         }
     } else if (is_type(b, MATERIAL_PLASTIC)) {
         float p_spec = plastic_specular_probability(b, wo.z);
         if (u.z < p_spec) {
-            vec3 m = b.alpha == 0.0 ? vec3(0.0, 0.0, 1.0) : ggx_sample_visible_normal(wo, b.alpha, u.xy);
+            vec3 m = b.alpha == 0.0 ? vec3(0.0, 0.0, 1.0) : microfacet_sample(wo, b.alpha, b.beckmann, u.xy);
             wi = 2.0 * dot(wo, m) * m - wo;
             if (wi.z <= 0.0) return false;
             if (b.alpha == 0.0) {
@@ -224,7 +320,7 @@ bool bsdf_sample(SurfaceHit s, Bsdf b, vec3 u, out vec3 wi_world, out vec3 weigh
             transmit = true;
         }
     } else if (is_type(b, MATERIAL_DIELECTRIC)) {
-        vec3 m = b.alpha == 0.0 ? vec3(0.0, 0.0, 1.0) : ggx_sample_visible_normal(wo, b.alpha, u.xy);
+        vec3 m = b.alpha == 0.0 ? vec3(0.0, 0.0, 1.0) : microfacet_sample(wo, b.alpha, b.beckmann, u.xy);
         float f = fresnel_dielectric(dot(wo, m), b.eta);
         if (u.z < f) {
             wi = 2.0 * dot(wo, m) * m - wo;
@@ -256,8 +352,7 @@ bool bsdf_sample(SurfaceHit s, Bsdf b, vec3 u, out vec3 wi_world, out vec3 weigh
 
 // How much a transmission from wo to wi compresses radiance (eta^2 entering glass, 1/eta^2 leaving); 1 for
 // reflection. Russian roulette divides it out so that paths inside glass are not killed for looking dim.
-float bsdf_eta_scale(SurfaceHit s, vec3 wi) {
-    if (dot(wi, s.ng) >= 0.0 || !HAS_MATERIAL(MATERIAL_DIELECTRIC) || material_type(s.material) != MATERIAL_DIELECTRIC) return 1.0;
-    float eta = material_row(s.material, 2).x;
-    return s.front_face ? eta * eta : 1.0 / (eta * eta);
+float bsdf_eta_scale(SurfaceHit s, Bsdf b, vec3 wi) {
+    if (dot(wi, s.ng) >= 0.0 || !is_type(b, MATERIAL_DIELECTRIC)) return 1.0;
+    return b.eta * b.eta;  // b.eta is already inverted when leaving
 }

@@ -78,6 +78,9 @@ bool trace_bsp(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
             int prim = prim_refs[first_ref + i];
             vec2 bary;
             float t = intersect_prim(ray, prim, t_min, hit.t, bary);
+#if defined(MASKED_TRAVERSAL) && HAS_MATERIAL(MATERIAL_MASK)
+            if (t < hit.t && passes_through(ray, prim, t, bary)) continue;  // a cut-out (mask.glsl)
+#endif
             if (t < hit.t) {
                 hit.t = t;
                 hit.prim = prim;

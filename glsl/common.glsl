@@ -49,5 +49,10 @@ int material_of(int prim) { return floatBitsToInt(geometry[GEOMETRY_ROWS * prim 
 int light_of(int prim) { return floatBitsToInt(geometry[GEOMETRY_ROWS * prim + 2].w); }
 bool is_sphere(int prim) { return HAS_SPHERES != 0 && prim >= triangle_count; }
 
+uint hash_u32(uint x) {  // lowbias32 (Chris Wellons): rng.glsl's scrambles, and choices made by hashing a hit
+    x ^= x >> 16; x *= 0x7feb352dU; x ^= x >> 15; x *= 0x846ca68bU; x ^= x >> 16;
+    return x;
+}
+
 float luminance(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
 float max_component(vec3 c) { return max(c.x, max(c.y, c.z)); }

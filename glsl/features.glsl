@@ -31,6 +31,9 @@
 #ifndef HAS_LIGHTS_BY_POWER
 #define HAS_LIGHTS_BY_POWER 1
 #endif
+#ifndef HAS_NESTED_MATERIALS
+#define HAS_NESTED_MATERIALS 1
+#endif
 #ifndef MATERIAL_TYPES
 #define MATERIAL_TYPES 0xFFFF
 #endif

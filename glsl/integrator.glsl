@@ -83,7 +83,7 @@ vec3 path_radiance(Ray ray, inout Sampler sampler) {
         bool delta;
         if (!bsdf_sample(s, bsdf, u_bsdf.xyz, wi, weight, pdf, delta)) break;
         throughput *= weight;
-        eta_scale *= bsdf_eta_scale(s, wi);
+        eta_scale *= bsdf_eta_scale(s, bsdf, wi);
         prev_bsdf_pdf = pdf;
         prev_delta = delta;
         prev_p = s.p;

@@ -1,6 +1,7 @@
-// Fresnel equations and the GGX (Trowbridge-Reitz) microfacet distribution, in the local shading frame
-// where the normal is +Z. Conventions follow pbrt-v4 (section 9.6): alpha is the GGX width, eta the ratio of
-// the indices of refraction n_transmitted / n_incident.
+// Fresnel equations and the GGX (Trowbridge-Reitz) and Beckmann microfacet distributions, in the local
+// shading frame where the normal is +Z. Conventions follow pbrt-v4 (section 9.6): alpha is the distribution's
+// width, eta the ratio of the indices of refraction n_transmitted / n_incident. The microfacet_* functions at
+// the end serve either distribution; bsdf.glsl calls only those.
 
 // Unpolarised Fresnel reflectance of a dielectric boundary for light arriving at cos_i > 0.
 // Returns 1 on total internal reflection.
@@ -79,4 +80,68 @@ vec3 ggx_sample_visible_normal(vec3 wo, float alpha, vec2 u) {
 // Density of the visible normal m seen from wo: G1(wo) max(0, wo.m) D(m) / cos(wo).
 float ggx_visible_normal_pdf(vec3 wo, vec3 m, float alpha) {
     return ggx_g1(wo, alpha) * max(0.0, dot(wo, m)) * ggx_d(m, alpha) / wo.z;
+}
+
+// -- Beckmann ---------------------------------------------------------------------------------------------
+// D(m) = exp(-tan^2 / alpha^2) / (pi alpha^2 cos^4), Smith's Lambda by Walter et al.'s rational fit (2007),
+// which is also Mitsuba's, so that a Beckmann surface imported from Mitsuba scatters as it does there.
+float beckmann_d(vec3 m, float alpha) {
+    float cos2 = m.z * m.z;
+    if (cos2 <= 0.0) return 0.0;
+    float a2 = alpha * alpha;
+    float tan2 = max(0.0, 1.0 - cos2) / cos2;
+    return exp(-tan2 / a2) / (PI * a2 * cos2 * cos2);
+}
+
+float beckmann_lambda(vec3 w, float alpha) {
+    float cos2 = w.z * w.z;
+    if (cos2 <= 0.0) return 0.0;
+    float tan_theta = sqrt(max(0.0, 1.0 - cos2) / cos2);
+    float a = 1.0 / max(alpha * tan_theta, 1e-20);
+    if (a >= 1.6) return 0.0;
+    return (1.0 - 1.259 * a + 0.396 * a * a) / (3.535 * a + 2.181 * a * a);
+}
+
+// Normals drawn with density D(m) cos(theta_m) (tan^2 theta = -alpha^2 ln(1 - u)): simpler than Beckmann's
+// visible normals and just as unbiased, at a little more noise near grazing angles.
+vec3 beckmann_sample_normal(float alpha, vec2 u) {
+    float tan2 = -alpha * alpha * log(1.0 - min(u.x, ONE_MINUS_EPSILON));
+    float cos_theta = inversesqrt(1.0 + tan2);
+    float sin_theta = sqrt(max(0.0, 1.0 - cos_theta * cos_theta));
+    float phi = 2.0 * PI * u.y;
+    return vec3(sin_theta * cos(phi), sin_theta * sin(phi), cos_theta);
+}
+
+// -- Either distribution ----------------------------------------------------------------------------------
+float microfacet_d(vec3 m, float alpha, bool beckmann) {
+    return beckmann ? beckmann_d(m, alpha) : ggx_d(m, alpha);
+}
+
+float microfacet_lambda(vec3 w, float alpha, bool beckmann) {
+    return beckmann ? beckmann_lambda(w, alpha) : ggx_lambda(w, alpha);
+}
+
+float microfacet_g1(vec3 w, float alpha, bool beckmann) { return 1.0 / (1.0 + microfacet_lambda(w, alpha, beckmann)); }
+
+// Height-correlated masking-shadowing.
+float microfacet_g(vec3 wo, vec3 wi, float alpha, bool beckmann) {
+    return 1.0 / (1.0 + microfacet_lambda(wo, alpha, beckmann) + microfacet_lambda(wi, alpha, beckmann));
+}
+
+// A microfacet normal for light leaving along wo (wo.z > 0): GGX's visible normals, Beckmann's D cos.
+vec3 microfacet_sample(vec3 wo, float alpha, bool beckmann, vec2 u) {
+    return beckmann ? beckmann_sample_normal(alpha, u) : ggx_sample_visible_normal(wo, alpha, u);
+}
+
+// The density with which microfacet_sample draws m.
+float microfacet_pdf(vec3 wo, vec3 m, float alpha, bool beckmann) {
+    if (beckmann) return beckmann_d(m, alpha) * max(m.z, 0.0);
+    return ggx_visible_normal_pdf(wo, m, alpha);
+}
+
+// f |cos theta_i| / pdf of a reflection about m drawn by microfacet_sample, Fresnel left out: G / G1(wo) for
+// visible normals; G (wo.m) / (wo.z m.z) for normals drawn from D cos.
+float microfacet_reflection_weight(vec3 wo, vec3 wi, vec3 m, float alpha, bool beckmann) {
+    if (beckmann) return microfacet_g(wo, wi, alpha, true) * dot(wo, m) / (wo.z * m.z);
+    return microfacet_g(wo, wi, alpha, false) / ggx_g1(wo, alpha);
 }

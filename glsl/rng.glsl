@@ -9,11 +9,6 @@
 
 const uint sobol_directions[128] = SOBOL_DIRECTIONS;
 
-uint hash_u32(uint x) {  // lowbias32 (Chris Wellons)
-    x ^= x >> 16; x *= 0x7feb352dU; x ^= x >> 15; x *= 0x846ca68bU; x ^= x >> 16;
-    return x;
-}
-
 uint hash_combine(uint seed, uint v) { return seed ^ (v + (seed << 6) + (seed >> 2)); }
 
 float u32_to_unit_float(uint x) { return min(float(x >> 8) * (1.0 / 16777216.0), 0.99999994); }

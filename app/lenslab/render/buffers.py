@@ -23,19 +23,25 @@ from lenslab.limits import SceneTooLarge, format_bytes  # SceneTooLarge: raised 
 from lenslab.render.gpu_layout import (ENV_CONSTANT, ENV_MAP, GEOMETRY_BINDING, GEOMETRY_ROWS,
                                        IMAGE_DATA_BINDING, KD_NODES_BINDING, LIGHT_AREA, LIGHT_CHOICE_BINDING,
                                        LIGHT_ENVIRONMENT, LIGHT_PLACES, LIGHT_POINT, LIGHT_ROWS, LIGHT_SUN,
-                                       LIGHTS_BINDING, MATERIAL_CONDUCTOR, MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE,
-                                       MATERIAL_EMISSIVE, MATERIAL_PLASTIC, MATERIAL_ROWS, MATERIAL_THIN_DIELECTRIC,
-                                       MATERIALS_BINDING, PRIM_REFS_BINDING, SHADING_BINDING, SHADING_ROWS)
+                                       LIGHTS_BINDING, MATERIAL_BLEND, MATERIAL_BUMP_MAP, MATERIAL_CONDUCTOR,
+                                       MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_EMISSIVE, MATERIAL_MASK,
+                                       MATERIAL_NESTING, MATERIAL_NORMAL_MAP, MATERIAL_PLASTIC, MATERIAL_ROWS,
+                                       MATERIAL_THIN_DIELECTRIC, MATERIALS_BINDING, MICROFACET_BECKMANN,
+                                       MICROFACET_GGX, PRIM_REFS_BINDING, SHADING_BINDING, SHADING_ROWS)
 from lenslab.render.textures import TextureTable, read_texture_image
 from lenslab.scene.flatten import FlatScene
-from lenslab.scene.materials import Conductor, Diffuse, Dielectric, Emissive, Material, Plastic, ThinDielectric
+from lenslab.scene.materials import (Blend, BumpMap, Conductor, Diffuse, Dielectric, Emissive, Mask, Material,
+                                     NormalMap, Plastic, ThinDielectric, inner_materials)
 from lenslab.scene.lights import Light, PointLight, SunLight
-from lenslab.scene.scene import ConstantEnvironment, Environment, EnvironmentMap
+from lenslab.scene.scene import ConstantEnvironment, Environment, EnvironmentMap, SceneError
 from lenslab.scene.textures import InlineImageTexture
 
 # Each material class's type code in its GPU record.
 MATERIAL_CODES = {Diffuse: MATERIAL_DIFFUSE, Emissive: MATERIAL_EMISSIVE, Conductor: MATERIAL_CONDUCTOR,
-                  Plastic: MATERIAL_PLASTIC, Dielectric: MATERIAL_DIELECTRIC, ThinDielectric: MATERIAL_THIN_DIELECTRIC}
+                  Plastic: MATERIAL_PLASTIC, Dielectric: MATERIAL_DIELECTRIC, ThinDielectric: MATERIAL_THIN_DIELECTRIC,
+                  Blend: MATERIAL_BLEND, Mask: MATERIAL_MASK, BumpMap: MATERIAL_BUMP_MAP,
+                  NormalMap: MATERIAL_NORMAL_MAP}
+MICROFACET_CODES = {"ggx": MICROFACET_GGX, "beckmann": MICROFACET_BECKMANN}
 
 # Where each of the packed scene's arrays is bound.
 BINDINGS = {"kd_nodes": KD_NODES_BINDING, "prim_refs": PRIM_REFS_BINDING, "geometry": GEOMETRY_BINDING,
@@ -50,10 +56,12 @@ def _luminance(rgb) -> float:
     return 0.2126 * r + 0.7152 * g + 0.0722 * b
 
 
-def pack_material(material: Material, textures: TextureTable) -> np.ndarray:
+def pack_material(material: Material, textures: TextureTable, inner: Sequence[int] = ()) -> np.ndarray:
     """MATERIAL_ROWS (eight) vec4 rows, read by glsl/bsdf.glsl's bsdf_at():
     0 (albedo, type), 1 (emission, two-sided), 2 (eta rgb | ior, internal reflectance, reflectance table, alpha),
-    3 (k rgb, albedo texture), 4 (specular tint, roughness texture), 5 (absorption per metre), 6-7 spare."""
+    3 (k rgb, albedo texture), 4 (specular tint, roughness texture), 5 (absorption per metre, distribution),
+    6-7 spare. A material that holds others (``inner``: the indices of their records, see
+    :class:`MaterialTable`) keeps its parameter and texture in row 0 and those indices in row 2."""
     record = np.zeros((MATERIAL_ROWS, 4), np.float32)
     code = MATERIAL_CODES.get(type(material))
     if code is None:
@@ -61,8 +69,19 @@ def pack_material(material: Material, textures: TextureTable) -> np.ndarray:
     record[0, 3] = code
     record[3, 3] = record[4, 3] = -1.0  # no textures
     record[4, :3] = 1.0
+    if code in HOLDING_CODES:
+        record[2, :2] = -1.0  # holds no material
+    for slot, index in enumerate(inner):
+        record[2, slot] = index
+    if isinstance(material, (Blend, Mask, BumpMap, NormalMap)):
+        value, texture = {Blend: ("weight", "weight_texture"), Mask: ("opacity", "opacity_texture"),
+                          BumpMap: ("scale", "texture"), NormalMap: (None, "texture")}[type(material)]
+        record[0, 0] = getattr(material, value) if value else 0.0
+        record[0, 1] = textures.index_of(getattr(material, texture))
+        return record
     roughness = getattr(material, "roughness", 0.0)
-    record[2, 3] = roughness**2  # GGX alpha from perceptual roughness
+    record[2, 3] = roughness**2  # microfacet alpha from perceptual roughness
+    record[5, 3] = MICROFACET_CODES[getattr(material, "distribution", "ggx")]
     if isinstance(material, (Diffuse, Plastic)):
         record[0, :3] = material.albedo
         record[3, 3] = textures.index_of(material.albedo_texture)
@@ -80,8 +99,9 @@ def pack_material(material: Material, textures: TextureTable) -> np.ndarray:
         if alpha > 0:
             # A rough coating reflects a different share than Fresnel alone says: tabulate it (Mitsuba's
             # roughplastic), so the diffuse base gets exactly what the coating lets through.
-            record[2, 1] = rough_internal_reflectance(material.ior, alpha)
-            table = textures.add_floats(rough_reflectance_table(material.ior, alpha).astype(np.float32))
+            distribution = material.distribution
+            record[2, 1] = rough_internal_reflectance(material.ior, alpha, distribution)
+            table = textures.add_floats(rough_reflectance_table(material.ior, alpha, distribution).astype(np.float32))
             record[2, 2] = np.int32(table).view(np.float32)
         else:
             record[2, 1] = internal_diffuse_reflectance(material.ior)
@@ -93,6 +113,52 @@ def pack_material(material: Material, textures: TextureTable) -> np.ndarray:
         record[2, 0] = material.ior
         record[4, :3] = material.tint
     return record
+
+
+class MaterialTable:
+    """Every material's GPU record: the scene's own first, at the indices the geometry names, then the
+    materials they hold (a blend's two, a light's surface ...), each after its holder's list, referred to by
+    index from the holder's row 2."""
+
+    def __init__(self, materials: Sequence[Material], textures: TextureTable, names: Sequence[str] = ()):
+        self._textures = textures
+        self._records: list[np.ndarray | None] = [None] * len(materials)
+        for index, material in enumerate(materials):
+            name = names[index] if index < len(names) else str(index)
+            self._records[index] = self._pack(material, name, depth=1)
+
+    def _pack(self, material: Material, name: str, depth: int) -> np.ndarray:
+        if depth > MATERIAL_NESTING:
+            raise SceneError(f"material '{name}': materials nest more than {MATERIAL_NESTING} deep")
+        inner = [self._add(held, name, depth + 1) for held in inner_materials(material)]
+        return pack_material(material, self._textures, inner)
+
+    def _add(self, material: Material, name: str, depth: int) -> int:
+        self._records.append(None)
+        index = len(self._records) - 1
+        self._records[index] = self._pack(material, name, depth)
+        return index
+
+    def rows(self) -> np.ndarray:
+        records = self._records or [np.zeros((MATERIAL_ROWS, 4), np.float32)]  # GL refuses empty buffers
+        return np.concatenate(records)
+
+
+def held_materials(records: np.ndarray, used: Sequence[int]) -> set[int]:
+    """Indices of the records ``used`` and every record they hold, from the packed rows (MATERIAL_ROWS x 4
+    each): the materials a kernel must be able to shade."""
+    seen: set[int] = set()
+    todo = [int(i) for i in used]
+    while todo:
+        index = todo.pop()
+        if index in seen or not 0 <= index < len(records):
+            continue
+        seen.add(index)
+        todo.extend(int(i) for i in records[index, 2, :2] if i >= 0 and records[index, 0, 3] in HOLDING_CODES)
+    return seen
+
+
+HOLDING_CODES = (MATERIAL_EMISSIVE, MATERIAL_BLEND, MATERIAL_MASK, MATERIAL_BUMP_MAP, MATERIAL_NORMAL_MAP)
 
 
 def _emitted_power(flat: FlatScene) -> np.ndarray:
@@ -294,8 +360,7 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
     shading[:, 0, 3], shading[:, 1, 3], shading[:, 2, 3] = uv[:, 0], uv[:, 1], uv[:, 2]
     shading[:, 3, :3] = uv[:, 3:6]
 
-    materials = [pack_material(m, textures) for m in flat.materials] or [np.zeros((MATERIAL_ROWS, 4), np.float32)]
-    material_rows = np.concatenate(materials)
+    material_rows = MaterialTable(flat.materials, textures, flat.material_names).rows()
 
     def at_least_one(a: np.ndarray) -> np.ndarray:  # GL refuses zero-sized buffers
         return a if a.size else np.zeros(4, a.dtype)

@@ -16,9 +16,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lenslab.render.buffers import MATERIAL_CODES, PackedScene
+from lenslab.render.buffers import HOLDING_CODES, MATERIAL_CODES, PackedScene, held_materials
 from lenslab.render.gpu_layout import (ENV_MAP, GEOMETRY_ROWS, LIGHT_AREA, LIGHT_ENVIRONMENT, LIGHT_POINT, LIGHT_ROWS,
-                                       LIGHT_SUN, MATERIAL_ROWS)
+                                       LIGHT_SUN, MATERIAL_BLEND, MATERIAL_ROWS)
 
 ALL_MATERIAL_TYPES = frozenset(MATERIAL_CODES.values())
 
@@ -39,6 +39,9 @@ class KernelFeatures:
     lights_at_point: bool = True
     lights_by_power: bool = True
     material_types: frozenset[int] = ALL_MATERIAL_TYPES  # render/buffers.py's MATERIAL_CODES
+    # Materials that hold materials (a light with a surface, blends, masks, bump and normal maps): the
+    # resolve loop of glsl/bsdf.glsl.
+    nested_materials: bool = True
 
     def defines(self) -> dict[str, int]:
         return {
@@ -51,6 +54,7 @@ class KernelFeatures:
             "HAS_SUN": int(self.sun),
             "HAS_LIGHTS_AT_POINT": int(self.lights_at_point),
             "HAS_LIGHTS_BY_POWER": int(self.lights_by_power),
+            "HAS_NESTED_MATERIALS": int(self.nested_materials),
             "MATERIAL_TYPES": sum(1 << code for code in self.material_types),
         }
 
@@ -65,13 +69,15 @@ def scene_features(packed: PackedScene) -> KernelFeatures:
     materials = arrays["materials"][: int(uniforms["texture_base"])].reshape(-1, MATERIAL_ROWS, 4)
     used = (np.unique(arrays["geometry"].reshape(-1, GEOMETRY_ROWS, 4)[:prim_count, 1, 3].view(np.int32))
             if prim_count else [])
-    records = materials[np.asarray(used, dtype=np.int64)]
+    # The records primitives name, and every record those hold (a blend's two, a light's surface ...).
+    records = materials[np.asarray(sorted(held_materials(materials, used)), dtype=np.int64)]
     # A scene without lights still has a row (GL refuses empty buffers).
     light_rows = arrays["lights"].reshape(-1, 4)[0::LIGHT_ROWS][: int(uniforms["light_count"])]
     light_kinds = set(light_rows[:, 0].astype(int).tolist())
     return KernelFeatures(
         spheres=prim_count > triangle_count,
-        textures=bool((records[:, 3, 3] >= 0).any() or (records[:, 4, 3] >= 0).any()),
+        textures=bool((records[:, 3, 3] >= 0).any() or (records[:, 4, 3] >= 0).any()
+                      or ((records[:, 0, 3] >= MATERIAL_BLEND) & (records[:, 0, 1] >= 0)).any()),
         environment_map=int(uniforms["env_type"]) == ENV_MAP,
         environment_light=LIGHT_ENVIRONMENT in light_kinds,
         area_lights=LIGHT_AREA in light_kinds,
@@ -80,4 +86,5 @@ def scene_features(packed: PackedScene) -> KernelFeatures:
         lights_at_point=bool(uniforms["lights_at_point"]),
         lights_by_power=not uniforms["lights_at_point"],
         material_types=frozenset(int(code) for code in records[:, 0, 3]),
+        nested_materials=bool(((records[:, 2, 0] >= 0) & np.isin(records[:, 0, 3], HOLDING_CODES)).any()),
     )

@@ -14,8 +14,9 @@ def fresnel_dielectric(cos_i, eta):
     cos_i = np.clip(np.asarray(cos_i, float), 0.0, 1.0)
     sin2_t = (1.0 - cos_i**2) / eta**2
     cos_t = np.sqrt(np.maximum(0.0, 1.0 - sin2_t))
-    r_parl = (eta * cos_i - cos_t) / (eta * cos_i + cos_t)
-    r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t)
+    with np.errstate(invalid="ignore", divide="ignore"):  # 0/0 at grazing total reflection: replaced below
+        r_parl = (eta * cos_i - cos_t) / (eta * cos_i + cos_t)
+        r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t)
     return np.where(sin2_t >= 1.0, 1.0, 0.5 * (r_parl**2 + r_perp**2))
 
 
@@ -53,32 +54,57 @@ def _visible_normals(wo: np.ndarray, alpha: float, u1: np.ndarray, u2: np.ndarra
     return m / np.linalg.norm(m, axis=-1, keepdims=True)
 
 
-def _smith_lambda(w: np.ndarray, alpha: float) -> np.ndarray:
+def _smith_lambda(w: np.ndarray, alpha: float, distribution: str = "ggx") -> np.ndarray:
+    """Smith's Lambda of each direction w (..., 3): GGX exactly, Beckmann by Walter et al.'s rational fit
+    (as glsl/microfacet.glsl and Mitsuba)."""
     cos2 = np.maximum(w[..., 2] ** 2, 1e-12)
-    return 0.5 * (np.sqrt(1 + alpha**2 * np.maximum(0, 1 - cos2) / cos2) - 1)
+    tan2 = np.maximum(0, 1 - cos2) / cos2
+    if distribution == "beckmann":
+        a = 1.0 / np.maximum(alpha * np.sqrt(tan2), 1e-12)
+        return np.where(a >= 1.6, 0.0, (1 - 1.259 * a + 0.396 * a**2) / (3.535 * a + 2.181 * a**2))
+    return 0.5 * (np.sqrt(1 + alpha**2 * tan2) - 1)
+
+
+def _beckmann_normals(alpha: float, u1: np.ndarray, u2: np.ndarray) -> np.ndarray:
+    """Beckmann microfacet normals drawn with density D(m) cos(theta_m), for a stratified set of (u1, u2);
+    numpy twin of glsl/microfacet.glsl's beckmann_sample_normal. Returns (K, 3)."""
+    tan2 = -alpha**2 * np.log1p(-u1)
+    cos = 1 / np.sqrt(1 + tan2)
+    sin = np.sqrt(np.maximum(0, 1 - cos**2))
+    phi = 2 * np.pi * u2
+    return np.stack([sin * np.cos(phi), sin * np.sin(phi), cos], axis=-1)
 
 
 @lru_cache(maxsize=64)
-def rough_reflectance_table(eta: float, alpha: float, size: int = ROUGH_TABLE_SIZE, grid: int = 96) -> np.ndarray:
-    """Directional albedo of a GGX dielectric interface's reflection, R(mu) at mu = i / (size - 1):
-    the integral of F D G / (4 mu) over outgoing directions, estimated over the visible normals of each
-    incident direction (E = mean of F G / G1) on a stratified grid. As Mitsuba's roughplastic, this is what
-    the coating takes away from the light that reaches the diffuse base."""
+def rough_reflectance_table(eta: float, alpha: float, distribution: str = "ggx", size: int = ROUGH_TABLE_SIZE,
+                            grid: int = 96) -> np.ndarray:
+    """Directional albedo of a rough dielectric interface's reflection, R(mu) at mu = i / (size - 1):
+    the integral of F D G / (4 mu) over outgoing directions, on a stratified grid of microfacet normals: GGX's
+    visible normals of each incident direction (E = mean of F G / G1), or Beckmann normals drawn from
+    D cos (E = mean of F G (wo.m) / (mu cos theta_m)). As Mitsuba's roughplastic, this is what the coating takes
+    away from the light that reaches the diffuse base."""
     mu = np.maximum(np.arange(size) / (size - 1), 1e-6)
     wo = np.stack([np.sqrt(1 - mu**2), np.zeros(size), mu], axis=1)
     u1, u2 = (np.stack(np.meshgrid(np.arange(grid), np.arange(grid)), axis=-1).reshape(-1, 2).T + 0.5) / grid
-    m = _visible_normals(wo, alpha, u1, u2)
+    if distribution == "beckmann":
+        m = np.broadcast_to(_beckmann_normals(alpha, u1, u2), (size, len(u1), 3))
+    else:
+        m = _visible_normals(wo, alpha, u1, u2)
     wo_dot_m = np.einsum("mk,mnk->mn", wo, m)
     wi = 2 * wo_dot_m[..., None] * m - wo[:, None, :]
-    lam_o = _smith_lambda(wo, alpha)[:, None]
-    g_over_g1 = (1 + lam_o) / (1 + lam_o + _smith_lambda(wi, alpha))
-    value = np.where(wi[..., 2] > 0, fresnel_dielectric(wo_dot_m, eta) * g_over_g1, 0.0)
+    lam_o = _smith_lambda(wo, alpha, distribution)[:, None]
+    g = 1 / (1 + lam_o + _smith_lambda(wi, alpha, distribution))
+    if distribution == "beckmann":
+        weight = g * np.maximum(wo_dot_m, 0) / (mu[:, None] * m[..., 2])
+    else:
+        weight = g * (1 + lam_o)  # G / G1(wo)
+    value = np.where(wi[..., 2] > 0, fresnel_dielectric(wo_dot_m, eta) * weight, 0.0)
     return value.mean(axis=1)
 
 
 @lru_cache(maxsize=64)
-def rough_internal_reflectance(eta: float, alpha: float) -> float:
+def rough_internal_reflectance(eta: float, alpha: float, distribution: str = "ggx") -> float:
     """Cosine-weighted mean reflectance of the same interface seen from inside (relative index 1/eta):
     2 * integral of R(mu) mu dmu, by the trapezoid rule over the table."""
     mu = np.arange(ROUGH_TABLE_SIZE) / (ROUGH_TABLE_SIZE - 1)
-    return float(np.trapezoid(2 * rough_reflectance_table(1.0 / eta, alpha) * mu, mu))
+    return float(np.trapezoid(2 * rough_reflectance_table(1.0 / eta, alpha, distribution) * mu, mu))

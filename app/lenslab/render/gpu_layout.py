@@ -19,7 +19,18 @@ MATERIAL_CONDUCTOR = 2
 MATERIAL_PLASTIC = 3
 MATERIAL_DIELECTRIC = 4
 MATERIAL_THIN_DIELECTRIC = 5
+# Materials that hold materials (scene/materials.py): row 0 (parameter, its texture, -, type), row 2 the
+# indices of the records they hold. An Emissive's surface index is its row 2, x (-1: black).
+MATERIAL_BLEND = 6
+MATERIAL_MASK = 7
+MATERIAL_BUMP_MAP = 8
+MATERIAL_NORMAL_MAP = 9
 MATERIAL_ROWS = 8
+# How deep materials may hold one another: glsl/bsdf.glsl's resolve loop runs at most this many steps.
+MATERIAL_NESTING = 8
+# A microfacet material's distribution (row 5, w).
+MICROFACET_GGX = 0
+MICROFACET_BECKMANN = 1
 
 # Entries of a rough plastic coating's reflectance table (render/fresnel.py), over cos theta in [0, 1].
 ROUGH_TABLE_SIZE = 64

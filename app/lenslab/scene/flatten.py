@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from lenslab.limits import LARGEST_NUMBER
-from lenslab.scene.materials import Material
+from lenslab.scene.materials import Material, walk_materials
 from lenslab.scene.scene import DEFAULT_MATERIAL, Node, Scene, SceneError
 from lenslab.scene.shapes import Box, Disk, MeshFile, Rectangle, Relief, Sphere, TriangleMesh
 from lenslab.scene.io.meshes import LoadedMesh, MeshLoadError, MeshPart
@@ -211,12 +211,13 @@ def _check_in_world(values: np.ndarray, node: Node) -> None:
 
 def _check_finite_material(name: str, material: Material) -> None:
     """A material's numbers, whichever reader they came through (a glTF's factors are JSON, which allows NaN):
-    one that is not finite would turn every pixel the material touches into NaN."""
-    for f in dataclasses.fields(material):
-        value = getattr(material, f.name)
-        numbers = value if isinstance(value, tuple) else (value,)
-        if any(isinstance(v, float) and not abs(v) <= LARGEST_NUMBER for v in numbers):
-            raise SceneError(f"material '{name}': {f.name} {value} is not a finite number")
+    one that is not finite would turn every pixel the material touches into NaN. Materials it holds too."""
+    for held in walk_materials(material):
+        for f in dataclasses.fields(held):
+            value = getattr(held, f.name)
+            numbers = value if isinstance(value, tuple) else (value,)
+            if any(isinstance(v, float) and not abs(v) <= LARGEST_NUMBER for v in numbers):
+                raise SceneError(f"material '{name}': {f.name} {value} is not a finite number")
 
 
 def _check_finite_attribute(what: str, parts: list[np.ndarray], triangle_node: np.ndarray, nodes: list[Node]) -> None:

@@ -4,8 +4,13 @@ Each material is a small dataclass registered under the ``type`` name that the s
 packs each type into its own GPU record (``lenslab.render.buffers``); adding a material means adding a class
 here, a packer there and a branch in ``glsl/bsdf.glsl``.
 
-Roughness is the artist's "perceptual" roughness r in [0, 1]; the GGX microfacet width is alpha = r^2 (as in
-Disney's and glTF's conventions). Zero means a perfectly smooth surface (a mirror-like delta lobe).
+Roughness is the artist's "perceptual" roughness r in [0, 1]; the microfacet width is alpha = r^2 (as in
+Disney's and glTF's conventions). Zero means a perfectly smooth surface (a mirror-like delta lobe). The
+microfacet distribution is GGX by default, or Beckmann (Mitsuba's default for its rough BSDFs).
+
+Some materials hold other materials (docs/scene-format.md, "Materials that hold materials"): a light whose
+surface also reflects (``Emissive.surface``), a blend of two, a cut-out (``Mask``), and bump and normal maps
+that tilt the shading normal of the material they hold.
 """
 
 from __future__ import annotations
@@ -17,6 +22,10 @@ from typing import ClassVar
 from lenslab.scene.textures import Texture
 
 RGB = tuple[float, float, float]
+
+MICROFACET_DISTRIBUTIONS = ("ggx", "beckmann")
+_DISTRIBUTION = {"choices": MICROFACET_DISTRIBUTIONS,
+                 "doc": "microfacet distribution of a rough surface: GGX (long tails) or Beckmann"}
 
 # Complex refractive indices (eta, k) of common metals at red, green and blue (about 650, 550 and 450 nm),
 # from the measured spectra that pbrt and Mitsuba ship, reduced to RGB.
@@ -48,11 +57,14 @@ class Diffuse(Material):
 
 @dataclass
 class Emissive(Material):
-    """A light source: emits ``radiance`` from the front face (both faces if ``two_sided``) and reflects nothing."""
+    """A light source: emits ``radiance`` from the front face (both faces if ``two_sided``). Its ``surface``
+    says how it also reflects the light that falls on it (a lamp's white diffuser, Mitsuba's area light with a
+    BSDF); none, the default, is a black surface that reflects nothing."""
 
     type_name: ClassVar[str] = "emissive"
     radiance: RGB = field(default=(1.0, 1.0, 1.0), metadata={"range": (0.0, 1e6), "doc": "W/(m^2 sr) per channel"})
     two_sided: bool = field(default=False, metadata={"doc": "emit from the back face too"})
+    surface: Material | None = field(default=None, metadata={"doc": "how the light's surface reflects; none: black"})
 
     @property
     def emits(self) -> bool:
@@ -70,6 +82,7 @@ class Conductor(Material):
     tint: RGB = field(default=(1.0, 1.0, 1.0), metadata={"range": (0.0, 1.0), "doc": "scales the reflectance"})
     roughness: float = field(default=0.0, metadata={"range": (0.0, 1.0), "doc": "0 = polished mirror"})
     roughness_texture: Texture | None = None
+    distribution: str = field(default="ggx", metadata=_DISTRIBUTION)
 
     def complex_ior(self) -> tuple[RGB, RGB]:
         return (self.eta, self.k) if self.metal == "custom" else METALS[self.metal]
@@ -85,6 +98,7 @@ class Plastic(Material):
     ior: float = field(default=1.49, metadata={"range": (1.0, 4.0), "doc": "index of refraction of the coating"})
     roughness: float = field(default=0.0, metadata={"range": (0.0, 1.0)})
     roughness_texture: Texture | None = None
+    distribution: str = field(default="ggx", metadata=_DISTRIBUTION)
 
 
 @dataclass
@@ -98,6 +112,7 @@ class Dielectric(Material):
     type_name: ClassVar[str] = "dielectric"
     ior: float = field(default=1.5, metadata={"range": (1.0001, 4.0), "doc": "index of refraction inside"})
     roughness: float = field(default=0.0, metadata={"range": (0.0, 1.0)})
+    distribution: str = field(default="ggx", metadata=_DISTRIBUTION)
     tint: RGB = field(default=(1.0, 1.0, 1.0), metadata={"range": (0.0, 1.0), "doc": "scales reflection and transmission"})
     absorption_color: RGB = field(default=(1.0, 1.0, 1.0), metadata={"range": (1e-6, 1.0)})
     absorption_distance_m: float = field(default=0.1, metadata={"range": (1e-6, 1e6)})
@@ -116,6 +131,78 @@ class ThinDielectric(Material):
     tint: RGB = field(default=(1.0, 1.0, 1.0), metadata={"range": (0.0, 1.0)})
 
 
+# -- Materials that hold materials ------------------------------------------------------------------------
+# Each wraps one or two materials. The renderer resolves the chain at every hit, from the outside in, down to
+# the material that scatters (glsl/bsdf.glsl, resolve_material).
+
+
+@dataclass
+class Blend(Material):
+    """A mix of two materials: ``first`` weighted by 1 - weight, ``second`` by ``weight`` (Mitsuba's
+    blendbsdf). The renderer picks one of the two at each hit with those odds: unbiased, as pbrt-v4's mix."""
+
+    type_name: ClassVar[str] = "blend"
+    first: Material = field(default_factory=Diffuse, metadata={"doc": "weighted by 1 - weight"})
+    second: Material = field(default_factory=lambda: Conductor(), metadata={"doc": "weighted by weight"})
+    weight: float = field(default=0.5, metadata={"range": (0.0, 1.0), "doc": "share of the second material"})
+    weight_texture: Texture | None = field(default=None, metadata={"doc": "overrides weight (luminance) where given"})
+
+
+@dataclass
+class Mask(Material):
+    """A cut-out: where ``opacity`` is below 1 the surface is partly absent, and light passes straight
+    through it (leaves, fences, a printed stencil; Mitsuba's mask). Rays pass with probability 1 - opacity,
+    shadow rays included."""
+
+    type_name: ClassVar[str] = "mask"
+    material: Material = field(default_factory=Diffuse, metadata={"doc": "the surface where it is present"})
+    opacity: float = field(default=0.5, metadata={"range": (0.0, 1.0), "doc": "1: solid, 0: absent"})
+    opacity_texture: Texture | None = field(default=None, metadata={"doc": "overrides opacity (luminance) where given"})
+
+
+@dataclass
+class BumpMap(Material):
+    """Relief without geometry: a height texture tilts the shading normal of ``material`` (Mitsuba's bumpmap:
+    the surface is displaced by ``scale`` times the texture's luminance along its normal)."""
+
+    type_name: ClassVar[str] = "bump_map"
+    material: Material = field(default_factory=Diffuse)
+    texture: Texture | None = field(default=None, metadata={"doc": "height, as luminance"})
+    scale: float = field(default=1.0, metadata={"range": (-1e3, 1e3), "doc": "height per unit of texture value"})
+
+
+@dataclass
+class NormalMap(Material):
+    """A tangent-space normal map (RGB = (n + 1) / 2, linear, +Z out of the surface, +X along u) gives the
+    shading normal of ``material`` (Mitsuba's normalmap)."""
+
+    type_name: ClassVar[str] = "normal_map"
+    material: Material = field(default_factory=Diffuse)
+    texture: Texture | None = field(default=None, metadata={"doc": "read as linear: set its colour space to linear"})
+
+
+WRAPPER_TYPES = (Blend, Mask, BumpMap, NormalMap)
+
+
+def inner_materials(material: Material) -> list[Material]:
+    """The materials a material holds (none for a plain one)."""
+    if isinstance(material, Blend):
+        return [material.first, material.second]
+    if isinstance(material, (Mask, BumpMap, NormalMap)):
+        return [material.material]
+    if isinstance(material, Emissive) and material.surface is not None:
+        return [material.surface]
+    return []
+
+
+def walk_materials(material: Material):
+    """The material and every material it holds, outermost first."""
+    yield material
+    for inner in inner_materials(material):
+        yield from walk_materials(inner)
+
+
 MATERIAL_TYPES: dict[str, type[Material]] = {
-    cls.type_name: cls for cls in (Diffuse, Emissive, Conductor, Plastic, Dielectric, ThinDielectric)
+    cls.type_name: cls for cls in (Diffuse, Emissive, Conductor, Plastic, Dielectric, ThinDielectric,
+                                   Blend, Mask, BumpMap, NormalMap)
 }

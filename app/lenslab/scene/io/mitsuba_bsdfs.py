@@ -9,8 +9,8 @@ deliberately ignore.
 
 Mitsuba's defaults (``src/bsdfs/*.cpp``): diffuse reflectance 0.5; conductor material "none" (a perfect
 mirror); plastic diffuse_reflectance 0.5, int_ior 1.49; dielectric int_ior 1.5046 (bk7), ext_ior 1.000277;
-rough variants alpha 0.1 with the Beckmann distribution. Our microfacets are GGX with alpha = roughness^2,
-so ``roughness = sqrt(alpha)``; a Beckmann alpha is carried over as a GGX one, with a note.
+rough variants alpha 0.1 with the Beckmann distribution. Our microfacet alpha is roughness^2, so
+``roughness = sqrt(alpha)``, and the distribution (Beckmann or GGX) is carried over.
 """
 
 from __future__ import annotations
@@ -19,7 +19,9 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Callable
 
-from lenslab.scene.materials import Conductor, Dielectric, Diffuse, Material, Plastic, ThinDielectric
+from lenslab.scene.materials import (Blend, BumpMap, Conductor, Dielectric, Diffuse, Mask, Material, NormalMap, Plastic,
+                                     ThinDielectric, walk_materials)
+from lenslab.scene.textures import Texture
 
 from . import mitsuba_values as mv
 
@@ -91,9 +93,12 @@ def _ior(p: "Props", name: str, default: float) -> float:
     return ior
 
 
-def _roughness(p: "Props", notes: list[str]) -> float:
-    """Our perceptual roughness r from Mitsuba's microfacet alpha (ours is GGX with alpha = r^2)."""
-    distribution = p.string("distribution", "beckmann")
+def _roughness(p: "Props", notes: list[str]) -> tuple[float, str]:
+    """Our perceptual roughness r from Mitsuba's microfacet alpha (ours is alpha = r^2), and the distribution.
+    ``sample_visible`` only changes how Mitsuba samples, not what it renders: taken and left."""
+    distribution = p.string("distribution", "beckmann").strip().lower()
+    if distribution not in ("beckmann", "ggx"):
+        raise p.node.error(f'unknown microfacet distribution "{distribution}" (expected beckmann or ggx)')
     p.take("sample_visible")
     if p.has("alpha_u") or p.has("alpha_v"):
         au, av = _alpha(p, "alpha_u", notes), _alpha(p, "alpha_v", notes)
@@ -102,12 +107,10 @@ def _roughness(p: "Props", notes: list[str]) -> float:
             notes.append(f"anisotropic roughness ({au:g}, {av:g}) is rendered isotropic (alpha {alpha:.3g})")
     else:
         alpha = _alpha(p, "alpha", notes)
-    if distribution != "ggx":
-        notes.append(f'the "{distribution}" microfacet distribution is rendered as GGX with the same alpha')
     if alpha > 1:
         notes.append(f"alpha {alpha:g} is rougher than LensLab allows: 1 used")
         alpha = 1.0
-    return math.sqrt(max(alpha, 0.0))
+    return math.sqrt(max(alpha, 0.0)), distribution
 
 
 def _alpha(p: "Props", name: str, notes: list[str]) -> float:
@@ -133,27 +136,30 @@ def _note(notes: list[str]) -> str | None:
 def _map_conductor(p: "Props", imp: "_Importer") -> Mapped:
     notes: list[str] = []
     rough = p.node.type == "roughconductor"
-    roughness = _roughness(p, notes) if rough else 0.0
+    roughness, distribution = _roughness(p, notes) if rough else (0.0, "ggx")
     tint = _unit(p.color("specular_reflectance", 1.0))
     if p.has("eta") or p.has("k"):
         if p.has("material"):
             p.take("material")
             notes.append("both material and eta/k given: eta/k used")
         eta, k = p.color("eta", 0.0), p.color("k", 1.0)
-        material = Conductor(metal="custom", eta=_clip(eta, 0, 100), k=_clip(k, 0, 100), tint=tint, roughness=roughness)
+        material = Conductor(metal="custom", eta=_clip(eta, 0, 100), k=_clip(k, 0, 100), tint=tint, roughness=roughness,
+                             distribution=distribution)
     else:
         name = p.string("material", "none")
         if name in MITSUBA_METALS:
-            material = Conductor(metal=MITSUBA_METALS[name], tint=tint, roughness=roughness)
+            material = Conductor(metal=MITSUBA_METALS[name], tint=tint, roughness=roughness, distribution=distribution)
         elif name == "none":  # Mitsuba's default: a perfect mirror, which eta 0, k 1 gives at every angle
-            material = Conductor(metal="custom", eta=(0.0, 0.0, 0.0), k=(1.0, 1.0, 1.0), tint=tint, roughness=roughness)
+            material = Conductor(metal="custom", eta=(0.0, 0.0, 0.0), k=(1.0, 1.0, 1.0), tint=tint, roughness=roughness,
+                                 distribution=distribution)
         else:
             f0 = mv.CONDUCTOR_F0.get(name)
             if f0 is None:
                 raise p.node.error(f'unknown conductor material "{name}"')
             # eta 1 and k = 2 sqrt(F0 / (1 - F0)) reflect F0 at normal incidence
             k = tuple(min(2 * math.sqrt(f / (1 - f)), 100.0) for f in f0)
-            material = Conductor(metal="custom", eta=(1.0, 1.0, 1.0), k=k, tint=tint, roughness=roughness)
+            material = Conductor(metal="custom", eta=(1.0, 1.0, 1.0), k=k, tint=tint, roughness=roughness,
+                                 distribution=distribution)
             notes.append(f'"{name}" is not a LensLab metal preset: matched at normal incidence only')
     return Mapped(material, _note(notes))
 
@@ -173,7 +179,7 @@ def _relative_ior(p: "Props", notes: list[str], lo: float) -> float:
 
 def _map_plastic(p: "Props", imp: "_Importer") -> Mapped:
     notes: list[str] = []
-    roughness = _roughness(p, notes) if p.node.type == "roughplastic" else 0.0
+    roughness, distribution = _roughness(p, notes) if p.node.type == "roughplastic" else (0.0, "ggx")
     albedo = _unit(p.color("diffuse_reflectance", 0.5))
     ior = _ior(p, "int_ior", 1.49) / _ior(p, "ext_ior", 1.000277)
     if not 1.0 <= ior <= 4.0:
@@ -183,13 +189,13 @@ def _map_plastic(p: "Props", imp: "_Importer") -> Mapped:
         notes.append("specular_reflectance is not supported: the coat reflects as clear plastic")
     if p.bool("nonlinear", False):
         notes.append("nonlinear colour shift is not supported")
-    return Mapped(Plastic(albedo=albedo, ior=ior, roughness=roughness), _note(notes))
+    return Mapped(Plastic(albedo=albedo, ior=ior, roughness=roughness, distribution=distribution), _note(notes))
 
 
 def _map_dielectric(p: "Props", imp: "_Importer") -> Mapped:
     notes: list[str] = []
     kind = p.node.type
-    roughness = _roughness(p, notes) if kind == "roughdielectric" else 0.0
+    roughness, distribution = _roughness(p, notes) if kind == "roughdielectric" else (0.0, "ggx")
     transmit = _unit(p.color("specular_transmittance", 1.0))
     reflect = _unit(p.color("specular_reflectance", 1.0))
     if reflect != (1.0, 1.0, 1.0) and reflect != transmit:
@@ -197,7 +203,7 @@ def _map_dielectric(p: "Props", imp: "_Importer") -> Mapped:
     if kind == "thindielectric":
         return Mapped(ThinDielectric(ior=_relative_ior(p, notes, 1.0001), tint=transmit), _note(notes))
     ior = _relative_ior(p, notes, 1.0001)
-    return Mapped(Dielectric(ior=ior, roughness=roughness, tint=transmit), _note(notes))
+    return Mapped(Dielectric(ior=ior, roughness=roughness, distribution=distribution, tint=transmit), _note(notes))
 
 
 def _map_principled(p: "Props", imp: "_Importer") -> Mapped:
@@ -208,27 +214,116 @@ def _map_principled(p: "Props", imp: "_Importer") -> Mapped:
     return Mapped(Diffuse(albedo), _grey_note(p.node.type, "its base colour"))
 
 
-def _map_wrapper(p: "Props", imp: "_Importer") -> Mapped:
-    """twosided, mask, bumpmap, normalmap, blendbsdf: the (first) nested BSDF, unwrapped."""
-    kind = p.node.type
-    for key in list(p.values):
-        if p.values[key].tag != "bsdf":
-            p.take(key)
-    inner = [n for n in p.objects if n.tag == "bsdf"] + [p.take(k) for k in list(p.values) if p.values[k].tag == "bsdf"]
+def _nested_bsdfs(p: "Props") -> list:
+    """The BSDF elements a BSDF holds, named or not, in document order."""
+    return [n for n in p.objects if n.tag == "bsdf"] + [p.take(k) for k in list(p.values) if p.values[k].tag == "bsdf"]
+
+
+def _held(p: "Props", imp: "_Importer", notes: list[str]) -> Material:
+    """The one BSDF a wrapper holds, mapped (Mitsuba's default diffuse when it holds none)."""
+    inner = _nested_bsdfs(p)
     if not inner:
-        return Mapped(Diffuse((0.5, 0.5, 0.5)), f"{kind} holds no BSDF: Mitsuba's default diffuse used")
-    mapped = imp.map_bsdf(inner[0])
-    notes = [mapped.note] if mapped.note else []
-    if kind == "twosided":
-        if len(inner) > 1:
-            notes.append("its back-side BSDF is dropped (LensLab surfaces look the same from both sides)")
-    elif kind == "mask":
-        notes.append("the opacity mask is ignored")
-    elif kind in ("bumpmap", "normalmap"):
-        notes.append(f"the {kind} is ignored")
-    elif kind == "blendbsdf":
-        notes.append("only its first BSDF is used")
-    return Mapped(mapped.material, "; ".join(notes) or None)
+        notes.append(f"{p.node.type} holds no BSDF: Mitsuba's default diffuse used")
+        return Diffuse((0.5, 0.5, 0.5))
+    for extra in inner[1:]:
+        notes.append(f"{p.node.type} holds one BSDF: the one at line {extra.line} is ignored")
+    return _mapped(imp.map_bsdf(inner[0]), notes)
+
+
+def _mapped(mapped: Mapped, notes: list[str]) -> Material:
+    if mapped.note:
+        notes.append(mapped.note)
+    return mapped.material
+
+
+def _scalar_or_texture(p: "Props", imp: "_Importer", name: str, default: float,
+                       notes: list[str]) -> tuple[float, Texture | None]:
+    """A property Mitsuba reads with eval_1: a number, a colour (its luminance) or a texture (its luminance,
+    looked up where the ray hits)."""
+    node = p.take(name)
+    if node is None:
+        return default, None
+    if node.tag in ("float", "integer"):
+        text = node.attrs.get("value", "")
+        try:
+            return mv.parse_number(text), None
+        except ValueError:
+            raise node.error(f'could not parse "{text}" as a finite floating point value') from None
+    return _texture_or_mean(imp, node, notes)
+
+
+def _texture_or_mean(imp: "_Importer", node, notes: list[str]) -> tuple[float, Texture | None]:
+    if node.tag == "texture":
+        texture = imp.texture_of(node)
+        if texture is not None:
+            return 0.0, texture
+    r, g, b = imp.color_of(node)  # a colour, or a texture LensLab cannot look up (averaged, with a warning)
+    return 0.2126 * r + 0.7152 * g + 0.0722 * b, None
+
+
+def _texture_property(p: "Props", imp: "_Importer", name: str | None) -> tuple[object, Texture | None]:
+    """The texture a bumpmap (unnamed, or any name) or normalmap (``normalmap``) holds, and its element."""
+    if name is not None:
+        node = p.take(name)
+        candidates = [node] if node is not None else []
+    else:
+        candidates = [n for n in p.objects if n.tag == "texture"]
+        candidates += [p.take(k) for k in list(p.values) if p.values[k].tag == "texture"]
+    if not candidates:
+        raise p.node.error(f"{p.node.type} needs a <texture>")
+    node = candidates[0]
+    return node, imp.texture_of(node) if node.tag == "texture" else None
+
+
+def _map_twosided(p: "Props", imp: "_Importer") -> Mapped:
+    """Our surfaces look the same from both sides already: the front BSDF, unwrapped."""
+    notes: list[str] = []
+    inner = _nested_bsdfs(p)
+    if not inner:
+        return Mapped(Diffuse((0.5, 0.5, 0.5)), "twosided holds no BSDF: Mitsuba's default diffuse used")
+    material = _mapped(imp.map_bsdf(inner[0]), notes)
+    if len(inner) > 1:
+        notes.append("its back-side BSDF is dropped (LensLab surfaces look the same from both sides)")
+    return Mapped(material, _note(notes))
+
+
+def _map_mask(p: "Props", imp: "_Importer") -> Mapped:
+    notes: list[str] = []
+    opacity, texture = _scalar_or_texture(p, imp, "opacity", 0.5, notes)
+    material = _held(p, imp, notes)
+    return Mapped(Mask(material=material, opacity=min(max(opacity, 0.0), 1.0), opacity_texture=texture), _note(notes))
+
+
+def _map_blendbsdf(p: "Props", imp: "_Importer") -> Mapped:
+    notes: list[str] = []
+    weight, texture = _scalar_or_texture(p, imp, "weight", 0.5, notes)
+    inner = _nested_bsdfs(p)
+    if len(inner) != 2:
+        raise p.node.error(f"blendbsdf needs two BSDFs, not {len(inner)}")
+    first, second = (_mapped(imp.map_bsdf(node), notes) for node in inner)
+    if any(isinstance(held, Mask) for part in (first, second) for held in walk_materials(part)):
+        notes.append("a mask inside a blend does not cut the surface in LensLab: it is solid there")
+    return Mapped(Blend(first=first, second=second, weight=min(max(weight, 0.0), 1.0), weight_texture=texture),
+                  _note(notes))
+
+
+def _map_bumpmap(p: "Props", imp: "_Importer") -> Mapped:
+    notes: list[str] = []
+    scale = p.float("scale", 1.0)
+    node, texture = _texture_property(p, imp, None)
+    material = _held(p, imp, notes)
+    if texture is None:
+        notes.append(f"its texture at line {node.line} cannot be looked up: the bump map is flat")
+    return Mapped(BumpMap(material=material, texture=texture, scale=scale), _note(notes))
+
+
+def _map_normalmap(p: "Props", imp: "_Importer") -> Mapped:
+    notes: list[str] = []
+    node, texture = _texture_property(p, imp, "normalmap")
+    material = _held(p, imp, notes)
+    if texture is None:
+        notes.append(f"its texture at line {node.line} cannot be looked up: the normal map is flat")
+    return Mapped(NormalMap(material=material, texture=texture), _note(notes))
 
 
 BSDF_MAPPINGS: dict[str, BsdfMapping] = {
@@ -243,10 +338,10 @@ BSDF_MAPPINGS: dict[str, BsdfMapping] = {
     "thindielectric": _map_dielectric,
     "principled": _map_principled,
     "principledthin": _map_principled,
-    "twosided": _map_wrapper,
-    "mask": _map_wrapper,
-    "bumpmap": _map_wrapper,
-    "normalmap": _map_wrapper,
-    "blendbsdf": _map_wrapper,
+    "twosided": _map_twosided,
+    "mask": _map_mask,
+    "bumpmap": _map_bumpmap,
+    "normalmap": _map_normalmap,
+    "blendbsdf": _map_blendbsdf,
 }
 """Mitsuba BSDF plugin name -> mapping onto a LensLab material. Approximations return a ``note``."""

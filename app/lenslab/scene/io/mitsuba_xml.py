@@ -534,6 +534,8 @@ class _Importer:
         self.environment = ConstantEnvironment()
         self._environment_node: XNode | None = None
         self.lights: list[Light] = []
+        self._top_level_area_lights: list[XNode] = []  # checked against _attached_emitters at the end
+        self._attached_emitters: set[int] = set()  # ids of the emitter elements shapes took
         self.render = RenderSettings(spp=4, max_depth=1024, rr_depth=5, seed=0, sampler="independent")
         self.resolution = (768, 576)
         self.camera: _Camera | None = None
@@ -662,6 +664,9 @@ class _Importer:
         for child in root.children:
             with _named_errors(child):
                 self._top_level(child, sensors)
+        for light in self._top_level_area_lights:
+            if id(light) not in self._attached_emitters:
+                self.warn(light, "an area emitter that no <shape> refers to lights nothing: ignored")
         if sensors:
             with _named_errors(sensors[0]):
                 self.sensor(sensors[0])
@@ -761,7 +766,9 @@ class _Importer:
             self.lights.append(SunLight(name=name, direction=tuple(float(-v) for v in travel / np.linalg.norm(travel)),
                                         irradiance=_clip_rgb(irradiance), angular_diameter_deg=0.0))
         elif kind == "area":
-            self.warn(node, "an area emitter must sit inside a <shape>: ignored")
+            # Declared here and referenced from a shape (<ref id=...> inside it), as Mitsuba's own Cornell
+            # box does: whether any shape took it is known once the whole scene is read (run()).
+            self._top_level_area_lights.append(node)
         else:
             p.finish(silent=set(p.values))
             self.warn(node, f'emitter "{kind}" is not supported yet: ignored (the scene lacks this light)')
@@ -854,7 +861,7 @@ class _Importer:
             self.warn(bsdfs[1], "a shape takes one BSDF: the first is used")
         material = None
         if emitters:
-            material = self.area_light(emitters[0], node, name, flip, bool(bsdfs))
+            material = self.area_light(emitters[0], node, name, flip, bsdfs[0] if bsdfs else None)
             for extra in emitters[1:]:
                 self.warn(extra, "a shape takes one emitter: the first is used")
         if material is None:
@@ -869,7 +876,10 @@ class _Importer:
             matrix = self._similarity(node, matrix)
         return self.place(node, name, matrix, shape, material)
 
-    def area_light(self, emitter: XNode, shape_node: XNode, name: str, flip: bool, has_bsdf: bool) -> str | None:
+    def area_light(self, emitter: XNode, shape_node: XNode, name: str, flip: bool, bsdf: XNode | None) -> str | None:
+        """An area light: Emissive, whose surface is the shape's BSDF. Mitsuba gives an emitting shape without
+        a BSDF a black diffuse one (``Shape::Shape``), which is our surface-less light."""
+        self._attached_emitters.add(id(emitter))
         if emitter.type != "area":
             self.warn(emitter, f'emitter "{emitter.type}" cannot be attached to a shape: ignored')
             return None
@@ -879,11 +889,17 @@ class _Importer:
         if flip:
             self.warn(shape_node, "flip_normals on an emitting "
                       f"{shape_node.type} is not supported: it emits from its outside")
-        if has_bsdf:
-            self.warn(emitter, "the light's own BSDF is dropped: a LensLab emitter reflects nothing")
+        surface = None
+        if bsdf is not None and bsdf.type == "null":
+            self.warn(bsdf, "a light with a null BSDF: in LensLab its surface is black and blocks what lies behind it")
+        elif bsdf is not None:
+            mapped = self.map_bsdf(bsdf)
+            if mapped.note:
+                self.warn(bsdf, mapped.note)
+            surface = mapped.material
         material = self.unique_material(f"{name}.emitter")
         clipped = tuple(float(min(max(c, 0.0), 1e6)) for c in radiance)
-        self.materials[material] = Emissive(radiance=clipped, two_sided=False)  # type: ignore[arg-type]
+        self.materials[material] = Emissive(radiance=clipped, two_sided=False, surface=surface)  # type: ignore[arg-type]
         return material
 
     def instance(self, node: XNode, p: Props, name: str) -> list[Node]:
