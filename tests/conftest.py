@@ -20,3 +20,15 @@ def renderer():
         pytest.skip(f"no OpenGL 4.3 context: {exc}")
     yield r
     r.release()
+
+
+@pytest.fixture(scope="session")
+def mitsuba():
+    """Mitsuba 3's Python module with its comparison variant set, or a skip saying why it cannot render here."""
+    pytest.importorskip("mitsuba", reason="Mitsuba 3 is not installed (pip install 'lenslab[validate]')")
+    from lenslab.validate import mitsuba_env
+
+    works, why = mitsuba_env.mitsuba_works()
+    if not works:
+        pytest.skip(why)
+    return mitsuba_env.load_mitsuba()
