@@ -107,7 +107,7 @@ def test_obj_materials_map_onto_ours(tmp_path):
     loaded = load_parts(path)
     parts = by_name(loaded)
     assert set(parts) == {"Chalk", "Lacquer", "Glass", "Lamp", "Brass", "Steel"}
-    assert loaded.warnings == ("model.obj: material 'Lamp': emits (Ke), so its reflection (Kd, Ks) is not rendered",)
+    assert loaded.warnings == ()
 
     chalk = parts["Chalk"].material
     assert type(chalk) is Diffuse and chalk.albedo == pytest.approx((0.7, 0.6, 0.5)) and chalk.albedo_texture is None
@@ -123,6 +123,8 @@ def test_obj_materials_map_onto_ours(tmp_path):
 
     lamp = parts["Lamp"].material
     assert type(lamp) is Emissive and lamp.radiance == (5.0, 4.0, 3.0)
+    # Its Kd is its diffuser's colour: the lamp reflects as well as glows.
+    assert type(lamp.surface) is Diffuse and lamp.surface.albedo == pytest.approx((0.8, 0.8, 0.8))
 
     brass = parts["Brass"].material  # the classic MTL metal: black Kd, coloured Ks
     assert type(brass) is Conductor and brass.metal == "custom"
@@ -320,11 +322,12 @@ def test_gltf_metallic_roughness_and_khr_extensions_map_onto_ours(tmp_path, suff
 
     panel = parts["Panel"].material
     assert type(panel) is Emissive and panel.radiance == pytest.approx((4.0, 2.0, 1.0)) and panel.two_sided
+    # glTF's emission adds to the surface's own reflection: here the default white, fully rough metal.
+    assert type(panel.surface) is Conductor and panel.surface.roughness == pytest.approx(1.0)
 
     # The node transforms of the graph are applied: the fourth quad sits 9 m along x.
     assert parts["Panel"].mesh.vertices[:, 0].mean() == pytest.approx(9.0)
-    assert loaded.warnings == (f"props{suffix}: material 'Panel': emits, so its reflection (base colour, "
-                               "roughness) is not rendered",)
+    assert loaded.warnings == ()
 
 
 def test_unmappable_gltf_features_are_reported_once_per_material_by_name(tmp_path):

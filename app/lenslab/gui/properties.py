@@ -37,13 +37,15 @@ from lenslab.gui.widgets import ColorEdit, IntEdit, NumberEdit, Section, VectorE
 from lenslab.scene.editing import file_reference
 from lenslab.scene.lights import LIGHT_TYPES, Light
 from lenslab.scene.materials import MATERIAL_TYPES, Diffuse, Material
+from lenslab.scene.textures import TEXTURE_TYPES, Texture
 from lenslab.scene.io.meshes import MESH_SUFFIXES
 from lenslab.scene.scene import ENVIRONMENT_TYPES, Environment, Node
 from lenslab.scene.shapes import SHAPE_TYPES, Box, Disk, Rectangle, Relief, Shape, Sphere
 
 #: Polymorphic slots: the base class picks the registry of concrete types to choose from.
 TAGGED_TYPES: dict[type, dict[str, type]] = {Shape: SHAPE_TYPES, Material: MATERIAL_TYPES,
-                                             Environment: ENVIRONMENT_TYPES, Light: LIGHT_TYPES}
+                                             Environment: ENVIRONMENT_TYPES, Light: LIGHT_TYPES,
+                                             Texture: TEXTURE_TYPES}
 
 #: Fields whose RGB triple is a colour (the scene model's RGB alias is a plain tuple, so the name tells).
 COLOUR_FIELDS = {"albedo", "radiance", "color", "colour", "reflectance", "transmittance", "specular", "tint",
@@ -158,11 +160,8 @@ class PropertyEditor(QWidget):
         if target is None or not self.doc.model.exists(target):
             return (None,)
         obj = self.doc.model.resolve(target)
-        types = [type(obj)]
-        for f in dataclasses.fields(obj):
-            types.append(type(getattr(obj, f.name)))
         extra = tuple(self.doc.scene.materials) if target[0] == "node" else ()
-        return (target, tuple(types), extra)
+        return (target, _type_tree(obj), extra)
 
     def rebuild(self) -> None:
         target = self._current_target()
@@ -315,11 +314,12 @@ class PropertyEditor(QWidget):
             layout.addWidget(hint(" ".join(doc.replace("``", "").split())))
 
     # -- fields ------------------------------------------------------------------------------------------------
-    def _add_type_selector(self, form, target, path, obj, base: type, allow_none: bool = False) -> None:
+    def _add_type_selector(self, form, target, path, obj, base: type, allow_none: bool = False,
+                           none_label: str = "none (group)") -> None:
         registry = TAGGED_TYPES[base]
         combo = QComboBox()
         if allow_none:
-            combo.addItem("none (group)", None)
+            combo.addItem(none_label, None)
         for type_name in registry:
             combo.addItem(type_name.capitalize(), type_name)
 
@@ -352,7 +352,13 @@ class PropertyEditor(QWidget):
             annotation = hints.get(f.name)
             value = getattr(obj, f.name)
             meta = dict(f.metadata)
-            if dataclasses.is_dataclass(value) and tagged_base(annotation) is None:
+            base = tagged_base(annotation)
+            if base is not None:
+                # A material or texture held by this one (a light's surface, a blend's two, a bump map's
+                # texture): its own type choice and fields, indented under the field's name.
+                self._add_held(form, target, path, annotation, value, base, meta)
+                continue
+            if dataclasses.is_dataclass(value) and base is None:
                 sub = self._form()
                 self._add_fields(sub, target, path, value)
                 box = QWidget()
@@ -369,6 +375,21 @@ class PropertyEditor(QWidget):
                 editor.widget.setToolTip(meta["doc"])
             form.addRow(label, editor.widget)
             self._editors[path] = editor
+
+    def _add_held(self, form, target, path, annotation, value, base: type, meta: dict) -> None:
+        sub = self._form()
+        sub.setContentsMargins(12, 0, 0, 0)
+        optional = type(None) in typing.get_args(annotation)
+        self._add_type_selector(sub, target, path, value, base, allow_none=optional, none_label="none")
+        if value is not None:
+            self._add_fields(sub, target, path, value)
+        label = QLabel(pretty(path[-1]))
+        if meta.get("doc"):
+            label.setToolTip(meta["doc"])
+        box = QWidget()
+        box.setLayout(sub)
+        form.addRow(label)
+        form.addRow(box)
 
     def _make_editor(self, target, path, annotation, value, meta) -> FieldEditor | None:
         lo, hi = meta.get("range", (-1e6, 1e6))
@@ -489,6 +510,13 @@ class PropertyEditor(QWidget):
                     return
             if target[0] in ("node", "light"):
                 self.title.setText(self.doc.model.resolve(target).name)
+
+
+def _type_tree(obj: Any) -> tuple:
+    """The types of a dataclass and of everything it holds: the form's structure, rebuilt when it changes."""
+    if not dataclasses.is_dataclass(obj):
+        return (type(obj),)
+    return (type(obj),) + tuple(_type_tree(getattr(obj, f.name)) for f in dataclasses.fields(obj))
 
 
 def _quiet(widget, setter, value) -> None:

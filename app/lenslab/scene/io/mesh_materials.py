@@ -12,7 +12,8 @@ OBJ + MTL. The MTL is parsed here, not taken from trimesh, which keeps neither t
 could not open nor the texture options. Ka (ambient), illum and map_Ka have no meaning to a path tracer and
 are not reported.
 
-- Ke > 0            -> Emissive(radiance=Ke), front face only.
+- Ke > 0            -> Emissive(radiance=Ke), front face only, whose surface is what the rest of the
+                       statements make of it (below) when they state a reflection (Kd, Ks, map_Kd); else black.
 - d < 1 (or Tr > 0) -> Dielectric(ior=Ni, else 1.5; tint=Tf; smooth unless Pr says otherwise).
 - Pm >= 0.5, or a black Kd with a noticeable Ks (the classic MTL metal)
                     -> Conductor with F0 = Kd (Pm) or Ks, as complex IOR eta = 1, k = 2 sqrt(F0 / (1 - F0)).
@@ -28,7 +29,8 @@ the map replaces Kd rather than multiplying it. map_Pr is a linear roughness tex
 glTF 2.0 / GLB. Scalars and extensions are read from the file's own JSON (trimesh drops the KHR extensions);
 trimesh reads the geometry. Images are read through OpenImageIO.
 
-- emissiveFactor * KHR_materials_emissive_strength > 0 -> Emissive (two-sided when doubleSided).
+- emissiveFactor * KHR_materials_emissive_strength > 0 -> Emissive (two-sided when doubleSided), whose surface is
+  the material the rest of it makes (glTF's emission adds to its reflection).
 - metallic >= 0.5 -> Conductor: baseColor is F0 at normal incidence, as the complex IOR eta = 1,
   k = 2 sqrt(F0 / (1 - F0)), whose Fresnel curve rises to white at grazing angles as glTF's Schlick term does.
 - KHR_materials_transmission > 0 -> Dielectric(ior=KHR_materials_ior or 1.5, roughness, tint=baseColor,
@@ -426,8 +428,10 @@ class ObjMaterials:
         roughness_texture = self._texture(keys, "map_pr", folder, note, "linear")
 
         if max(ke) > 0.0:
-            note("emits (Ke), so its reflection (Kd, Ks) is not rendered")
-            return Emissive(radiance=ke)
+            # A lamp's diffuser reflects as well as glows (as in Blender, where Ke adds to the surface).
+            reflects = any(key in keys for key in ("kd", "ks", "map_kd"))
+            rest = {key: value for key, value in keys.items() if key != "ke"}
+            return Emissive(radiance=ke, surface=self._map(name, rest, folder) if reflects else None)
         if opacity < 1.0:
             if opacity > 0.0:
                 note(f"dissolve {_fmt(opacity)} (partly transparent) rendered as clear glass")
@@ -574,8 +578,8 @@ class GltfMaterials:
         return self._mapped[index]
 
     # -- one material ------------------------------------------------------------------------------------
-    def _map(self, index: int, name: str) -> Material:
-        material = self.materials[index]
+    def _map(self, index: int, name: str, material: dict | None = None) -> Material:
+        material = self.materials[index] if material is None else material
 
         def note(text: str) -> None:
             self.notes.add(index, name, text)
@@ -626,8 +630,9 @@ class GltfMaterials:
                 if mean is not None:
                     emission = emission * mean
                     note("emissive texture averaged to one colour (emitters take one radiance)")
-            note("emits, so its reflection (base colour, roughness) is not rendered")
-            return Emissive(radiance=_rgb(np.minimum(emission, 1e6)), two_sided=bool(material.get("doubleSided", False)))
+            rest = dict(material, emissiveFactor=(0.0, 0.0, 0.0))
+            return Emissive(radiance=_rgb(np.minimum(emission, 1e6)), two_sided=bool(material.get("doubleSided", False)),
+                            surface=self._map(index, name, rest))
         if metallic >= 0.5:
             f0 = np.asarray(base_rgb)
             if base_info is not None:
