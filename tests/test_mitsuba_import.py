@@ -16,7 +16,7 @@ import pytest
 
 from lenslab.scene.io import mitsuba_values as mv
 from lenslab.scene.io.mitsuba_xml import BSDF_MAPPINGS, load_mitsuba_scene, load_mitsuba_string
-from lenslab.scene.materials import Conductor, Dielectric, Diffuse, Emissive, Plastic, ThinDielectric
+from lenslab.scene.materials import Blend, Conductor, Dielectric, Diffuse, Emissive, Mask, Plastic, ThinDielectric
 from lenslab.scene.lights import PointLight, SunLight
 from lenslab.scene.scene import ConstantEnvironment, EnvironmentMap, SceneError
 from lenslab.scene.shapes import Box, Disk, MeshFile, Rectangle, Sphere
@@ -479,10 +479,10 @@ def test_emitters_area_constant_and_unsupported(tmp_path):
     scene, warnings = load(tmp_path, body)
     assert scene.environment == ConstantEnvironment((0.5, 0.6, 0.7))
     lamp, ball = scene.nodes
-    assert scene.materials[lamp.material] == Emissive((10.0, 8.0, 6.0), two_sided=False)
+    # The light keeps its BSDF as its surface: it reflects as in Mitsuba.
+    assert scene.materials[lamp.material] == Emissive((10.0, 8.0, 6.0), two_sided=False, surface=Diffuse((0.5,) * 3))
     assert ':4: <emitter type="spot">' in only(warnings, 'emitter "spot"')
-    assert "reflects nothing" in only(warnings, "own BSDF")
-    assert len(warnings) == 2 and scene.lights == []
+    assert len(warnings) == 1 and scene.lights == []
 
 
 def test_point_and_directional_emitters_become_lights(tmp_path):
@@ -689,3 +689,39 @@ def test_imported_cornell_box_renders(renderer):
         assert left[0] > left[1] and right[1] > right[0]
     finally:
         session.release()
+
+
+def test_an_area_emitter_declared_at_the_top_and_referred_to_from_a_shape(tmp_path):
+    # Mitsuba's own Cornell box declares its light's emitter at the top level and puts a <ref> in the shape:
+    # the light is used, with no warning; one that no shape refers to is reported.
+    body = (camera_xml() + '<emitter type="area" id="lamp"><rgb name="radiance" value="4"/></emitter>'
+            '<emitter type="area" id="spare"><rgb name="radiance" value="1"/></emitter>'
+            '<bsdf type="diffuse" id="white"><rgb name="reflectance" value="0.78"/></bsdf>'
+            '<shape type="rectangle" id="light"><ref id="lamp"/><ref id="white"/></shape>')
+    scene, warnings = load(tmp_path, body)
+    light = scene.materials[scene.nodes[0].material]
+    assert light == Emissive((4.0, 4.0, 4.0), two_sided=False, surface=Diffuse((0.78,) * 3))
+    assert '<emitter type="area" id="spare">' in only(warnings, "no <shape> refers to")
+    assert len(warnings) == 1
+
+
+def test_wrapping_bsdfs_map_onto_layered_materials(tmp_path):
+    body = (camera_xml()
+            + '<shape type="sphere" id="a"><bsdf type="blendbsdf"><float name="weight" value="0.3"/>'
+              '<bsdf type="diffuse"/><bsdf type="roughconductor"><float name="alpha" value="0.04"/></bsdf></bsdf></shape>'
+            + '<shape type="sphere" id="b"><bsdf type="mask"><rgb name="opacity" value="0.25"/>'
+              '<bsdf type="twosided"><bsdf type="diffuse"/></bsdf></bsdf></shape>'
+            + '<shape type="sphere" id="c"><bsdf type="blendbsdf"><bsdf type="mask"><bsdf type="diffuse"/></bsdf>'
+              '<bsdf type="diffuse"/></bsdf></shape>'
+            + '<shape type="sphere" id="d"><bsdf type="roughdielectric"><string name="distribution" value="cauchy"/>'
+              '</bsdf></shape>')
+    with pytest.raises(SceneError, match='unknown microfacet distribution "cauchy"'):
+        load(tmp_path, body)
+    scene, warnings = load(tmp_path, body.rsplit("<shape", 1)[0])
+    blend = scene.materials[scene.nodes[0].material]
+    assert isinstance(blend, Blend) and blend.weight == pytest.approx(0.3) and blend.first == Diffuse((0.5,) * 3)
+    assert blend.second.roughness == pytest.approx(0.2) and blend.second.distribution == "beckmann"
+    mask = scene.materials[scene.nodes[1].material]
+    assert isinstance(mask, Mask) and mask.opacity == pytest.approx(0.25) and mask.material == Diffuse((0.5,) * 3)
+    assert "a mask inside a blend does not cut" in only(warnings, "inside a blend")
+    assert len(warnings) == 1

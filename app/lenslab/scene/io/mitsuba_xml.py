@@ -45,8 +45,9 @@ from lenslab.optics.thinlens import (FOCAL_LENGTH_RANGE_MM, FOCUS_DISTANCE_RANGE
                                      focal_length_for_fov)
 from lenslab.scene.camera import ThinLensCamera
 from lenslab.scene.materials import Diffuse, Emissive, Material
-from lenslab.scene.lights import Light, PointLight, SunLight
+from lenslab.scene.lights import Light, PointLight, SpotLight, SunLight
 from lenslab.scene.scene import ConstantEnvironment, EnvironmentMap, Node, RenderSettings, Scene, SceneError
+from lenslab.scene.scene import environment_orientation
 from lenslab.scene.shapes import Box, Disk, MeshFile, Rectangle, Sphere
 from lenslab.scene.transform import transform_points
 
@@ -695,6 +696,8 @@ class _Importer:
         elif tag == "ref":
             self.resolve_ref(child)
             self.warn(child, "a top-level <ref> adds nothing: ignored")
+        elif tag == "sampler":
+            self.warn(child, "a sampler belongs inside the <sensor> (Mitsuba 3 ignores it here too): ignored")
         elif tag in OBJECT_TAGS or tag in VALUE_TAGS:
             self.warn(child, "not expected in <scene>: ignored")
         else:
@@ -769,14 +772,21 @@ class _Importer:
             # Declared here and referenced from a shape (<ref id=...> inside it), as Mitsuba's own Cornell
             # box does: whether any shape took it is known once the whole scene is read (run()).
             self._top_level_area_lights.append(node)
+        elif kind == "spot":
+            self.spot(node, p)
         else:
             p.finish(silent=set(p.values))
             self.warn(node, f'emitter "{kind}" is not supported yet: ignored (the scene lacks this light)')
 
     def envmap(self, node: XNode, p: "Props") -> None:
         """Mitsuba's envmap: u = atan2(x, -z) / 2pi in its local frame, so its left edge (u = 0) looks down -Z
-        where ours has the centre column: the same picture turned half a turn, ``rotation_deg`` 180. A
-        ``to_world`` turning it by theta about +Y gives ``rotation_deg`` 180 - theta."""
+        where ours has the centre column: the same picture turned half a turn about +Y. Its ``to_world`` R
+        then turns that frame into the world, so our map's frame turns by R Ry(180), whatever R is: that
+        rotation becomes ``zenith`` and ``rotation_deg`` (scene.environment_orientation). A turn by theta about
+        +Y alone gives ``rotation_deg`` 180 - theta and the zenith straight up.
+
+        Mitsuba applies to_world's inverse to a direction without normalising it, so a to_world that scales
+        or shears distorts its lookups; LensLab keeps the nearest rotation and says so."""
         filename = p.string("filename")
         scale = p.float("scale", 1.0)
         to_world = p.transform("to_world")
@@ -786,19 +796,90 @@ class _Importer:
         path = self.resolve_file(node, filename)
         if not os.path.isfile(path):
             raise node.error(f"environment map not found: {path}")
-        linear = to_world[:3, :3]
-        theta = math.degrees(math.atan2(linear[0, 2], linear[0, 0]))
-        if not np.allclose(linear, mv.rotate_matrix((0, 1, 0), theta)[:3, :3], atol=1e-6):
-            self.warn(node, "to_world other than a turn about +Y is not supported: only its turn about +Y is kept")
-        rotation = (180.0 - theta + 180.0) % 360.0 - 180.0
-        if rotation == -180.0:
-            rotation = 180.0
+        rotation = self._nearest_rotation(node, to_world[:3, :3], "the map")
+        half_turn = np.diag([-1.0, 1.0, -1.0])  # Ry(180), exactly
+        zenith, rotation_deg = environment_orientation(rotation @ half_turn)
+        zenith = tuple(0.0 if abs(v) < 1e-12 else v for v in zenith)  # a turn about +Y keeps (0, 1, 0) exact
         if self._environment_node is not None:
             self.warn(node, "LensLab has one environment: this envmap replaces the "
                       f"{self._environment_node.label()} at {self._environment_node.where()}")
         self.environment = EnvironmentMap(file=self._scene_relative(path), strength=float(max(scale, 0.0)),
-                                          rotation_deg=float(rotation), rows="pole_to_pole")
+                                          rotation_deg=float(rotation_deg), rows="pole_to_pole", zenith=zenith)
         self._environment_node = node
+
+    def _nearest_rotation(self, node: XNode, linear: np.ndarray, what: str) -> np.ndarray:
+        """The rotation nearest a to_world's 3x3 part (from its SVD), with a warning where that part also
+        scales, shears or mirrors (which LensLab's lights and maps do not)."""
+        u, sizes, vt = np.linalg.svd(linear)
+        mirrored = np.linalg.det(u @ vt) < 0
+        if mirrored:
+            u = u @ np.diag([1.0, 1.0, -1.0])
+        if not np.allclose(sizes, 1.0, atol=1e-6):
+            self.warn(node, f"to_world scales or shears {what}: Mitsuba looks directions up through it without "
+                      "normalising them (a distorted picture); LensLab uses its rotation alone")
+        if mirrored:
+            self.warn(node, f"to_world mirrors {what}: LensLab uses the nearest rotation, unmirrored")
+        return u @ vt
+
+    def spot(self, node: XNode, p: "Props") -> None:
+        """Mitsuba's spot (src/emitters/spot.cpp): at to_world's origin, shining along its +Z, its texture's u
+        along +X and v along +Y with v = 0 the image's top row, so the image's top points along -Y: our
+        SpotLight's ``up``. A to_world that scales evenly changes nothing (Mitsuba normalises directions)."""
+        intensity_node = p.take("intensity")
+        if intensity_node is not None and intensity_node.tag == "texture" and \
+                intensity_node.type not in ("srgb", "d65", "uniform"):
+            raise intensity_node.error("a spot's intensity cannot vary over space (Mitsuba refuses it too)")
+        intensity = self.color_of(intensity_node, emission=True) if intensity_node is not None else (1.0,) * 3
+        cutoff = p.float("cutoff_angle", 20.0)
+        beam = p.float("beam_width", cutoff * 3.0 / 4.0)
+        texture_node = p.take("texture")
+        to_world = p.transform("to_world")
+        p.finish()
+        if not 0.0 < cutoff <= 180.0 or beam < 0.0:
+            raise node.error(f"cutoff_angle must be in (0, 180] and beam_width at least 0 "
+                             f"(got {cutoff:g} and {beam:g})")
+        texture = self._spot_texture(texture_node) if texture_node is not None else None
+        linear = to_world[:3, :3]
+        sizes = np.linalg.svd(linear, compute_uv=False)
+        if sizes.max() - sizes.min() > 1e-6 * sizes.max():
+            self.warn(node, "to_world scales unevenly or shears the spot: Mitsuba's cone is then elliptical, "
+                      "LensLab's stays round about to_world's +Z")
+        if texture is not None and np.linalg.det(linear) < 0:
+            self.warn(node, "to_world mirrors the spot: its texture is projected unmirrored")
+        axis, top = linear @ (0.0, 0.0, 1.0), -(linear @ (0.0, 1.0, 0.0))
+        name = self.unique_name(node.attrs.get("id") or "spot")
+        self.lights.append(SpotLight(
+            name=name, position=tuple(float(v) + 0.0 for v in to_world[:3, 3]),  # + 0.0: no -0.0 in files
+            direction=tuple(float(v) + 0.0 for v in axis / np.linalg.norm(axis)), intensity=_clip_rgb(intensity),
+            cutoff_angle_deg=float(cutoff), beam_width_deg=float(beam), texture=texture,
+            up=tuple(float(v) + 0.0 for v in top / np.linalg.norm(top))))
+
+    def _spot_texture(self, node: XNode):
+        """A spot's projected texture. Mitsuba refuses one that does not vary over space."""
+        if node.tag != "texture" or node.type in ("srgb", "d65", "uniform"):
+            raise node.error("a spot's texture must vary over space, such as a bitmap (Mitsuba refuses others)")
+        texture_of = getattr(self, "texture_of", None)
+        if texture_of is not None:
+            texture = texture_of(node)
+            if texture is None:
+                self.warn(node, "this texture cannot be projected by LensLab: the spot shines untextured")
+            return texture
+        # Until the importer reads textures in general: a bitmap's file, as Mitsuba reads it.
+        from lenslab.scene.textures import ImageTexture
+
+        if node.type != "bitmap":
+            self.warn(node, f'texture "{node.type}" cannot be projected by LensLab: the spot shines untextured')
+            return None
+        tp = Props(self, node)
+        filename = tp.string("filename")
+        raw = tp.bool("raw", False)
+        tp.finish()
+        if not filename:
+            raise node.error('a bitmap needs a "filename"')
+        path = self.resolve_file(node, filename)
+        if not os.path.isfile(path):
+            raise node.error(f"texture not found: {path}")
+        return ImageTexture(file=self._scene_relative(path), color_space="linear" if raw else "auto")
 
     # -- shapes -------------------------------------------------------------------------------------------
     def shape(self, node: XNode) -> list[Node]:
@@ -1057,8 +1138,12 @@ class _Importer:
             raise node.error(f"sample_count {spp} is out of range [1, {1 << 24}]")
         self.render.spp = spp
         self.render.seed = int(seed) % (2**31)
-        # independent stays independent; every stratified or low-discrepancy sampler maps onto our Sobol.
+        # independent stays independent; every stratified or low-discrepancy sampler maps onto our Sobol: the
+        # same image, with the noise of a different pattern.
         self.render.sampler = "independent" if node.type == "independent" else "sobol"
+        if node.type != "independent":
+            self.warn(node, f'sampler "{node.type}" is rendered with LensLab\'s Owen-scrambled Sobol sampler: '
+                      "the same image, stratified in its own way")
 
     # -- the camera, last: without a sensor it needs the scene's extent --------------------------------------------
     def make_camera(self) -> ThinLensCamera:
