@@ -148,7 +148,7 @@ Bsdf bsdf_at(SurfaceHit s) {
     b.eta = r2.x;
     b.internal_reflectance = r2.y;
     b.reflectance_table = floatBitsToInt(r2.z);
-    b.beckmann = int(material_row(m, 5).w) == MICROFACET_BECKMANN;
+    b.beckmann = HAS_BECKMANN != 0 && int(material_row(m, 5).w) == MICROFACET_BECKMANN;
     if (HAS_TEXTURES != 0 && r3.w >= 0.0) b.color = texture_rgb(int(r3.w), s.uv);
     if (HAS_TEXTURES != 0 && r4.w >= 0.0) {  // roughness texture: perceptual roughness in the red channel
         float r = texture_rgb(int(r4.w), s.uv).x;

@@ -22,6 +22,9 @@
 #ifndef HAS_POINT_LIGHTS
 #define HAS_POINT_LIGHTS 1
 #endif
+#ifndef HAS_SPOT_LIGHTS
+#define HAS_SPOT_LIGHTS 1
+#endif
 #ifndef HAS_SUN
 #define HAS_SUN 1
 #endif
@@ -33,6 +36,9 @@
 #endif
 #ifndef HAS_NESTED_MATERIALS
 #define HAS_NESTED_MATERIALS 1
+#endif
+#ifndef HAS_BECKMANN
+#define HAS_BECKMANN 1
 #endif
 #ifndef MATERIAL_TYPES
 #define MATERIAL_TYPES 0xFFFF

@@ -18,7 +18,8 @@ import numpy as np
 
 from lenslab.render.buffers import HOLDING_CODES, MATERIAL_CODES, PackedScene, held_materials
 from lenslab.render.gpu_layout import (ENV_MAP, GEOMETRY_ROWS, LIGHT_AREA, LIGHT_ENVIRONMENT, LIGHT_POINT, LIGHT_ROWS,
-                                       LIGHT_SUN, MATERIAL_BLEND, MATERIAL_ROWS)
+                                       LIGHT_SPOT, LIGHT_SUN, MATERIAL_BLEND, MATERIAL_ROWS,
+                                       MICROFACET_BECKMANN)
 
 ALL_MATERIAL_TYPES = frozenset(MATERIAL_CODES.values())
 
@@ -33,6 +34,7 @@ class KernelFeatures:
     environment_light: bool = True  # next-event estimation may choose the environment
     area_lights: bool = True
     point_lights: bool = True
+    spot_lights: bool = True
     sun: bool = True
     # How next-event estimation chooses a light (glsl/lights.glsl): by what each brings to the shading point
     # (a few lights), or by power (many). The general kernel has both and asks the uniform lights_at_point.
@@ -42,6 +44,7 @@ class KernelFeatures:
     # Materials that hold materials (a light with a surface, blends, masks, bump and normal maps): the
     # resolve loop of glsl/bsdf.glsl.
     nested_materials: bool = True
+    beckmann: bool = True  # a rough material with the Beckmann distribution (else GGX alone)
 
     def defines(self) -> dict[str, int]:
         return {
@@ -51,10 +54,12 @@ class KernelFeatures:
             "HAS_ENVIRONMENT_LIGHT": int(self.environment_light),
             "HAS_AREA_LIGHTS": int(self.area_lights),
             "HAS_POINT_LIGHTS": int(self.point_lights),
+            "HAS_SPOT_LIGHTS": int(self.spot_lights),
             "HAS_SUN": int(self.sun),
             "HAS_LIGHTS_AT_POINT": int(self.lights_at_point),
             "HAS_LIGHTS_BY_POWER": int(self.lights_by_power),
             "HAS_NESTED_MATERIALS": int(self.nested_materials),
+            "HAS_BECKMANN": int(self.beckmann),
             "MATERIAL_TYPES": sum(1 << code for code in self.material_types),
         }
 
@@ -82,9 +87,11 @@ def scene_features(packed: PackedScene) -> KernelFeatures:
         environment_light=LIGHT_ENVIRONMENT in light_kinds,
         area_lights=LIGHT_AREA in light_kinds,
         point_lights=LIGHT_POINT in light_kinds,
+        spot_lights=LIGHT_SPOT in light_kinds,
         sun=LIGHT_SUN in light_kinds,
         lights_at_point=bool(uniforms["lights_at_point"]),
         lights_by_power=not uniforms["lights_at_point"],
         material_types=frozenset(int(code) for code in records[:, 0, 3]),
         nested_materials=bool(((records[:, 2, 0] >= 0) & np.isin(records[:, 0, 3], HOLDING_CODES)).any()),
+        beckmann=bool(((records[:, 5, 3] == MICROFACET_BECKMANN) & ~np.isin(records[:, 0, 3], HOLDING_CODES)).any()),
     )
