@@ -4,12 +4,15 @@
 //
 // The light table (render/buffers.py) holds LIGHT_ROWS (three) vec4 per light:
 //   (type, primitive index as float bits, cumulative power share, power share), (position | direction, -),
-//   (rgb, -). The type is one of LIGHT_AREA, LIGHT_POINT, LIGHT_SUN, LIGHT_ENVIRONMENT (render/gpu_layout.py).
+//   (rgb, -). The type is one of LIGHT_AREA, LIGHT_POINT, LIGHT_SPOT, LIGHT_SUN, LIGHT_ENVIRONMENT
+//   (render/gpu_layout.py). A spot holds cos(cutoff) and cos(beam) in rows 1 and 2's w, and in row 0's second
+//   slot the offset of its other parameters in image_data (spot_intensity).
 
 uniform int env_type;           // ENV_CONSTANT (env_radiance) or ENV_MAP (a lat-long map)
 uniform float env_strength;
 uniform int env_texture;        // the map's texture record
-uniform float env_rotation;     // radians about +Y
+uniform mat3 env_world_to_map;  // world directions into the panorama's own frame (a rotation: its transpose
+                                // takes them back); render/environment.py
 uniform int env_dist_offset;    // sampling tables in image_data (render/environment.py)
 uniform ivec2 env_size;           // the map's pixels
 uniform ivec2 env_table_size;     // cells of its sampling tables (at most 1024 x 512)
@@ -146,16 +149,19 @@ float area_light_pdf(int prim, vec3 p, vec3 q, vec3 nq, float pmf) {
 }
 
 // -- the environment ----------------------------------------------------------------------------------
-vec2 environment_uv(vec3 d) {
-    float phi = atan(d.x, -d.z) - env_rotation;
+// The lat-long mapping works in the panorama's own frame; the lookup, the pdf and the sampling below all
+// pass through these two, so any rotation of the map keeps them consistent (a rotation keeps solid angle).
+vec2 environment_uv(vec3 world_dir) {
+    vec3 d = env_world_to_map * world_dir;
+    float phi = atan(d.x, -d.z);
     return vec2(fract(0.5 + phi * (0.5 * INV_PI)), acos(clamp(d.y, -1.0, 1.0)) * INV_PI);
 }
 
 vec3 environment_direction(vec2 uv) {
-    float phi = (uv.x - 0.5) * 2.0 * PI + env_rotation;
+    float phi = (uv.x - 0.5) * 2.0 * PI;
     float theta = uv.y * PI;
     float s = sin(theta);
-    return vec3(s * sin(phi), cos(theta), -s * cos(phi));
+    return vec3(s * sin(phi), cos(theta), -s * cos(phi)) * env_world_to_map;  // the transpose: back to the world
 }
 
 float env_table(int i) { return uintBitsToFloat(image_data[env_dist_offset + i]); }
@@ -208,6 +214,27 @@ vec3 sample_environment_direction(vec2 u) {
     float c0 = env_table(base + col), c1 = env_table(base + col + 1);
     float uu = (float(col) + (u.x - c0) / max(c1 - c0, 1e-12)) / float(w);
     return environment_direction(vec2(uu, clamp(v, 0.0, 1.0)));
+}
+
+// -- spots --------------------------------------------------------------------------------------------
+// Mitsuba 3's spot (src/emitters/spot.cpp): full intensity within the beam, then linear in the angle down to
+// zero at the cutoff, times an optional texture projected through the cone (scene/lights.py's SpotLight).
+float spot_param(int at, int i) { return uintBitsToFloat(image_data[at + i]); }
+vec3 spot_vector(int at, int i) { return vec3(spot_param(at, i), spot_param(at, i + 1), spot_param(at, i + 2)); }
+
+// The radiant intensity (W/sr) spot light (l0, l1, l2) sends along the unit direction dir, away from it.
+vec3 spot_intensity(vec4 l0, vec4 l1, vec4 l2, vec3 dir) {
+    int at = floatBitsToInt(l0.y);  // SPOT_PARAMS floats: axis, right, top, cutoff, slope, 1/(2 tan cutoff), texture
+    float cos_theta = dot(spot_vector(at, 0), dir);
+    if (cos_theta <= l1.w) return vec3(0.0);  // at or beyond the cutoff
+    float falloff = cos_theta >= l2.w ? 1.0 : (spot_param(at, 9) - acos(cos_theta)) * spot_param(at, 10);
+    vec3 intensity = l2.xyz * falloff;
+    int tex = int(spot_param(at, 12));
+    if (tex >= 0) {  // the slide: u along right, v along top, over the square the cutoff's tangent spans
+        vec2 across = vec2(dot(spot_vector(at, 3), dir), dot(spot_vector(at, 6), dir));
+        intensity *= texture_rgb(tex, 0.5 + across * (spot_param(at, 11) / cos_theta));
+    }
+    return intensity;
 }
 
 // -- the sun ------------------------------------------------------------------------------------------
@@ -271,6 +298,17 @@ bool sample_light(vec3 p, LightChoice choice, vec2 u, out LightSample ls) {
         ls.pdf = pmf;
         ls.delta = true;
         return d2 > 0.0;
+    }
+    if (HAS_SPOT_LIGHTS != 0 && type == LIGHT_SPOT) {
+        vec3 to_l = l1.xyz - p;
+        float d2 = dot(to_l, to_l);
+        if (!(d2 > 0.0)) return false;
+        ls.dist = sqrt(d2);
+        ls.wi = to_l / ls.dist;
+        ls.radiance = spot_intensity(l0, l1, l2, -ls.wi) / d2;
+        ls.pdf = pmf;
+        ls.delta = true;
+        return max_component(ls.radiance) > 0.0;
     }
     if (HAS_SUN != 0 && type == LIGHT_SUN) {
         if (sun_one_minus_cos <= 0.0) {

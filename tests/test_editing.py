@@ -20,7 +20,7 @@ from lenslab.scene import editing
 from lenslab.scene.camera import ThinLensCamera
 from lenslab.scene.editable import EditableScene, unique_name
 from lenslab.scene.events import SceneChange
-from lenslab.scene.lights import PointLight, SunLight
+from lenslab.scene.lights import PointLight, SpotLight, SunLight
 from lenslab.scene.materials import Diffuse, Emissive
 from lenslab.scene.scene import EnvironmentMap, Node, Scene
 from lenslab.scene.shapes import Box, MeshFile, Rectangle, Sphere
@@ -159,8 +159,11 @@ def test_a_point_light_goes_above_the_point_of_focus_and_a_sun_shines_over_the_c
     assert sun.direction == pytest.approx((0.5, 1.0, 0.7))
     model.scene.lights.append(sun)
     assert editing.new_light(model, "sun").name == "sun.001"
+    spot = editing.new_light(model, "spot")  # where the point light goes, aimed down at the point of focus
+    assert isinstance(spot, SpotLight) and spot.position == pytest.approx(point.position)
+    assert spot.direction == pytest.approx((0.0, -1.0, 0.0))
     with pytest.raises(ValueError):
-        editing.new_light(model, "spot")
+        editing.new_light(model, "projector")
 
 
 def test_new_objects_go_into_a_selected_group_and_a_new_material_is_a_grey_diffuse():

@@ -82,12 +82,12 @@ def test_a_uniform_no_shader_declares_is_refused_by_name(renderer):
 
 
 def test_a_specialised_kernel_skips_the_uniforms_it_dropped(renderer):
-    scene = open_scene("cornell_box")  # no environment map: its kernel never reads env_rotation
+    scene = open_scene("cornell_box")  # no environment map: its kernel never reads env_strength
     session = RenderSession(renderer, scene, width=16, height=16)
     try:
-        dropped = "env_rotation" not in session.program  # Mesa drops it; NVIDIA's compiler keeps it, unread
-        renderer.set_uniforms(session.program, {"env_rotation": 1.0})  # declared: accepted either way
+        dropped = "env_strength" not in session.program  # Mesa drops it; NVIDIA's compiler keeps it, unread
+        renderer.set_uniforms(session.program, {"env_strength": 1.0})  # declared: accepted either way
         if not dropped:
-            assert session.program["env_rotation"].value == pytest.approx(1.0)
+            assert session.program["env_strength"].value == pytest.approx(1.0)
     finally:
         session.release()

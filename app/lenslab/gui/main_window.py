@@ -168,9 +168,11 @@ class MainWindow(QMainWindow):
         act["add_group"] = a("Group", lambda: self.add_primitive("group"), icon="group")
         act["add_sphere"] = a("Sphere", lambda: self.add_primitive("sphere"), icon="sphere")
         act["add_box"] = a("Box", lambda: self.add_primitive("box"), icon="box")
+        act["add_cylinder"] = a("Cylinder", lambda: self.add_primitive("cylinder"), icon="cylinder")
         act["add_rectangle"] = a("Rectangle", lambda: self.add_primitive("rectangle"), icon="rectangle")
         act["add_light"] = a("Area Light", lambda: self.add_primitive("light"), icon="light")
         act["add_point_light"] = a("Point Light", lambda: self.add_light("point"), icon="light")
+        act["add_spot_light"] = a("Spot Light", lambda: self.add_light("spot"), icon="light")
         act["add_sun"] = a("Sun", lambda: self.add_light("sun"), icon="light")
         act["new_material"] = a("New Material", self.new_material, icon="material")
         act["duplicate"] = a("&Duplicate", self.duplicate_selection, "Ctrl+D")
@@ -326,7 +328,8 @@ class MainWindow(QMainWindow):
         edit.addAction(act["redo"])
         edit.addSeparator()
         add = edit.addMenu("&Add")
-        for name in ("add_group", "add_sphere", "add_box", "add_rectangle", "add_light", "add_point_light", "add_sun"):
+        for name in ("add_group", "add_sphere", "add_box", "add_cylinder", "add_rectangle", "add_light",
+                     "add_point_light", "add_spot_light", "add_sun"):
             add.addAction(act[name])
         add.addSeparator()
         add.addAction(act["import_mesh"])

@@ -40,12 +40,16 @@ from lenslab.scene.materials import MATERIAL_TYPES, Diffuse, Material
 from lenslab.scene.textures import TEXTURE_TYPES, Texture
 from lenslab.scene.io.meshes import MESH_SUFFIXES
 from lenslab.scene.scene import ENVIRONMENT_TYPES, Environment, Node
-from lenslab.scene.shapes import SHAPE_TYPES, Box, Disk, Rectangle, Relief, Shape, Sphere
+from lenslab.scene.shapes import SHAPE_TYPES, Box, Cylinder, Disk, Rectangle, Relief, Shape, Sphere
 
 #: Polymorphic slots: the base class picks the registry of concrete types to choose from.
 TAGGED_TYPES: dict[type, dict[str, type]] = {Shape: SHAPE_TYPES, Material: MATERIAL_TYPES,
                                              Environment: ENVIRONMENT_TYPES, Light: LIGHT_TYPES,
                                              Texture: TEXTURE_TYPES}
+#: What each kind of light is, under its name in the property editor.
+LIGHT_SUBTITLES = {"point": "Point light: intensity in W/sr, the same in every direction",
+                   "spot": "Spot light: intensity in W/sr along its axis, fading to nothing at the cutoff angle",
+                   "sun": "Sun: parallel light from a direction, irradiance in W/m²"}
 
 #: Fields whose RGB triple is a colour (the scene model's RGB alias is a plain tuple, so the name tells).
 COLOUR_FIELDS = {"albedo", "radiance", "color", "colour", "reflectance", "transmittance", "specular", "tint",
@@ -105,15 +109,16 @@ def convert_type(old: Any, new_cls: type) -> Any:
 
 def _same_extent(old: Any, new_cls: type) -> dict[str, Any]:
     """Size fields that keep a shape's extent when its type changes (a 0.3 m box becomes a 0.3 m sphere)."""
-    half = {Sphere: lambda o: o.radius, Disk: lambda o: o.radius, Box: lambda o: max(o.size) / 2,
+    half = {Sphere: lambda o: o.radius, Disk: lambda o: o.radius, Cylinder: lambda o: max(o.radius, o.height / 2),
+            Box: lambda o: max(o.size) / 2,
             Rectangle: lambda o: max(o.size) / 2, Relief: lambda o: max(o.size) / 2}.get(type(old))
     if half is None:
         return {}
     r = float(half(old))
     if isinstance(old, (Rectangle, Relief)) and new_cls in (Rectangle, Relief):
         return {"size": tuple(old.size)}  # a floor becomes a relief of the same extent, and back
-    return {Sphere: {"radius": r}, Disk: {"radius": r}, Box: {"size": (2 * r,) * 3},
-            Rectangle: {"size": (2 * r, 2 * r)}, Relief: {"size": (2 * r, 2 * r)}}.get(new_cls, {})
+    return {Sphere: {"radius": r}, Disk: {"radius": r}, Cylinder: {"radius": r, "height": 2 * r},
+            Box: {"size": (2 * r,) * 3}, Rectangle: {"size": (2 * r, 2 * r)}, Relief: {"size": (2 * r, 2 * r)}}.get(new_cls, {})
 
 
 class FieldEditor:
@@ -192,8 +197,7 @@ class PropertyEditor(QWidget):
             self._build_material(layout, obj)
         elif kind == "light":
             self.title.setText(obj.name)
-            self.subtitle.setText("Sun: parallel light from a direction, irradiance in W/m²" if obj.type_name == "sun"
-                                  else "Point light: intensity in W/sr, the same in every direction")
+            self.subtitle.setText(LIGHT_SUBTITLES.get(obj.type_name, ""))
             section = Section("Light")
             form = self._form()
             section.add(form)

@@ -16,13 +16,14 @@ from lenslab.gui.commands import MoveNodeCommand, RenameMaterialCommand
 from lenslab.gui.document import listen
 from lenslab.gui.properties import display_rgb
 from lenslab.scene.editing import can_move, reparented_transform
-from lenslab.scene.shapes import Box, MeshFile, Rectangle, Sphere
+from lenslab.scene.shapes import Box, Cylinder, MeshFile, Rectangle, Sphere
 
 NODE_MIME = "application/x-lenslab-node-paths"
 
 OBJECTS = ("objects",)
 MATERIALS = ("materials",)
-LIGHTS = ("lights",)  # point lights and suns; area lights are objects with an emissive material
+LIGHTS = ("lights",)  # point lights, spots and suns; area lights are objects with an emissive material
+LIGHT_KIND_NAMES = {"point": "point light", "spot": "spot light", "sun": "sun"}
 GROUPS = {OBJECTS: "Objects", MATERIALS: "Materials", LIGHTS: "Lights"}
 TARGET_KINDS = ("camera", "environment", "render", "material", "node", "light")  # rows that select something
 
@@ -183,7 +184,8 @@ class SceneTreeModel(QAbstractItemModel):
         shape = node.shape
         if shape is None:
             return "group"
-        return {Sphere: "sphere", Box: "box", Rectangle: "rectangle", MeshFile: "mesh"}.get(type(shape), "mesh")
+        return {Sphere: "sphere", Box: "box", Cylinder: "cylinder", Rectangle: "rectangle",
+                MeshFile: "mesh"}.get(type(shape), "mesh")
 
     def _tooltip(self, kind, key, obj) -> str | None:
         if kind == "node":
@@ -194,9 +196,9 @@ class SceneTreeModel(QAbstractItemModel):
             parts.append(f"material: {obj.material or 'default grey'}")
             return "<br>".join(parts)
         if kind == "light":
-            return f"<b>{obj.name}</b><br>{'sun' if obj.type_name == 'sun' else 'point light'}"
+            return f"<b>{obj.name}</b><br>{LIGHT_KIND_NAMES.get(obj.type_name, obj.type_name)}"
         if key == LIGHTS:
-            return "Point lights and suns. Area lights are objects with an emissive material."
+            return "Point lights, spots and suns. Area lights are objects with an emissive material."
         if kind == "material":
             users = len(self.doc.model.material_users(key[1]))
             return f"<b>{key[1]}</b><br>{obj.type_name} · used by {users} node{'s' * (users != 1)}"
@@ -374,7 +376,8 @@ class SceneTreeView(QTreeView):
 
 def node_context_menu(parent, actions: dict) -> QMenu:
     menu = QMenu(parent)
-    for name in ("add_group", "add_sphere", "add_box", "add_rectangle", "add_light", "add_point_light", "add_sun",
+    for name in ("add_group", "add_sphere", "add_box", "add_rectangle", "add_light", "add_point_light", "add_spot_light",
+                 "add_sun",
                  "import_mesh", None,
                  "new_material", None, "focus_on_selection", "rename", "duplicate", "delete"):
         if name is None:

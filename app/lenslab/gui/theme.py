@@ -97,6 +97,7 @@ _ICONS = {
     "sphere": '<circle cx="12" cy="12" r="8" {s}/><ellipse cx="12" cy="12" rx="8" ry="3" {s}/>',
     "box": '<path d="M12 3 L20 7.5 V16.5 L12 21 L4 16.5 V7.5 Z M4 7.5 L12 12 L20 7.5 M12 12 V21" {s}/>',
     "rectangle": '<path d="M3 16 L9 7 H21 L15 16 Z" {s}/>',
+    "cylinder": '<ellipse cx="12" cy="6" rx="7" ry="2.5" {s}/><path d="M5 6 V18 A7 2.5 0 0 0 19 18 V6" {s}/>',
     "mesh": '<path d="M12 3 L21 18 H3 Z M12 3 L12 13 M3 18 L12 13 L21 18 M7.5 10.5 L12 13 L16.5 10.5" {s}/>',
     "group": '<path d="M3 6 H10 L12 8 H21 V18 H3 Z" {s}/>',
     "light": '<path d="M9 17 H15 M10 20 H14 M12 3 A6 6 0 0 1 15.5 13.8 C14.6 14.6 14.5 15.5 14.5 16 H9.5 '

@@ -32,9 +32,10 @@ from lenslab.render.textures import TextureTable, read_texture_image
 from lenslab.scene.flatten import FlatScene
 from lenslab.scene.materials import (Blend, BumpMap, Conductor, Diffuse, Dielectric, Emissive, Mask, Material,
                                      NormalMap, Plastic, ThinDielectric, inner_materials)
-from lenslab.scene.lights import Light, PointLight, SunLight
+from lenslab.render.gpu_layout import LIGHT_SPOT, SPOT_PARAMS
+from lenslab.scene.lights import Light, PointLight, SpotLight, SunLight
 from lenslab.scene.scene import ConstantEnvironment, Environment, EnvironmentMap, SceneError
-from lenslab.scene.textures import InlineImageTexture
+from lenslab.scene.textures import Checkerboard, InlineImageTexture
 
 # Each material class's type code in its GPU record.
 MATERIAL_CODES = {Diffuse: MATERIAL_DIFFUSE, Emissive: MATERIAL_EMISSIVE, Conductor: MATERIAL_CONDUCTOR,
@@ -206,6 +207,40 @@ class _LightEntry:
     rgb: tuple = (0.0, 0.0, 0.0)
     falloff: float = 1.0 / (16.0 * math.pi)  # a point light: intensity P / 4 pi over d^2, facing it
     reach2: float = 1e-12
+    w: tuple = (0.0, 0.0)  # the fourth values of rows 1 and 2 (a spot's cosines)
+
+
+def _spot_light_entry(light: SpotLight, textures: TextureTable) -> _LightEntry:
+    """A spot's row: (position, cos cutoff) in row 1, (intensity, cos beam) in row 2, and its SPOT_PARAMS in
+    image_data at the offset row 0 holds where an area light holds its primitive (glsl/lights.glsl's
+    spot_intensity).
+
+    Its power is the intensity times the falloff integrated over the sphere (SpotLight.weighted_solid_angle),
+    times the texture's mean where that is known without reading an image file again (only a weight for
+    choosing lights: any positive value stays unbiased). In its cone it brings a surface facing it I / d^2, as
+    a point light of the same intensity does, so its falloff is a quarter of that per unit of power."""
+    right, top, axis = light.frame()
+    cutoff, beam = light.cutoff_and_beam_rad()
+    slope = 1.0 / (cutoff - beam) if cutoff > beam else 0.0  # a hard edge never reaches the ramp
+    params = np.array([*axis, *right, *top, cutoff, slope, 0.5 / math.tan(cutoff), textures.index_of(light.texture)],
+                      np.float32)
+    assert params.size == SPOT_PARAMS
+    solid_angle = light.weighted_solid_angle()
+    power = _luminance(light.intensity) * solid_angle * _texture_mean(light.texture)
+    return _LightEntry(LIGHT_SPOT, power, prim=textures.add_floats(params), vector=tuple(light.position),
+                       rgb=tuple(light.intensity), falloff=0.25 / solid_angle,
+                       w=(math.cos(cutoff), math.cos(beam)))
+
+
+def _texture_mean(texture) -> float:
+    """The mean luminance of a spot's texture where it is at hand (a checkerboard, pixels in memory); 1 for an
+    image file, which the texture table reads."""
+    if isinstance(texture, Checkerboard):
+        return 0.5 * (_luminance(texture.color_a) + _luminance(texture.color_b))
+    if isinstance(texture, InlineImageTexture) and texture.pixels is not None:
+        pixels = np.asarray(texture.pixels, np.float64)[..., :3]
+        return float(0.2126 * pixels[..., 0].mean() + 0.7152 * pixels[..., 1].mean() + 0.0722 * pixels[..., 2].mean())
+    return 1.0
 
 
 def _area_light_entries(flat: FlatScene, power: np.ndarray) -> list[_LightEntry]:
@@ -231,8 +266,8 @@ def _environment_uniforms(environment: Environment, textures: TextureTable, scen
                           importance: bool = True):
     """(uniform values, power for light selection, sampling tables to append to image_data)."""
     uniforms = {"env_type": ENV_CONSTANT, "env_radiance": (0.0, 0.0, 0.0), "env_strength": 1.0, "env_texture": -1,
-                "env_rotation": 0.0, "env_dist_offset": 0, "env_size": (1, 1), "env_table_size": (1, 1),
-                "env_rows_pole_to_pole": 0}
+                "env_world_to_map": _mat3_uniform(np.eye(3)), "env_dist_offset": 0, "env_size": (1, 1),
+                "env_table_size": (1, 1), "env_rows_pole_to_pole": 0}
     if isinstance(environment, ConstantEnvironment):
         uniforms["env_radiance"] = tuple(float(v) for v in environment.radiance)
         return uniforms, infinite_light_power(4.0 * math.pi * _luminance(environment.radiance), scene_radius)
@@ -251,13 +286,18 @@ def _environment_uniforms(environment: Environment, textures: TextureTable, scen
         uniforms.update(
             env_type=ENV_MAP, env_strength=float(environment.strength),
             env_texture=textures.index_of(InlineImageTexture(pixels=rgb, name=str(path))),
-            env_rotation=math.radians(environment.rotation_deg),
+            env_world_to_map=_mat3_uniform(environment.world_from_map().T),
             env_dist_offset=textures.add_floats(distribution.packed()), env_size=(rgb.shape[1], rgb.shape[0]),
             env_table_size=(distribution.pdf.shape[1], distribution.pdf.shape[0]),
             env_rows_pole_to_pole=int(environment.rows == "pole_to_pole"),
         )
         return uniforms, environment_power(rgb, environment.strength, scene_radius)
     raise TypeError(f"no GPU packing for environment type {type(environment).__name__}")
+
+
+def _mat3_uniform(matrix: np.ndarray) -> tuple[float, ...]:
+    """A 3x3 matrix as a GLSL mat3 uniform takes it: nine floats, column by column."""
+    return tuple(float(v) for v in np.asarray(matrix, float).flatten(order="F"))
 
 
 def _reference_budget_warning(kdtree: KdTree) -> str:
@@ -313,6 +353,8 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
         if isinstance(light, PointLight):
             entries.append(_LightEntry(LIGHT_POINT, 4.0 * math.pi * _luminance(light.intensity),
                                        vector=light.position, rgb=light.intensity))
+        elif isinstance(light, SpotLight):
+            entries.append(_spot_light_entry(light, textures))
         elif isinstance(light, SunLight):
             half_angle = math.radians(light.angular_diameter_deg) / 2
             sun_uniforms = {"sun_direction": light.unit_direction(), "sun_one_minus_cos": 2 * math.sin(half_angle / 2) ** 2,
@@ -330,6 +372,7 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
     for row, (entry, pmf, cdf) in enumerate(zip(entries, pmfs, np.cumsum(pmfs))):
         lights_table[row, 0] = (entry.kind, np.int32(entry.prim).view(np.float32), cdf, pmf)
         lights_table[row, 1, :3], lights_table[row, 2, :3] = entry.vector, entry.rgb
+        lights_table[row, 1, 3], lights_table[row, 2, 3] = entry.w
         if entry.kind == LIGHT_AREA:
             light_of_prim[entry.prim] = row
     if len(entries):

@@ -2,7 +2,10 @@
 them (pbrt-v4's PiecewiseConstant2D over (u, v), weighted by sin(theta) for the sphere's area).
 
 Directions map to (u, v) in [0, 1)^2 with v = 0 straight up (+Y, the image's top row) and u = 0.5 looking
-down -Z; ``rotation`` (radians) turns the panorama about +Y. The same mapping is in glsl/lights.glsl.
+down -Z, in the panorama's own frame; ``rotation`` orients that frame in the world: the 3x3
+``EnvironmentMap.world_from_map()``, or a number, radians about +Y as ``rotation_deg`` turns it. The GPU gets the
+transpose (glsl/lights.glsl's ``env_world_to_map``) and applies it in the lookup, the pdf and the sampling alike.
+The same mapping is in glsl/lights.glsl.
 """
 
 from __future__ import annotations
@@ -13,19 +16,32 @@ from dataclasses import dataclass
 import numpy as np
 
 
-def direction_to_uv(d: np.ndarray, rotation: float = 0.0) -> np.ndarray:
-    d = np.asarray(d, float)
-    phi = np.arctan2(d[..., 0], -d[..., 2]) - rotation
+Rotation = float | np.ndarray  # a turn about +Y in radians, or a 3x3 rotation matrix
+
+
+def world_from_map(rotation: Rotation = 0.0) -> np.ndarray:
+    """The 3x3 rotation from the panorama's frame to the world: ``rotation`` itself, or for a number the turn
+    about +Y that ``rotation_deg`` (in radians here) means: clockwise seen from above, -rotation right-handed."""
+    if np.ndim(rotation) == 2:
+        return np.asarray(rotation, float)
+    c, s = math.cos(rotation), math.sin(rotation)
+    return np.array([[c, 0.0, -s], [0.0, 1.0, 0.0], [s, 0.0, c]])
+
+
+def direction_to_uv(d: np.ndarray, rotation: Rotation = 0.0) -> np.ndarray:
+    local = np.asarray(d, float) @ world_from_map(rotation)  # each row times the matrix: its transpose applied
+    phi = np.arctan2(local[..., 0], -local[..., 2])
     u = np.mod(0.5 + phi / (2 * np.pi), 1.0)
-    v = np.arccos(np.clip(d[..., 1], -1, 1)) / np.pi
+    v = np.arccos(np.clip(local[..., 1], -1, 1)) / np.pi
     return np.stack([u, v], axis=-1)
 
 
-def uv_to_direction(uv: np.ndarray, rotation: float = 0.0) -> np.ndarray:
-    phi = (uv[..., 0] - 0.5) * 2 * np.pi + rotation
+def uv_to_direction(uv: np.ndarray, rotation: Rotation = 0.0) -> np.ndarray:
+    phi = (uv[..., 0] - 0.5) * 2 * np.pi
     theta = uv[..., 1] * np.pi
     s = np.sin(theta)
-    return np.stack([s * np.sin(phi), np.cos(theta), -s * np.cos(phi)], axis=-1)
+    local = np.stack([s * np.sin(phi), np.cos(theta), -s * np.cos(phi)], axis=-1)
+    return local @ world_from_map(rotation).T
 
 
 def luminance(rgb: np.ndarray) -> np.ndarray:
@@ -71,7 +87,7 @@ class EnvironmentDistribution:
         pdf = func / func.sum() * (h * w)
         return cls(pdf.astype(np.float32), marginal.astype(np.float32), conditional.astype(np.float32))
 
-    def pdf_direction(self, d: np.ndarray, rotation: float = 0.0) -> np.ndarray:
+    def pdf_direction(self, d: np.ndarray, rotation: Rotation = 0.0) -> np.ndarray:
         """Density per steradian of choosing direction d."""
         h, w = self.pdf.shape
         uv = direction_to_uv(d, rotation)

@@ -35,12 +35,18 @@ MICROFACET_BECKMANN = 1
 # Entries of a rough plastic coating's reflectance table (render/fresnel.py), over cos theta in [0, 1].
 ROUGH_TABLE_SIZE = 64
 
-# -- Textures: TEXTURE_ROWS vec4 rows per texture record (render/textures.py, glsl/textures.glsl).
+# -- Textures: TEXTURE_ROWS vec4 rows per texture record (render/textures.py, glsl/textures.glsl): row 0 its
+# type, rows 1-2 its uv transform, rows 3-4 what its type needs.
 TEXTURE_IMAGE = 0
 TEXTURE_CHECKER = 1
-TEXTURE_ROWS = 4
-TEXELS_HALF = 0  # how an image's texels are packed (record row 1, z): two half-float uints a texel
+TEXTURE_ROWS = 5
+TEXELS_HALF = 0  # how an image's texels are packed (record row 3, x): two half-float uints a texel
 TEXELS_FLOAT = 1  # three 32-bit float uints a texel, for values beyond the half-float range
+TEXTURE_WRAP_REPEAT = 0  # an image beyond [0, 1]^2 (record row 3, y), as scene/textures.WRAP_MODES
+TEXTURE_WRAP_MIRROR = 1
+TEXTURE_WRAP_CLAMP = 2
+TEXTURE_FILTER_BILINEAR = 0  # record row 3, z, as scene/textures.FILTERS
+TEXTURE_FILTER_NEAREST = 1
 
 # -- Geometry: vec4 rows per primitive in the geometry buffer, per triangle in the shading buffer.
 GEOMETRY_ROWS = 3
@@ -55,7 +61,12 @@ LIGHT_AREA = 0
 LIGHT_POINT = 1
 LIGHT_SUN = 2
 LIGHT_ENVIRONMENT = 3
+LIGHT_SPOT = 4
 LIGHT_ROWS = 3
+# A spot's parameters beyond its three rows, in image_data at the offset its row 0 holds (buffers.py's
+# _spot_light_entry, glsl/lights.glsl's spot_intensity): axis, right, top (3 each), cutoff angle, the ramp's
+# slope 1 / (cutoff - beam), 1 / (2 tan cutoff), texture record (-1: none).
+SPOT_PARAMS = 13
 # The lights the LightPlaces uniform block holds: next-event estimation chooses among at most this many by
 # what each brings to the shading point.
 LIGHT_PLACES = 32

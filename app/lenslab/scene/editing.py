@@ -23,17 +23,17 @@ import numpy as np
 from lenslab.optics.thinlens import FOCUS_DISTANCE_RANGE_M
 from lenslab.scene.camera import CameraFrame
 from lenslab.scene.editable import EditableScene
-from lenslab.scene.lights import Light, PointLight, SunLight
+from lenslab.scene.lights import Light, PointLight, SpotLight, SunLight
 from lenslab.scene.materials import Diffuse, Emissive, Material
 from lenslab.scene.scene import EnvironmentMap, Node, Scene
-from lenslab.scene.shapes import Box, MeshFile, Rectangle, Sphere
+from lenslab.scene.shapes import Box, Cylinder, MeshFile, Rectangle, Sphere
 from lenslab.scene.textures import ImageTexture
 from lenslab.scene.transform import Transform
 
 #: What Edit > Add makes; "light" is an area light (an emissive rectangle), "group" a node without a shape.
-PRIMITIVES = ("group", "sphere", "box", "rectangle", "light")
+PRIMITIVES = ("group", "sphere", "box", "cylinder", "rectangle", "light")
 #: The lights that are not shapes.
-LIGHTS = ("point", "sun")
+LIGHTS = ("point", "spot", "sun")
 
 
 @dataclass(frozen=True)
@@ -67,6 +67,9 @@ def new_primitive(model: EditableScene, kind: str) -> NewObject:
         return NewObject(Node(model.unique_node_name("sphere"), Transform(translate=at), Sphere(radius=size / 2)))
     if kind == "box":
         return NewObject(Node(model.unique_node_name("box"), Transform(translate=at), Box(size=(size, size, size))))
+    if kind == "cylinder":  # standing: its axis (local +Z) turned to +Y, up in a LensLab scene
+        return NewObject(Node(model.unique_node_name("cylinder"), Transform(translate=at, rotate_deg=(-90.0, 0.0, 0.0)),
+                              Cylinder(radius=size / 2, height=size)))
     if kind == "rectangle":
         return NewObject(Node(model.unique_node_name("rectangle"), Transform(translate=at),
                               Rectangle(size=(size, size))))
@@ -80,8 +83,8 @@ def new_primitive(model: EditableScene, kind: str) -> NewObject:
 
 
 def new_light(model: EditableScene, kind: str) -> Light:
-    """A point light above the point of focus, bright enough for an object of the new-object size there, or a
-    sun from behind the camera's right shoulder."""
+    """A point light above the point of focus, bright enough for an object of the new-object size there, a spot
+    there aimed at it, or a sun from behind the camera's right shoulder."""
     frame = model.scene.camera.frame()
     if kind == "sun":
         direction = _rounded(0.5 * frame.right + frame.up + 0.7 * frame.back, 4)
@@ -90,6 +93,11 @@ def new_light(model: EditableScene, kind: str) -> Light:
         size = object_size(frame)
         at = _rounded(frame.focus_point() + frame.up * size * 4, 4)
         return PointLight(name=model.unique_light_name("point light"), position=at, intensity=(size * 40.0,) * 3)
+    if kind == "spot":
+        size = object_size(frame)
+        at = _rounded(frame.focus_point() + frame.up * size * 4, 4)
+        return SpotLight(name=model.unique_light_name("spot"), position=at, direction=_rounded(-frame.up, 4),
+                         up=_rounded(frame.back, 4), intensity=(size * 40.0,) * 3)
     raise ValueError(f"unknown light {kind!r} (expected one of {', '.join(LIGHTS)})")
 
 

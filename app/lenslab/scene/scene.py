@@ -7,6 +7,7 @@ tree into world-space arrays of triangles and spheres; the GUI edits the datacla
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, ClassVar, Iterator
@@ -68,8 +69,10 @@ class ConstantEnvironment(Environment):
 class EnvironmentMap(Environment):
     """An HDR panorama in latitude-longitude layout (EXR, HDR, ...) wrapped around the scene.
 
-    The image's centre column looks down -Z; its top row is straight up (+Y). ``rotation_deg`` turns the
-    panorama about the vertical axis, ``strength`` scales it.
+    In its own frame the image's centre column looks down -Z and its top row straight up (+Y). ``rotation_deg``
+    turns the panorama about that vertical axis (clockwise seen from above: the centre column moves towards +X),
+    then ``zenith`` tilts it, by the shortest turn that takes +Y to ``zenith``: any orientation is one pair of
+    the two (:meth:`world_from_map`, :func:`environment_orientation`). ``strength`` scales the radiance.
     """
 
     type_name: ClassVar[str] = "map"
@@ -81,6 +84,48 @@ class EnvironmentMap(Environment):
         "doc": "how the image's rows meet the sphere: 'centred' (H rows of equal height, row i centred at polar "
                "angle pi (i + 1/2) / H: the usual layout) or 'pole_to_pole' (row i at pi i / (H - 1), the first "
                "and last rows on the poles: Mitsuba's envmap, which its importer sets)"})
+    zenith: tuple[float, float, float] = field(default=(0.0, 1.0, 0.0), metadata={
+        "nonzero_vector": True,
+        "doc": "where the image's top row (its north pole) points; (0, 1, 0) is straight up"})
+
+    def world_from_map(self) -> np.ndarray:
+        """The 3x3 rotation taking a direction in the panorama's own frame to the world: the turn of
+        ``rotation_deg`` about +Y, then the tilt that takes +Y to ``zenith``."""
+        return _tilt_from_y(self.zenith) @ _turn_about_y(-self.rotation_deg)
+
+
+def environment_orientation(world_from_map: np.ndarray) -> tuple[tuple[float, float, float], float]:
+    """(zenith, rotation_deg) of an :class:`EnvironmentMap` whose panorama frame turns to the world by the
+    rotation ``world_from_map`` (3x3, orthonormal, determinant +1): the inverse of ``world_from_map()``."""
+    rotation = np.asarray(world_from_map, float)
+    zenith = rotation[:, 1]
+    about_y = _tilt_from_y(zenith).T @ rotation  # what is left once the tilt is undone fixes +Y
+    angle = -math.degrees(math.atan2(about_y[0, 2], about_y[0, 0]))
+    angle = (angle + 180.0) % 360.0 - 180.0
+    return tuple(float(v) for v in zenith), (180.0 if angle == -180.0 else angle + 0.0)  # type: ignore[return-value]
+
+
+def _turn_about_y(degrees: float) -> np.ndarray:
+    """The right-handed rotation by ``degrees`` about +Y (counter-clockwise seen from above)."""
+    c, s = math.cos(math.radians(degrees)), math.sin(math.radians(degrees))
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def _tilt_from_y(zenith) -> np.ndarray:
+    """The shortest rotation taking +Y to the direction ``zenith`` (Rodrigues' formula about +Y x zenith);
+    half a turn about +X for a zenith straight down, where every axis in the horizontal plane is as short."""
+    z = np.asarray(zenith, float)
+    norm = float(np.linalg.norm(z))
+    if not norm > 0 or not math.isfinite(norm):
+        raise ValueError("environment zenith must be a nonzero vector")
+    z = z / norm
+    axis = np.array([z[2], 0.0, -z[0]])  # +Y x zenith: its length is the sine of the angle
+    sine = float(np.linalg.norm(axis))
+    if sine < 1e-12:
+        return np.eye(3) if z[1] > 0 else np.diag([1.0, -1.0, -1.0])
+    k = axis / sine
+    cross = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    return np.eye(3) + sine * cross + (1.0 - z[1]) * (cross @ cross)
 
 
 ENVIRONMENT_TYPES = {cls.type_name: cls for cls in (ConstantEnvironment, EnvironmentMap)}
@@ -124,7 +169,7 @@ class Scene:
     def base_dir(self) -> Path:
         return self.source_path.parent if self.source_path else Path.cwd()
 
-    def flatten(self, mesh_loader: Callable[[Path, bool], object] | None = None) -> "FlatScene":
+    def flatten(self, mesh_loader: Callable[[Path, bool, int], object] | None = None) -> "FlatScene":
         from lenslab.scene.flatten import flatten_scene
 
         return flatten_scene(self, mesh_loader)
