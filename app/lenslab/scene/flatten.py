@@ -79,7 +79,7 @@ def _mesh_parts(scene: Scene, node: Node, loader) -> LoadedMesh:
     if not path.is_absolute():
         path = scene.base_dir() / path
     try:
-        return loader(path, shape.smooth)
+        return loader(path, shape.smooth, shape.shape_index)
     except MeshLoadError as exc:
         where = scene.source_path or "scene"
         raise SceneError(f"{where}: node '{node.name}': {exc}") from None

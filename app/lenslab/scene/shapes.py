@@ -186,11 +186,15 @@ def _lattice_hash(ix: np.ndarray, iy: np.ndarray, seed: int) -> np.ndarray:
 
 @dataclass
 class MeshFile(Shape):
-    """A triangle mesh read from a file (OBJ, PLY, glTF/GLB, STL) through trimesh; path relative to the scene."""
+    """A triangle mesh read from a file (OBJ, PLY, glTF/GLB, STL through trimesh; Mitsuba's .serialized, which
+    holds several meshes, ``shape_index`` picking one); path relative to the scene."""
 
     type_name: ClassVar[str] = "mesh"
     file: str = field(default="", metadata={"doc": "path to the mesh, relative to the scene file", "required": True})
     smooth: bool = field(default=True, metadata={"doc": "interpolate vertex normals (false: flat facets)"})
+    shape_index: int = field(default=0, metadata={"range": (0, 2**31 - 1),
+                                                  "doc": "which mesh of a Mitsuba .serialized file (0: the first); "
+                                                         "other files hold one"})
 
 
 SHAPE_TYPES: dict[str, type[Shape]] = {cls.type_name: cls for cls in (Sphere, Rectangle, Disk, Box, Relief, MeshFile)}

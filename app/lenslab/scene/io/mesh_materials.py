@@ -63,6 +63,7 @@ import numpy as np
 from lenslab.color import srgb_to_linear
 from lenslab.image_files import read_pixels
 from lenslab.scene.io.meshes import LoadedMesh, MeshLoadError, MeshPart, check_geometry
+from lenslab.scene.io.mitsuba_serialized import read_serialized
 from lenslab.scene.materials import Conductor, Dielectric, Diffuse, Emissive, Material, Plastic
 from lenslab.scene.shapes import TriangleMesh
 from lenslab.scene.textures import Checkerboard, ImageTexture, InlineImageTexture, Texture
@@ -72,13 +73,17 @@ from lenslab.scene.transform import transform_normals, transform_points
 PLACEHOLDER = Checkerboard(color_a=(1.0, 0.0, 1.0), color_b=(0.0, 0.0, 0.0), tiles=(16.0, 16.0))
 
 
-def load_parts(path: Path, smooth: bool = True) -> LoadedMesh:
-    """The mesh file as parts, one per material it uses; cached by path, modification times and ``smooth``."""
+def load_parts(path: Path, smooth: bool = True, shape_index: int = 0) -> LoadedMesh:
+    """The mesh file as parts, one per material it uses; cached by path, modification times, ``smooth`` and
+    ``shape_index`` (which mesh of a Mitsuba .serialized file; other files hold one, and take only 0)."""
     path = Path(path)
     if not os.path.isfile(path):
         raise MeshLoadError(f"{path}: mesh file not found")
+    if shape_index and path.suffix.lower() != ".serialized":
+        raise MeshLoadError(f"{path}: shape_index {shape_index}: only a Mitsuba .serialized file holds several "
+                            "meshes (this file's is 0)")
     path = path.resolve()
-    return _load_cached(str(path), path.stat().st_mtime_ns, _sidecar_stamp(path), smooth)
+    return _load_cached(str(path), path.stat().st_mtime_ns, _sidecar_stamp(path), smooth, shape_index)
 
 
 def _sidecar_stamp(path: Path) -> tuple:
@@ -90,14 +95,14 @@ def _sidecar_stamp(path: Path) -> tuple:
 
 
 @lru_cache(maxsize=32)
-def _load_cached(path: str, mtime_ns: int, sidecars: tuple, smooth: bool) -> LoadedMesh:
-    return _load(Path(path), smooth)
+def _load_cached(path: str, mtime_ns: int, sidecars: tuple, smooth: bool, shape_index: int) -> LoadedMesh:
+    return _load(Path(path), smooth, shape_index)
 
 
 # ---------------------------------------------------------------------------------------------------------
 # Geometry: the scene graph, one part per material
 # ---------------------------------------------------------------------------------------------------------
-def _load(path: Path, smooth: bool) -> LoadedMesh:
+def _load(path: Path, smooth: bool, shape_index: int = 0) -> LoadedMesh:
     import trimesh  # imported here: a scene without mesh files never pays for it
 
     notes = Notes(path.name)
@@ -107,6 +112,8 @@ def _load(path: Path, smooth: bool) -> LoadedMesh:
             source = GltfMaterials(path, notes)
         elif suffix == ".obj":
             source = ObjMaterials(path, notes)
+        elif suffix == ".serialized":
+            source = SerializedMesh(path, notes, shape_index)
         else:
             source = NoMaterials(path, notes)
         scene = source.load_trimesh()
@@ -218,6 +225,23 @@ class NoMaterials:
 
     def material_for(self, geometry) -> Mapped | None:
         return None
+
+
+class SerializedMesh(NoMaterials):
+    """Mitsuba's .serialized: mesh ``shape_index`` of the file (``mitsuba_serialized``), geometry only. Handed on
+    as trimesh's, so that it is checked, and given smooth normals where it has none, as any other file's."""
+
+    def __init__(self, path: Path, notes: Notes, shape_index: int):
+        super().__init__(path, notes)
+        self.shape_index = shape_index
+
+    def load_trimesh(self):
+        import trimesh
+
+        mesh = read_serialized(self.path, self.shape_index)
+        visual = trimesh.visual.TextureVisuals(uv=mesh.uvs) if mesh.uvs is not None else None
+        return trimesh.Scene(trimesh.Trimesh(mesh.vertices, mesh.faces, vertex_normals=mesh.normals, visual=visual,
+                                             process=False))
 
 
 # ---------------------------------------------------------------------------------------------------------

@@ -56,15 +56,16 @@ def check_geometry(vertices: np.ndarray, faces: np.ndarray, path: Path | str) ->
                             f"{LARGEST_NUMBER:g} a scene can hold")
 
 
-def load_mesh_parts(path: Path, smooth: bool = True) -> LoadedMesh:
+def load_mesh_parts(path: Path, smooth: bool = True, shape_index: int = 0) -> LoadedMesh:
     """The mesh file as parts, one per material it uses (geometry without one: a part each, material None).
 
     The file's materials (OBJ+MTL, glTF 2.0) are mapped onto ours by ``mesh_materials``, which says in
-    ``warnings`` what it could not map, once per material.
+    ``warnings`` what it could not map, once per material. ``shape_index`` picks one mesh of a Mitsuba
+    ``.serialized`` file, the one kind that holds several.
     """
     from lenslab.scene.io.mesh_materials import load_parts  # it imports this module's MeshPart and LoadedMesh
 
-    return load_parts(path, smooth)
+    return load_parts(path, smooth, shape_index)
 
 
 def load_mesh(path: Path, smooth: bool = True) -> TriangleMesh:

@@ -911,7 +911,7 @@ class _Importer:
             if flip:
                 local = mv.rotate_matrix((1, 0, 0), 180.0)
                 flip = False
-        elif kind in ("obj", "ply", "stl"):
+        elif kind in ("obj", "ply", "stl", "serialized"):
             filename = p.string("filename")
             if not filename:
                 raise node.error('needs a "filename"')
@@ -919,13 +919,13 @@ class _Importer:
             if not os.path.isfile(path):
                 raise node.error(f"mesh file not found: {path}")
             smooth = not p.bool("face_normals", False)
-            shape = MeshFile(file=self._scene_relative(path), smooth=smooth)
+            shape_index = p.int("shape_index", 0) if kind == "serialized" else 0  # which of the file's meshes
+            if not 0 <= shape_index < 2**31:
+                raise node.error(f"shape_index must be in [0, {2**31 - 1}] (got {shape_index})")
+            shape = MeshFile(file=self._scene_relative(path), smooth=smooth, shape_index=shape_index)
         else:
             p.finish(silent=set(p.values))
-            if kind == "serialized":
-                self.warn(node, "Mitsuba .serialized meshes are not readable yet: shape skipped (convert it to PLY)")
-            else:
-                self.warn(node, f'shape "{kind}" is not supported: skipped')
+            self.warn(node, f'shape "{kind}" is not supported: skipped')
             return []
 
         emitters = [n for n in p.objects if n.tag == "emitter"] + [p.take(k) for k in list(p.values) if p.values[k].tag == "emitter"]
