@@ -37,8 +37,10 @@ struct Bsdf {
     vec3 eta3;    // conductors: complex index
     vec3 k;
     float internal_reflectance;  // plastic: diffuse Fresnel reflectance inside the coating
-    int reflectance_table;       // rough plastic: the coating's reflectance, ROUGH_TABLE_SIZE entries in image_data
+    int transmittance_table;     // rough plastic: the coating's transmittance, ROUGH_TABLE_SIZE entries in image_data
     mat3 frame;   // local shading frame: columns tangent, bitangent, normal
+    vec3 base_normal;  // the shading normal before bump and normal maps tilted it (frame's z after)
+    float terminator;  // their shadowing term's alpha^2 (shadow_terminator); 0: none
 };
 
 // -- Materials that hold materials (scene/materials.py) --------------------------------------------------
@@ -94,15 +96,25 @@ vec3 mapped_normal(SurfaceHit s, vec3 n, int texture) {
     return dot(mapped, mapped) > 0.0 ? normalize(mapped) : n;
 }
 
-// The material that scatters at s, and its shading normal (s.ns, tilted by bump and normal maps).
-int resolve_material(SurfaceHit s, out vec3 ns) {
+// A tilted normal the viewer sees from behind (along wo, below its tangent plane) would shade nothing:
+// mirror its tilt across the untilted normal n instead, as Mitsuba's flip_invalid_normals (on by default).
+vec3 facing_viewer(vec3 tilted, vec3 n, vec3 wo) {
+    return dot(wo, tilted) > 0.0 ? tilted : 2.0 * dot(tilted, n) * n - tilted;
+}
+
+// The material that scatters at s, its shading normal (s.ns, tilted by bump and normal maps) and the alpha^2
+// of their shadowing term (0: none).
+int resolve_material(SurfaceHit s, out vec3 ns, out float terminator) {
     ns = s.ns;
+    terminator = 0.0;
     int m = s.material;
 #if HAS_NESTED_MATERIALS
     // Maps tilt the normal as the front face sees it; a hit from behind sees the mirror image (the
     // surface looks the same from both sides, as Mitsuba's twosided).
-    vec3 n = s.front_face ? s.ns : -s.ns, ng = s.front_face ? s.ng : -s.ng;
-    bool tilted = false;
+    vec3 n_front = s.front_face ? s.ns : -s.ns;
+    vec3 n = n_front, ng = s.front_face ? s.ng : -s.ng;
+    vec3 wo = s.front_face ? s.wo : s.wo - 2.0 * dot(s.wo, n_front) * n_front;
+    bool tilted = false, shadowing = false;
     for (int level = 0; level < MATERIAL_NESTING; level++) {
         vec4 r0 = material_row(m, 0);
         int type = int(r0.w);
@@ -110,12 +122,14 @@ int resolve_material(SurfaceHit s, out vec3 ns) {
         if (type == MATERIAL_BLEND) {
             float weight = r0.y >= 0.0 ? texture_value(int(r0.y), s.uv) : r0.x;
             if (hit_hash(s, level) < weight) inner = int(material_row(m, 2).y);
-        } else if (type == MATERIAL_BUMP_MAP) {
-            if (r0.y >= 0.0) n = bumped_normal(s, n, ng, int(r0.y), r0.x);
-            tilted = true;
-        } else if (type == MATERIAL_NORMAL_MAP) {
-            if (r0.y >= 0.0) n = mapped_normal(s, n, int(r0.y));
-            tilted = true;
+        } else if (type == MATERIAL_BUMP_MAP || type == MATERIAL_NORMAL_MAP) {
+            if (r0.y >= 0.0) {
+                vec3 t = type == MATERIAL_BUMP_MAP ? bumped_normal(s, n, ng, int(r0.y), r0.x)
+                                                   : mapped_normal(s, n, int(r0.y));
+                n = facing_viewer(t, n, wo);
+                tilted = true;
+                shadowing = shadowing || r0.z > 0.5;
+            }
         } else if (type != MATERIAL_MASK && type != MATERIAL_EMISSIVE) {
             break;
         }
@@ -123,12 +137,27 @@ int resolve_material(SurfaceHit s, out vec3 ns) {
         m = inner;
     }
     if (tilted) {
-        vec3 n_front = s.front_face ? s.ns : -s.ns;
         ns = s.front_face ? n : n - 2.0 * dot(n, n_front) * n_front;
         if (dot(ns, s.ng) <= 0.0) ns = s.ns;  // tilted under the surface: keep the untilted normal
+        if (shadowing) {
+            float c = clamp(dot(ns, s.ns), 1e-6, 1.0);
+            terminator = min(0.125 * (1.0 - c * c) / (c * c), 1.0);
+        }
     }
 #endif
     return m;
+}
+
+// Bump and normal maps tilt the shading normal without moving the surface, so light arriving low over the
+// true surface lights microfacets that the bumps would have shadowed, and shadows end in hard steps. Estevez et
+// al. 2019 ("A Microfacet-Based Shadowing Function to Solve the Bump Terminator Problem") attenuate by a Smith
+// shadowing term whose roughness grows with the tilt: G1 = 2 / (1 + sqrt(1 + alpha^2 tan^2)), the light's angle
+// measured from the untilted normal. Mitsuba's bumpmap and normalmap apply it by default; so do we.
+float shadow_terminator(Bsdf b, vec3 wi) {
+    if (b.terminator <= 0.0) return 1.0;
+    float c = dot(wi, b.base_normal);
+    float c2 = max(c * c, 1e-12);
+    return 2.0 / (1.0 + sqrt(1.0 + b.terminator * max(0.0, 1.0 - c2) / c2));
 }
 
 // b is of material type `code`: false at compile time for types the scene lacks (features.glsl).
@@ -137,7 +166,8 @@ bool is_type(Bsdf b, int code) { return HAS_MATERIAL(code) && b.type == code; }
 Bsdf bsdf_at(SurfaceHit s) {
     Bsdf b;
     vec3 ns;
-    int m = resolve_material(s, ns);
+    int m = resolve_material(s, ns, b.terminator);
+    b.base_normal = s.ns;
     vec4 r0 = material_row(m, 0), r2 = material_row(m, 2), r3 = material_row(m, 3), r4 = material_row(m, 4);
     b.type = int(r0.w);
     b.color = r0.xyz;
@@ -147,7 +177,7 @@ Bsdf bsdf_at(SurfaceHit s) {
     b.tint = r4.xyz;
     b.eta = r2.x;
     b.internal_reflectance = r2.y;
-    b.reflectance_table = floatBitsToInt(r2.z);
+    b.transmittance_table = floatBitsToInt(r2.z);
     b.beckmann = HAS_BECKMANN != 0 && int(material_row(m, 5).w) == MICROFACET_BECKMANN;
     if (HAS_TEXTURES != 0 && r3.w >= 0.0) b.color = texture_rgb(int(r3.w), s.uv);
     if (HAS_TEXTURES != 0 && r4.w >= 0.0) {  // roughness texture: perceptual roughness in the red channel
@@ -169,15 +199,15 @@ vec3 to_local(Bsdf b, vec3 w) { return w * b.frame; }  // = transpose(frame) * w
 vec3 to_world(Bsdf b, vec3 w) { return b.frame * w; }
 
 // -- plastic ------------------------------------------------------------------------------------------
-// Share of light the coating lets through at this angle: 1 - Fresnel when smooth, 1 - the tabulated
-// directional reflectance of the rough interface otherwise (as Mitsuba's roughplastic).
+// Share of light the coating lets through at this angle: 1 - Fresnel when smooth, the rough interface's
+// tabulated directional transmittance otherwise (render/fresnel.rough_transmittance_table, as Mitsuba's
+// roughplastic: the microfacets shadow part of what refracts, so it is less than 1 - reflectance).
 float plastic_transmittance(Bsdf b, float cos_theta) {
     if (b.alpha == 0.0) return 1.0 - fresnel_dielectric(cos_theta, b.eta);
     float x = clamp(cos_theta, 0.0, 1.0) * float(ROUGH_TABLE_SIZE - 1);
     int i = min(int(x), ROUGH_TABLE_SIZE - 2);
-    uint at = uint(b.reflectance_table + i);
-    float r = mix(uintBitsToFloat(image_data[at]), uintBitsToFloat(image_data[at + 1u]), x - float(i));
-    return 1.0 - r;
+    uint at = uint(b.transmittance_table + i);
+    return mix(uintBitsToFloat(image_data[at]), uintBitsToFloat(image_data[at + 1u]), x - float(i));
 }
 
 // The probability of choosing the coating's reflection when sampling (Mitsuba's heuristic).
@@ -220,7 +250,7 @@ vec3 rough_dielectric_eval(Bsdf b, vec3 wo, vec3 wi, out float pdf) {
 
 // f(wo, wi) |cos theta_i| and the density with which bsdf_sample would choose wi (solid angle).
 // b is bsdf_at(s), resolved once per hit and shared by evaluation and sampling.
-vec3 bsdf_eval(SurfaceHit s, Bsdf b, vec3 wi_world, out float pdf) {
+vec3 bsdf_eval_untilted(SurfaceHit s, Bsdf b, vec3 wi_world, out float pdf) {
     pdf = 0.0;
     if (bsdf_is_delta(b)) return vec3(0.0);
     vec3 wo = to_local(b, s.wo), wi = to_local(b, wi_world);
@@ -257,7 +287,7 @@ vec3 bsdf_eval(SurfaceHit s, Bsdf b, vec3 wi_world, out float pdf) {
 
 // Sample wi given three uniform numbers; weight = f |cos| / pdf. delta: a Dirac lobe was chosen
 // (no MIS against light sampling is possible for it).
-bool bsdf_sample(SurfaceHit s, Bsdf b, vec3 u, out vec3 wi_world, out vec3 weight, out float pdf, out bool delta) {
+bool bsdf_sample_untilted(SurfaceHit s, Bsdf b, vec3 u, out vec3 wi_world, out vec3 weight, out float pdf, out bool delta) {
     weight = vec3(0.0);
     pdf = 0.0;
     delta = false;
@@ -301,7 +331,7 @@ bool bsdf_sample(SurfaceHit s, Bsdf b, vec3 u, out vec3 wi_world, out vec3 weigh
         if (!delta) {  // both lobes can produce this direction: weigh by the full density
             wi_world = to_world(b, wi);
             if (dot(wi_world, s.ng) <= 0.0) return false;
-            vec3 f = bsdf_eval(s, b, wi_world, pdf);
+            vec3 f = bsdf_eval_untilted(s, b, wi_world, pdf);
             if (pdf <= 0.0) return false;
             weight = f / pdf;
             return true;
@@ -348,6 +378,20 @@ bool bsdf_sample(SurfaceHit s, Bsdf b, vec3 u, out vec3 wi_world, out vec3 weigh
     // The sampled side must agree with the geometric normal: reflection stays, transmission crosses.
     if ((dot(wi_world, s.ng) > 0.0) == transmit) return false;
     return pdf > 0.0;
+}
+
+// f(wo, wi) |cos theta_i| and the density with which bsdf_sample would choose wi (solid angle), with the
+// shadowing term of bump and normal maps.
+vec3 bsdf_eval(SurfaceHit s, Bsdf b, vec3 wi_world, out float pdf) {
+    return bsdf_eval_untilted(s, b, wi_world, pdf) * shadow_terminator(b, wi_world);
+}
+
+// Sample wi given three uniform numbers: see bsdf_sample_untilted. The shadowing term of bump and normal maps
+// scales the weight, not the density, as it scales the value.
+bool bsdf_sample(SurfaceHit s, Bsdf b, vec3 u, out vec3 wi_world, out vec3 weight, out float pdf, out bool delta) {
+    bool ok = bsdf_sample_untilted(s, b, u, wi_world, weight, pdf, delta);
+    weight *= shadow_terminator(b, wi_world);
+    return ok;
 }
 
 // How much a transmission from wo to wi compresses radiance (eta^2 entering glass, 1/eta^2 leaving); 1 for

@@ -102,6 +102,40 @@ def rough_reflectance_table(eta: float, alpha: float, distribution: str = "ggx",
     return value.mean(axis=1)
 
 
+def _refract(w: np.ndarray, m: np.ndarray, eta: float) -> tuple[np.ndarray, np.ndarray]:
+    """w (pointing away, on m's side) refracted through a boundary of relative index eta at normal m, and
+    whether it got through (not total internal reflection). Shapes (..., 3)."""
+    cos_i = np.einsum("...k,...k->...", w, m)
+    sin2_t = np.maximum(0.0, 1.0 - cos_i**2) / eta**2
+    cos_t = np.sqrt(np.maximum(0.0, 1.0 - sin2_t))
+    return -w / eta + (cos_i / eta - cos_t)[..., None] * m, sin2_t < 1.0
+
+
+@lru_cache(maxsize=64)
+def rough_transmittance_table(eta: float, alpha: float, distribution: str = "ggx", size: int = ROUGH_TABLE_SIZE,
+                              grid: int = 96) -> np.ndarray:
+    """Directional transmittance of a rough dielectric interface, T(mu) at mu = i / (size - 1): the share of
+    light arriving at cos theta = mu that crosses into the material, (1 - F) G1(refracted) averaged over the
+    visible normals (Mitsuba's eval_transmittance, which its roughplastic uses for the light that reaches the
+    diffuse base and leaves it again). It is less than 1 - R: the microfacets also shadow part of what
+    refracts. Beckmann normals are drawn from D cos and weighed to their visible density."""
+    mu = np.maximum(np.arange(size) / (size - 1), 1e-6)
+    wi = np.stack([np.sqrt(1 - mu**2), np.zeros(size), mu], axis=1)
+    u1, u2 = (np.stack(np.meshgrid(np.arange(grid), np.arange(grid)), axis=-1).reshape(-1, 2).T + 0.5) / grid
+    if distribution == "beckmann":
+        m = np.broadcast_to(_beckmann_normals(alpha, u1, u2), (size, len(u1), 3))
+        wi_dot_m = np.einsum("mk,mnk->mn", wi, m)
+        visible = np.maximum(wi_dot_m, 0) / ((1 + _smith_lambda(wi, alpha, distribution))[:, None] * mu[:, None] * m[..., 2])
+    else:
+        m = _visible_normals(wi, alpha, u1, u2)
+        wi_dot_m = np.einsum("mk,mnk->mn", wi, m)
+        visible = np.ones_like(wi_dot_m)
+    wt, through = _refract(np.broadcast_to(wi[:, None, :], m.shape), m, eta)
+    g1_t = 1 / (1 + _smith_lambda(-wt, alpha, distribution))  # the refracted ray's masking, seen from below
+    value = np.where(through & (wt[..., 2] < 0) & (wi_dot_m > 0), (1 - fresnel_dielectric(wi_dot_m, eta)) * g1_t, 0.0)
+    return (value * visible).mean(axis=1)
+
+
 @lru_cache(maxsize=64)
 def rough_internal_reflectance(eta: float, alpha: float, distribution: str = "ggx") -> float:
     """Cosine-weighted mean reflectance of the same interface seen from inside (relative index 1/eta):

@@ -169,6 +169,8 @@ class BumpMap(Material):
     material: Material = field(default_factory=Diffuse)
     texture: Texture | None = field(default=None, metadata={"doc": "height, as luminance"})
     scale: float = field(default=1.0, metadata={"range": (-1e3, 1e3), "doc": "height per unit of texture value"})
+    shadowing: bool = field(default=True, metadata={
+        "doc": "soften the hard shadow line tilted normals leave (Estevez et al. 2019; Mitsuba's default)"})
 
 
 @dataclass
@@ -179,6 +181,8 @@ class NormalMap(Material):
     type_name: ClassVar[str] = "normal_map"
     material: Material = field(default_factory=Diffuse)
     texture: Texture | None = field(default=None, metadata={"doc": "read as linear: set its colour space to linear"})
+    shadowing: bool = field(default=True, metadata={
+        "doc": "soften the hard shadow line tilted normals leave (Estevez et al. 2019; Mitsuba's default)"})
 
 
 WRAPPER_TYPES = (Blend, Mask, BumpMap, NormalMap)

@@ -50,13 +50,27 @@ def _grey_note(kind: str, what: str) -> str:
     return f"{kind} is not renderable yet: approximated by a diffuse surface with {what}"
 
 
+def _reflectance(p: "Props", imp: "_Importer", name: str, default: float) -> tuple[RGB, Texture | None]:
+    """A reflectance that may vary over the surface: (its colour, None), or, for a texture LensLab can look
+    up (nested or referred to), (Mitsuba's default colour, which the texture overrides, the texture)."""
+    node = p.values.get(name)
+    if node is not None and node.tag == "texture":
+        texture = imp.texture_of(node)
+        if texture is not None:
+            p.take(name)
+            return (float(default),) * 3, texture  # type: ignore[return-value]
+    return _clip_albedo(p.color(name, default)), None  # a colour, or a texture's mean (with a warning)
+
+
 def _map_diffuse(p: "Props", imp: "_Importer") -> Mapped:
-    return Mapped(Diffuse(_clip_albedo(p.color("reflectance", 0.5))))
+    albedo, texture = _reflectance(p, imp, "reflectance", 0.5)
+    return Mapped(Diffuse(albedo, albedo_texture=texture))
 
 
 def _map_roughdiffuse(p: "Props", imp: "_Importer") -> Mapped:
     p.float("alpha")
-    return Mapped(Diffuse(_clip_albedo(p.color("reflectance", 0.5))), "rough diffuse (Oren-Nayar) is rendered as Lambertian")
+    albedo, texture = _reflectance(p, imp, "reflectance", 0.5)
+    return Mapped(Diffuse(albedo, albedo_texture=texture), "rough diffuse (Oren-Nayar) is rendered as Lambertian")
 
 
 # Mitsuba's named indices of refraction (include/mitsuba/render/ior.h).
@@ -180,7 +194,7 @@ def _relative_ior(p: "Props", notes: list[str], lo: float) -> float:
 def _map_plastic(p: "Props", imp: "_Importer") -> Mapped:
     notes: list[str] = []
     roughness, distribution = _roughness(p, notes) if p.node.type == "roughplastic" else (0.0, "ggx")
-    albedo = _unit(p.color("diffuse_reflectance", 0.5))
+    albedo, texture = _reflectance(p, imp, "diffuse_reflectance", 0.5)
     ior = _ior(p, "int_ior", 1.49) / _ior(p, "ext_ior", 1.000277)
     if not 1.0 <= ior <= 4.0:
         notes.append(f"relative index of refraction {ior:.4g} is outside LensLab's 1-4: clamped")
@@ -189,7 +203,8 @@ def _map_plastic(p: "Props", imp: "_Importer") -> Mapped:
         notes.append("specular_reflectance is not supported: the coat reflects as clear plastic")
     if p.bool("nonlinear", False):
         notes.append("nonlinear colour shift is not supported")
-    return Mapped(Plastic(albedo=albedo, ior=ior, roughness=roughness, distribution=distribution), _note(notes))
+    return Mapped(Plastic(albedo=albedo, albedo_texture=texture, ior=ior, roughness=roughness, distribution=distribution),
+                  _note(notes))
 
 
 def _map_dielectric(p: "Props", imp: "_Importer") -> Mapped:
@@ -307,23 +322,33 @@ def _map_blendbsdf(p: "Props", imp: "_Importer") -> Mapped:
                   _note(notes))
 
 
+def _tilt_options(p: "Props", notes: list[str]) -> bool:
+    """Mitsuba's bump and normal map switches: the shadowing term (kept), and flip_invalid_normals, which
+    LensLab always does."""
+    if not p.bool("flip_invalid_normals", True):
+        notes.append("flip_invalid_normals false is not supported: tilted normals facing away are flipped")
+    return p.bool("use_shadowing_function", True)
+
+
 def _map_bumpmap(p: "Props", imp: "_Importer") -> Mapped:
     notes: list[str] = []
     scale = p.float("scale", 1.0)
+    shadowing = _tilt_options(p, notes)
     node, texture = _texture_property(p, imp, None)
     material = _held(p, imp, notes)
     if texture is None:
         notes.append(f"its texture at line {node.line} cannot be looked up: the bump map is flat")
-    return Mapped(BumpMap(material=material, texture=texture, scale=scale), _note(notes))
+    return Mapped(BumpMap(material=material, texture=texture, scale=scale, shadowing=shadowing), _note(notes))
 
 
 def _map_normalmap(p: "Props", imp: "_Importer") -> Mapped:
     notes: list[str] = []
     node, texture = _texture_property(p, imp, "normalmap")
+    shadowing = _tilt_options(p, notes)
     material = _held(p, imp, notes)
     if texture is None:
         notes.append(f"its texture at line {node.line} cannot be looked up: the normal map is flat")
-    return Mapped(NormalMap(material=material, texture=texture), _note(notes))
+    return Mapped(NormalMap(material=material, texture=texture, shadowing=shadowing), _note(notes))
 
 
 BSDF_MAPPINGS: dict[str, BsdfMapping] = {
