@@ -22,7 +22,18 @@ def test_shipped_scenes_round_trip_losslessly(tmp_path, name):
     again = load_scene(tmp_path / "copy.json")
     assert again == scene
     assert scene_to_dict(again) == scene_to_dict(scene)
-    assert json.loads((tmp_path / "copy.json").read_text())["lenslab_scene"] == 2
+    assert json.loads((tmp_path / "copy.json").read_text())["lenslab_scene"] == 3
+
+
+def test_a_version_2_scene_reads_as_written_and_saves_as_version_3(tmp_path):
+    # Version 3 added keys only: a version 2 file (the shipped scenes are) reads with their defaults.
+    path = tmp_path / "v2.json"
+    path.write_text(json.dumps({"lenslab_scene": 2, "materials": {"lamp": {"type": "emissive", "radiance": [2, 2, 2]}}}))
+    scene = load_scene(path)
+    assert scene.materials["lamp"].surface is None
+    save_scene(scene, tmp_path / "v3.json")
+    saved = json.loads((tmp_path / "v3.json").read_text())
+    assert saved["lenslab_scene"] == 3 and saved["materials"]["lamp"]["surface"] is None
 
 
 def test_shipped_scenes_are_listed():

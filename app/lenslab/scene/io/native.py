@@ -29,7 +29,8 @@ from lenslab.scene.textures import TEXTURE_TYPES, Texture
 from lenslab.scene.lights import LIGHT_TYPES, Light
 
 FORMAT_KEY = "lenslab_scene"
-FORMAT_VERSION = 2
+FORMAT_VERSION = 3
+READABLE_VERSIONS = (1, 2, FORMAT_VERSION)  # 2 differs from 3 only by what 3 added (docs/scene-format.md)
 #: Version 1 files measured the focus distance from the lens, kept the sensor one focal length behind it and
 #: spanned the image across the sensor's width; version 2's defaults are the photographer's (docs/scene-format.md,
 #: "Versions"). A version 1 file is read with its old meaning, so it renders exactly as it always did.
@@ -204,9 +205,9 @@ def scene_from_dict(data: Any, source_path: Path | None = None) -> Scene:
     version = data.get(FORMAT_KEY)
     if version is None:
         raise _Invalid(FORMAT_KEY, "missing: this is not a LensLab scene")
-    if version not in (1, FORMAT_VERSION) or isinstance(version, bool):
-        raise _Invalid(FORMAT_KEY, f"version {_describe(version)} is not supported (this LensLab reads 1 and "
-                                   f"{FORMAT_VERSION})")
+    if version not in READABLE_VERSIONS or isinstance(version, bool):
+        raise _Invalid(FORMAT_KEY, f"version {_describe(version)} is not supported (this LensLab reads "
+                                   f"{', '.join(map(str, READABLE_VERSIONS[:-1]))} and {FORMAT_VERSION})")
     data = {k: v for k, v in data.items() if k != FORMAT_KEY}
     _check_node_depth(data.get("nodes"))
     if version == 1:
