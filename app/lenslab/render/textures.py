@@ -17,7 +17,9 @@ import numpy as np
 
 from lenslab.color import srgb_to_linear
 from lenslab.image_files import read_pixels
-from lenslab.render.gpu_layout import TEXELS_FLOAT, TEXELS_HALF, TEXTURE_CHECKER, TEXTURE_IMAGE, TEXTURE_ROWS
+from lenslab.render.gpu_layout import (TEXELS_FLOAT, TEXELS_HALF, TEXTURE_CHECKER, TEXTURE_FILTER_BILINEAR,
+                                       TEXTURE_FILTER_NEAREST, TEXTURE_IMAGE, TEXTURE_ROWS, TEXTURE_WRAP_CLAMP,
+                                       TEXTURE_WRAP_MIRROR, TEXTURE_WRAP_REPEAT)
 from lenslab.scene.textures import Checkerboard, ImageTexture, InlineImageTexture, Texture
 
 log = logging.getLogger("lenslab.textures")
@@ -27,6 +29,8 @@ HALF_MAX = 65504.0
 BRIGHTEST = 1e10
 MAX_SIDE = 4096  # larger images are downsampled: one storage buffer holds all texels
 MISSING = Checkerboard(color_a=(1.0, 0.0, 1.0), color_b=(0.0, 0.0, 0.0), tiles=(16.0, 16.0))
+WRAP_CODES = {"repeat": TEXTURE_WRAP_REPEAT, "mirror": TEXTURE_WRAP_MIRROR, "clamp": TEXTURE_WRAP_CLAMP}
+FILTER_CODES = {"bilinear": TEXTURE_FILTER_BILINEAR, "nearest": TEXTURE_FILTER_NEAREST}
 
 
 def read_texture_image(path: Path, color_space: str = "auto") -> np.ndarray:
@@ -99,19 +103,19 @@ class TextureTable:
                 message = str(exc) if os.path.exists(path) else f"{path}: texture file not found"
                 self.warnings.append(f"{message}; showing a magenta checkerboard instead")  # the caller reports it
                 return self._add(MISSING)
-            self._add_texels(record, rgb, texture.tiles)
+            self._add_texels(record, rgb, texture)
         elif isinstance(texture, InlineImageTexture):
-            self._add_texels(record, np.asarray(texture.pixels, np.float32)[..., :3], texture.tiles)
+            self._add_texels(record, np.asarray(texture.pixels, np.float32)[..., :3], texture)
         elif isinstance(texture, Checkerboard):
             record[0, 0] = TEXTURE_CHECKER
-            record[1, :2] = texture.tiles
-            record[2, :3], record[3, :3] = texture.color_a, texture.color_b
+            record[3, :3], record[4, :3] = texture.color_a, texture.color_b
         else:
             raise TypeError(f"no GPU packing for texture type {type(texture).__name__}")
+        record[1:3, :3] = texture.uv_matrix()  # (s, t) = rows 1 and 2 . (u, v, 1)
         self._records.append(record)
         return len(self._records) - 1
 
-    def _add_texels(self, record: np.ndarray, rgb: np.ndarray, tiles) -> None:
+    def _add_texels(self, record: np.ndarray, rgb: np.ndarray, texture: ImageTexture | InlineImageTexture) -> None:
         height, width = rgb.shape[:2]
         rgb = np.asarray(rgb, np.float32)
         if np.abs(rgb).max(initial=0.0) <= HALF_MAX:
@@ -123,7 +127,7 @@ class TextureTable:
             packed = np.ascontiguousarray(rgb).view(np.uint32).reshape(-1)  # three uints per texel: r, g, b
             texel_format = TEXELS_FLOAT
         record[0] = (TEXTURE_IMAGE, np.int32(self._texel_count).view(np.float32), width, height)
-        record[1, :3] = (*tiles, texel_format)
+        record[3, :3] = (texel_format, WRAP_CODES[texture.wrap], FILTER_CODES[texture.filter])
         self._texels.append(packed)
         self._texel_count += packed.size
 

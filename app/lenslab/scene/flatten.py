@@ -16,7 +16,7 @@ import numpy as np
 from lenslab.limits import LARGEST_NUMBER
 from lenslab.scene.materials import Material, walk_materials
 from lenslab.scene.scene import DEFAULT_MATERIAL, Node, Scene, SceneError
-from lenslab.scene.shapes import Box, Disk, MeshFile, Rectangle, Relief, Sphere, TriangleMesh
+from lenslab.scene.shapes import Box, Cylinder, Disk, MeshFile, Rectangle, Relief, Sphere, TriangleMesh
 from lenslab.scene.io.meshes import LoadedMesh, MeshLoadError, MeshPart
 from lenslab.scene.transform import transform_normals, transform_points
 
@@ -72,7 +72,7 @@ def _mesh_parts(scene: Scene, node: Node, loader) -> LoadedMesh:
     if isinstance(shape, Relief):
         fields = (tuple(v) if isinstance(v, list) else v for v in dataclasses.astuple(shape))  # hashable
         return LoadedMesh((MeshPart(_relief_mesh(*fields)),))
-    if isinstance(shape, (Rectangle, Disk, Box)):
+    if isinstance(shape, (Rectangle, Disk, Cylinder, Box)):
         return LoadedMesh((MeshPart(shape.mesh()),))
     assert isinstance(shape, MeshFile)
     path = Path(shape.file)
@@ -93,10 +93,10 @@ def _relief_mesh(*fields) -> TriangleMesh:
 
 
 def made_triangles(scene: Scene) -> tuple[int, str]:
-    """How many triangles the shapes made in code (rectangles, disks, boxes, reliefs) will have, counted
+    """How many triangles the shapes made in code (rectangles, disks, cylinders, boxes, reliefs) will have, counted
     without making them (mesh files are not read here), and which node makes the most ("" for none)."""
     counts = [(node.shape.triangle_count, node.name) for node, _ in scene.walk()
-              if isinstance(node.shape, (Rectangle, Disk, Box, Relief))]
+              if isinstance(node.shape, (Rectangle, Disk, Cylinder, Box, Relief))]
     return sum(count for count, _ in counts), max(counts)[1] if counts else ""
 
 

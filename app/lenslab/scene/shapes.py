@@ -1,7 +1,7 @@
 """Shapes: what a node draws. Triangle meshes (from files or built in) and analytic spheres.
 
-Built-in shapes (rectangle, disk, box, relief) are meshes made in code so that a scene like the Cornell box needs no
-mesh files. Mesh files are read through trimesh (``lenslab.scene.io.meshes``) when the scene is flattened,
+Built-in shapes (rectangle, disk, cylinder, box, relief) are meshes made in code so that a scene like the Cornell
+box needs no mesh files. Mesh files are read through trimesh (``lenslab.scene.io.meshes``) when the scene is flattened,
 and cached by path and modification time.
 """
 
@@ -82,8 +82,62 @@ class Disk(Shape):
 
 
 @dataclass
+class Cylinder(Shape):
+    """An open tube (no caps) around the local Z axis, centred at the origin: Mitsuba's cylinder, whose unit
+    tube runs from z = 0 to 1, moved down by half its height.
+
+    A mesh made in code, as Disk: a prism of ``segments`` sides with smooth (radial) normals. Its
+    cross-section is a polygon of the circle's perimeter (not inscribed in it), so the tube keeps the
+    cylinder's area 2 pi r h and an emitting tube its power; its silhouette then strays from the circle by at
+    most pi^2 / (3 n^2) of the radius (0.02% at 128 sides). The uvs are Mitsuba's: u = phi / 2 pi around the
+    axis from +X towards +Y, v from 0 at the bottom (z = -h/2) to 1 at the top.
+    """
+
+    type_name: ClassVar[str] = "cylinder"
+    radius: float = field(default=0.5, metadata={"range": (1e-9, 1e9), "doc": "metres"})
+    height: float = field(default=1.0, metadata={"range": (1e-9, 1e9), "doc": "metres, along the local Z axis"})
+    segments: int = field(default=128, metadata={"range": (3, 4096),
+                                                 "doc": "sides of the prism that stands in for it"})
+    flip_normals: bool = field(default=False,
+                               metadata={"doc": "normals point into the tube (and a light shines inwards)"})
+
+    @property
+    def triangle_count(self) -> int:
+        return 2 * int(self.segments)
+
+    def mesh(self) -> TriangleMesh:
+        n = int(self.segments)
+        # Equal perimeter, hence equal area: n sides of 2 r' sin(pi/n) make 2 pi r.
+        r = self.radius * (np.pi / n) / np.sin(np.pi / n)
+        angles = 2 * np.pi * np.arange(n + 1) / n  # the seam's column twice: u = 0 and u = 1
+        ring = np.stack([np.cos(angles), np.sin(angles), np.zeros(n + 1)], axis=1)
+        half = self.height / 2
+        vertices = np.concatenate([r * ring + (0.0, 0.0, -half), r * ring + (0.0, 0.0, half)])
+        normals = np.concatenate([ring, ring])
+        u = np.arange(n + 1) / n
+        uvs = np.concatenate([np.stack([u, np.zeros(n + 1)], 1), np.stack([u, np.ones(n + 1)], 1)])
+        bottom, top = np.arange(n), n + 1 + np.arange(n)
+        # Counter-clockwise seen from outside: along +phi at the bottom, then up.
+        faces = np.concatenate([np.stack([bottom, bottom + 1, top + 1], 1), np.stack([bottom, top + 1, top], 1)])
+        if self.flip_normals:
+            faces, normals = faces[:, ::-1], -normals
+        return TriangleMesh(vertices, np.ascontiguousarray(faces), normals, uvs)
+
+
+# The faces' u and v axes, in the order of Box.mesh's quads (-x, +x, -y, +y, -z, +z).
+BOX_UV_AXES = np.array([
+    [(0, 1, 0), (0, 0, -1)], [(0, 1, 0), (0, 0, 1)],
+    [(0, 0, 1), (-1, 0, 0)], [(-1, 0, 0), (0, 0, 1)],
+    [(0, -1, 0), (-1, 0, 0)], [(0, 1, 0), (-1, 0, 0)],
+], dtype=float)
+
+
+@dataclass
 class Box(Shape):
-    """An axis-aligned box centred at the origin, faces pointing outwards."""
+    """An axis-aligned box centred at the origin, faces pointing outwards.
+
+    Each face spans [0, 1]^2 in uv, laid out as Mitsuba 3's ``cube`` lays them (its v turned to ours, where an
+    image's top row is at v = 1), so that a texture lands on an imported cube where Mitsuba puts it."""
 
     type_name: ClassVar[str] = "box"
     size: tuple[float, float, float] = field(default=(1.0, 1.0, 1.0), metadata={"range": (1e-9, 1e9)})
@@ -94,8 +148,14 @@ class Box(Shape):
         corners *= np.asarray(self.size, dtype=float)
         # Each face as a quad of corner indices (bit 2 = x, bit 1 = y, bit 0 = z), counter-clockwise seen from outside.
         quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
-        faces = np.array([tri for a, b, c, d in quads for tri in ((a, b, c), (a, c, d))])
-        return TriangleMesh(corners, faces, None, None)
+        vertices = corners[np.array(quads)].reshape(-1, 3)  # four of its own per face: uvs differ per face
+        faces = np.array([tri for f in range(0, 24, 4) for tri in ((f, f + 1, f + 2), (f, f + 2, f + 3))])
+        # (u, v) = (1 + a . p, 1 + b . p) / 2 with p the position scaled to [-1, 1]^3 and a, b signed axes per
+        # face: Mitsuba 3.9's cube (checked in tests/test_textures_uv.py).
+        unit = vertices / (np.asarray(self.size, dtype=float) / 2)
+        axes = np.repeat(BOX_UV_AXES, 4, axis=0)  # (24, 2, 3)
+        uvs = 0.5 + 0.5 * np.einsum("vij,vj->vi", axes, unit)
+        return TriangleMesh(vertices, faces, None, uvs)
 
 
 @dataclass
@@ -197,4 +257,5 @@ class MeshFile(Shape):
                                                          "other files hold one"})
 
 
-SHAPE_TYPES: dict[str, type[Shape]] = {cls.type_name: cls for cls in (Sphere, Rectangle, Disk, Box, Relief, MeshFile)}
+SHAPE_TYPES: dict[str, type[Shape]] = {cls.type_name: cls for cls in (Sphere, Rectangle, Disk, Cylinder, Box, Relief,
+                                                                   MeshFile)}

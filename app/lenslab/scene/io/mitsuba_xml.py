@@ -7,7 +7,8 @@ Two passes, as in Mitsuba's own parser (``src/core/parser.cpp``):
    splice ``<include>`` files in (relative to the including file), and register every ``id``.
 2. **Convert** the expanded tree: integrator, sensor/film/sampler, shapes with their BSDFs and area lights,
    the constant emitter. Each plugin is a small function; BSDFs go through ``mitsuba_bsdfs.BSDF_MAPPINGS``,
-   one entry per Mitsuba plugin name.
+   one entry per Mitsuba plugin name; textures, the cylinder and each shape's uvs through
+   ``mitsuba_textures`` (``texture_of``, ``material_on_shape``).
 
 Whatever LensLab cannot render yet gives one warning naming the element and its line, and the rest of the
 scene still loads. A file that is not well-formed XML, or that Mitsuba itself would reject (an undefined
@@ -48,9 +49,11 @@ from lenslab.scene.materials import Diffuse, Emissive, Material
 from lenslab.scene.lights import Light, PointLight, SpotLight, SunLight
 from lenslab.scene.scene import ConstantEnvironment, EnvironmentMap, Node, RenderSettings, Scene, SceneError
 from lenslab.scene.scene import environment_orientation
-from lenslab.scene.shapes import Box, Disk, MeshFile, Rectangle, Sphere
+from lenslab.scene.shapes import Box, Cylinder, Disk, MeshFile, Rectangle, Sphere
+from lenslab.scene.textures import Texture
 from lenslab.scene.transform import transform_points
 
+from . import mitsuba_textures as mt
 from . import mitsuba_values as mv
 from .mitsuba_bsdfs import BSDF_MAPPINGS, Mapped
 
@@ -542,6 +545,9 @@ class _Importer:
         self.camera: _Camera | None = None
         self._unsupported_sensor = False
         self.search_dirs: list[Path] = []
+        self._textures: dict[tuple[int, bool], Texture | None] = {}  # texture_of's, by element and use
+        self._uv_variants: dict[str, tuple[Material, dict]] = {}  # material_on_shape's, by material name
+        self._moved_textures: dict = {}  # mt.on_shape's copies of textures, shared between materials
 
     # -- reporting ----------------------------------------------------------------------------------------
     def warn(self, node: XNode, message: str) -> None:
@@ -608,9 +614,11 @@ class _Importer:
         raise node.error("expected a colour (<rgb>, <spectrum>, <float> or a texture)")
 
     def texture_color(self, node: XNode, emission: bool = False) -> RGB:
-        p = Props(self, node)
+        """A texture's colour where LensLab takes one colour: a constant texture's, or (with a warning) the
+        mean of one that varies."""
         kind = node.type
         if kind in ("srgb", "d65", "uniform"):
+            p = Props(self, node)
             value = p.take("color") or p.take("value")
             rgb = self.color_of(value, emission) if value is not None else (1.0, 1.0, 1.0)
             if kind == "d65" and p.has("scale"):
@@ -618,15 +626,57 @@ class _Importer:
                 rgb = tuple(c * s for c in rgb)
             p.finish()
             return rgb  # type: ignore[return-value]
-        if kind == "checkerboard":
-            c0, c1 = p.color("color0", 0.4), p.color("color1", 0.2)
-            p.take("to_uv")
-            p.finish()
-            rgb = tuple((a + b) / 2 for a, b in zip(c0, c1))
-            self.warn(node, f"textures are not supported yet: the checkerboard's mean colour {_fmt(rgb)} used")
-            return rgb  # type: ignore[return-value]
-        self.warn(node, "textures are not supported yet: grey 0.5 used")
-        return (0.5, 0.5, 0.5)
+        texture = self.texture_of(node)
+        if texture is None:
+            self.warn(node, f'texture "{kind}" is not supported: grey 0.5 used')
+            return (0.5, 0.5, 0.5)
+        rgb = mt.mean_colour(self, node, texture) or (0.5, 0.5, 0.5)  # an unreadable file: warned already
+        self.warn(node, f"LensLab cannot vary this property over the surface: the {kind}'s mean colour "
+                  f"{_fmt(rgb)} used")
+        return rgb
+
+    def texture_of(self, node: XNode, scalar: bool = False) -> Texture | None:
+        """The LensLab texture for a Mitsuba ``<texture>`` element (nested in a property, or the target of a
+        ``<ref>``), or None for one LensLab cannot look up (``color_of`` then gives its mean, with a warning).
+        ``scalar``: for a property Mitsuba reads with ``eval_1`` (a weight, an opacity), where a checkerboard
+        swaps its colours (mitsuba_textures.as_scalar). Converted once per element: every material that refers
+        to it shares the one texture. Its uvs are a mesh file's; ``material_on_shape`` fits other shapes."""
+        if node.tag != "texture":
+            return None
+        key = (id(node), scalar)
+        if key not in self._textures:
+            if scalar:
+                texture = self.texture_of(node)
+                self._textures[key] = mt.as_scalar(texture) if texture is not None else None
+            else:
+                with _named_errors(node):
+                    self._textures[key] = mt.texture_from_element(self, node)
+        return self._textures[key]
+
+    def material_on_shape(self, node: XNode, p: "Props", material: str, matrix: np.ndarray) -> str:
+        """The material to give a shape of Mitsuba type ``node.type`` placed at ``matrix``: ``material`` itself,
+        or, when it holds textures and the shape's uvs are not a mesh file's, a copy whose textures take the
+        shape's own uvs (mitsuba_textures.shape_uv). The first shape to use a material gets it fitted in place;
+        a shape with other uvs, a copy named after its type."""
+        original, variants = self._uv_variants.get(material, (self.materials[material], {}))
+        if not mt.textures_of(original):
+            return material
+        flip_tex = p.bool("flip_tex_coords", mt.FLIP_TEX_COORDS_DEFAULT.get(node.type, False))
+        uv = mt.shape_uv(node.type, matrix, flip_tex, p.bool("flip_normals", False))
+        if isinstance(uv, str):
+            self.warn(node, uv)
+            uv = mt.UNMAPPED
+        if uv not in variants:
+            fitted, exact = (original, True) if uv.is_identity else mt.on_shape(original, uv, self._moved_textures)
+            if not exact:
+                self.warn(node, "Mitsuba's texture seam on this sphere is where to_world turns it, and LensLab's "
+                          "sphere keeps its seam on the world's -X: a texture that does not repeat around the "
+                          "sphere lands differently there")
+            name = material if not variants else self.unique_material(f"{material}.{node.type}")
+            self.materials[name] = fitted
+            variants[uv] = name
+            self._uv_variants[material] = (original, variants)
+        return variants[uv]
 
     # -- BSDFs --------------------------------------------------------------------------------------------
     def map_bsdf(self, node: XNode) -> Mapped:
@@ -855,31 +905,14 @@ class _Importer:
             up=tuple(float(v) + 0.0 for v in top / np.linalg.norm(top))))
 
     def _spot_texture(self, node: XNode):
-        """A spot's projected texture. Mitsuba refuses one that does not vary over space."""
+        """A spot's projected texture (Mitsuba refuses one that does not vary over space). Textures expect the
+        uvs of a mesh file (mitsuba_textures: v = 1 - Mitsuba's v), which is how SpotLight projects them."""
         if node.tag != "texture" or node.type in ("srgb", "d65", "uniform"):
             raise node.error("a spot's texture must vary over space, such as a bitmap (Mitsuba refuses others)")
-        texture_of = getattr(self, "texture_of", None)
-        if texture_of is not None:
-            texture = texture_of(node)
-            if texture is None:
-                self.warn(node, "this texture cannot be projected by LensLab: the spot shines untextured")
-            return texture
-        # Until the importer reads textures in general: a bitmap's file, as Mitsuba reads it.
-        from lenslab.scene.textures import ImageTexture
-
-        if node.type != "bitmap":
-            self.warn(node, f'texture "{node.type}" cannot be projected by LensLab: the spot shines untextured')
-            return None
-        tp = Props(self, node)
-        filename = tp.string("filename")
-        raw = tp.bool("raw", False)
-        tp.finish()
-        if not filename:
-            raise node.error('a bitmap needs a "filename"')
-        path = self.resolve_file(node, filename)
-        if not os.path.isfile(path):
-            raise node.error(f"texture not found: {path}")
-        return ImageTexture(file=self._scene_relative(path), color_space="linear" if raw else "auto")
+        texture = self.texture_of(node)
+        if texture is None:
+            self.warn(node, "this texture cannot be projected by LensLab: the spot shines untextured")
+        return texture
 
     # -- shapes -------------------------------------------------------------------------------------------
     def shape(self, node: XNode) -> list[Node]:
@@ -911,6 +944,12 @@ class _Importer:
             if flip:
                 local = mv.rotate_matrix((1, 0, 0), 180.0)
                 flip = False
+        elif kind == "cylinder":  # a tube of the cylinder's area; the node's matrix carries Mitsuba's placement
+            p0, p1 = p.vector("p0", (0, 0, 0)), p.vector("p1", (0, 0, 1))
+            with _named_errors(node):
+                whole = mt.cylinder_matrix(p0, p1, p.float("radius", 1.0), to_world)
+            shape, to_world = mt.cylinder_shape(whole, flip)
+            flip = False  # the tube's normals turn themselves
         elif kind in ("obj", "ply", "stl", "serialized"):
             filename = p.string("filename")
             if not filename:
@@ -955,6 +994,7 @@ class _Importer:
         matrix = to_world @ local
         if isinstance(shape, Sphere):
             matrix = self._similarity(node, matrix)
+        material = self.material_on_shape(node, p, material, matrix)
         return self.place(node, name, matrix, shape, material)
 
     def area_light(self, emitter: XNode, shape_node: XNode, name: str, flip: bool, bsdf: XNode | None) -> str | None:
@@ -1217,7 +1257,7 @@ class _Importer:
                 if isinstance(shape, Sphere):
                     r = shape.radius
                     local = np.array([[x, y, z] for x in (-r, r) for y in (-r, r) for z in (-r, r)])
-                elif isinstance(shape, (Rectangle, Box, Disk)):
+                elif isinstance(shape, (Rectangle, Box, Disk, Cylinder)):
                     local = shape.mesh().vertices
                 else:
                     path = Path(shape.file)
