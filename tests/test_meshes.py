@@ -54,3 +54,23 @@ def test_disk_keeps_the_area_of_the_circle():
     area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
     assert area.sum() == pytest.approx(np.pi * 0.7**2, rel=1e-9)
     assert np.all(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])[:, 2] > 0)  # front face towards +Z
+
+
+def test_a_whole_mesh_file_reads_as_one_mesh_with_its_texture_coordinates(tmp_path):
+    # The studio's import and the Mitsuba importer's framing read a file whole. A PLY with texture coordinates
+    # once failed there (trimesh wanted PIL for them); an OBJ with two materials joins its parts.
+    from lenslab.scene.io.meshes import load_mesh
+
+    ply = tmp_path / "uv.ply"
+    ply.write_text("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                   "property float s\nproperty float t\nelement face 1\nproperty list uchar int vertex_indices\n"
+                   "end_header\n0 0 0 0 0\n1 0 0 1 0\n0 1 0 0 1\n3 0 1 2\n")
+    mesh = load_mesh(ply)
+    assert mesh.faces.tolist() == [[0, 1, 2]] and mesh.uvs.tolist() == [[0, 0], [1, 0], [0, 1]]
+    (tmp_path / "two.mtl").write_text("newmtl a\nKd 1 0 0\nnewmtl b\nKd 0 1 0\n")
+    obj = tmp_path / "two.obj"
+    obj.write_text("mtllib two.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nusemtl a\nf 1 2 3\nusemtl b\nf 2 4 3\n")
+    joined = load_mesh(obj)
+    assert len(joined.faces) == 2 and joined.faces.max() < len(joined.vertices)
+    assert sorted(map(tuple, joined.vertices[joined.faces].reshape(-1, 3).round(6).tolist())) == sorted(
+        [(0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)])

@@ -7,7 +7,6 @@ does not re-read a large file.
 from __future__ import annotations
 
 import os
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -68,29 +67,20 @@ def load_mesh_parts(path: Path, smooth: bool = True, shape_index: int = 0) -> Lo
     return load_parts(path, smooth, shape_index)
 
 
-def load_mesh(path: Path, smooth: bool = True) -> TriangleMesh:
+def load_mesh(path: Path, smooth: bool = True, shape_index: int = 0) -> TriangleMesh:
+    """The whole file as one triangle mesh, its parts joined (for its extent, and for the studio's import).
+    It is read as a scene reads it (load_mesh_parts): a PLY with texture coordinates once needed PIL here."""
     path = Path(path)
     if not os.path.isfile(path):
         raise MeshLoadError(f"{path}: mesh file not found")
-    return _load_cached(str(path.resolve()), path.stat().st_mtime_ns, smooth)
+    return join_parts([part.mesh for part in load_mesh_parts(path, smooth, shape_index).parts])
 
 
-@lru_cache(maxsize=32)
-def _load_cached(path: str, mtime_ns: int, smooth: bool) -> TriangleMesh:
-    import trimesh  # imported here: a scene without mesh files never pays for it
-
-    try:
-        mesh = trimesh.load(path, force="mesh", process=False)
-    except Exception as exc:  # trimesh raises many kinds; all mean the same to the user
-        raise MeshLoadError(f"{path}: cannot read mesh ({exc})") from exc
-    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
-        raise MeshLoadError(f"{path}: no triangles in file")
-    vertices = np.asarray(mesh.vertices, dtype=np.float64)
-    faces = np.asarray(mesh.faces, dtype=np.int64)
-    check_geometry(vertices, faces, path)
-    normals = np.asarray(mesh.vertex_normals, dtype=np.float64) if smooth else None
-    uvs = None
-    visual_uv = getattr(mesh.visual, "uv", None)
-    if visual_uv is not None and len(visual_uv) == len(vertices):
-        uvs = np.asarray(visual_uv, dtype=np.float64)
+def join_parts(meshes: list[TriangleMesh]) -> TriangleMesh:
+    """One mesh of several: normals and texture coordinates kept where every part has them."""
+    offsets = np.cumsum([0] + [len(m.vertices) for m in meshes[:-1]])
+    vertices = np.concatenate([m.vertices for m in meshes])
+    faces = np.concatenate([m.faces + offset for m, offset in zip(meshes, offsets)])
+    normals = (np.concatenate([m.normals for m in meshes]) if all(m.normals is not None for m in meshes) else None)
+    uvs = np.concatenate([m.uvs for m in meshes]) if all(m.uvs is not None for m in meshes) else None
     return TriangleMesh(vertices, faces, normals, uvs)

@@ -268,12 +268,14 @@ def _scalar_or_texture(p: "Props", imp: "_Importer", name: str, default: float,
 
 
 def _texture_or_mean(imp: "_Importer", node, notes: list[str]) -> tuple[float, Texture | None]:
+    """As Mitsuba's eval_1 reads it: a bitmap's luminance (the renderer's texture_value), a checkerboard with
+    its colours swapped (texture_of's scalar form), a plain colour's channel mean."""
     if node.tag == "texture":
-        texture = imp.texture_of(node)
+        texture = imp.texture_of(node, scalar=True)
         if texture is not None:
             return 0.0, texture
     r, g, b = imp.color_of(node)  # a colour, or a texture LensLab cannot look up (averaged, with a warning)
-    return 0.2126 * r + 0.7152 * g + 0.0722 * b, None
+    return (r + g + b) / 3.0, None
 
 
 def _texture_property(p: "Props", imp: "_Importer", name: str | None) -> tuple[object, Texture | None]:

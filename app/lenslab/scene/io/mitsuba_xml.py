@@ -1263,7 +1263,7 @@ class _Importer:
                     path = Path(shape.file)
                     path = path if path.is_absolute() else self.root_folder / path
                     try:
-                        v = load_mesh(path, shape.smooth).vertices
+                        v = load_mesh(path, shape.smooth, shape.shape_index).vertices
                     except MeshLoadError as exc:
                         raise SceneError(f"{exc}") from None
                     lo, hi = v.min(axis=0), v.max(axis=0)
