@@ -61,9 +61,11 @@ float texture_value(int t, vec2 uv) { return luminance(texture_rgb(t, uv)); }
 
 // d value / d(u, v) by central differences over a step small against a texel: within a texel that is the
 // bilinear filter's exact slope. The step grows with |uv| so that float spacing never swamps it. A
-// checkerboard's value is flat but for its edges, whose slope is infinite: zero, as Mitsuba's has none.
+// checkerboard's value, and a nearest-filtered image's, is flat but for its edges, whose slope is infinite:
+// zero, as Mitsuba's eval_1_grad.
 vec2 texture_value_gradient(int t, vec2 uv) {
-    if (int(materials[texture_base + TEXTURE_ROWS * t].x) == TEXTURE_CHECKER) return vec2(0.0);
+    vec4 r0 = materials[texture_base + TEXTURE_ROWS * t], r3 = materials[texture_base + TEXTURE_ROWS * t + 3];
+    if (int(r0.x) == TEXTURE_CHECKER || int(r3.z) == TEXTURE_FILTER_NEAREST) return vec2(0.0);
     float h = max(6.1e-5, 1.2e-4 * max(abs(uv.x), abs(uv.y)));
     vec2 du = vec2(h, 0.0), dv = vec2(0.0, h);
     return vec2(texture_value(t, uv + du) - texture_value(t, uv - du),
