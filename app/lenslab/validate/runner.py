@@ -30,7 +30,8 @@ from lenslab.validate import metrics
 from lenslab.validate.mitsuba_env import load_mitsuba
 
 SCENES_DIR = Path(__file__).resolve().parent / "scenes"
-SCENE_NAMES = ("cornell_dof", "glass_metal", "environment_depths", "bokeh", "point_sun")
+SCENE_NAMES = ("cornell_dof", "glass_metal", "environment_depths", "bokeh", "point_sun", "light_bsdf", "beckmann",
+               "spot", "rotated_env", "textured", "relief")
 MITSUBA_PASS_SPP = 256  # Mitsuba's LLVM wavefront holds every sample of a pass in memory
 LENSLAB_DISPATCH_SECONDS = 0.25  # as the CLI's --headless
 
@@ -70,11 +71,19 @@ def scene_path(name: str) -> Path:
 
 
 def render_lenslab(path: Path, spp: int, seed: int, res: int, renderer, warn: Callable[[str], None]) -> Render:
-    from lenslab.render.job import RenderJob
     from lenslab.scene.overrides import SceneOverrides
 
     start = time.perf_counter()
     scene = SceneOverrides(spp=spp, seed=seed, defines={"res": str(res), "spp": str(spp)}).open(path, warn=warn)
+    return render_scene(scene, spp, renderer, warn, start)
+
+
+def render_scene(scene, spp: int, renderer, warn: Callable[[str], None], start: float | None = None) -> Render:
+    """An opened scene rendered to ``spp`` by the job ``--headless`` runs; ``seconds`` count from ``start``
+    (when the file began to load), or from now."""
+    from lenslab.render.job import RenderJob
+
+    start = time.perf_counter() if start is None else start
     job = RenderJob(renderer, scene, spp=spp, dispatch_seconds=LENSLAB_DISPATCH_SECONDS)
     for message in job.session.warnings:
         warn(message)
@@ -98,8 +107,14 @@ def render_mitsuba_file(path: Path, defines: dict[str, str], spp: int, seed: int
     renders LensLab slowed LensLab's sampling by up to four times (docs/performance.md), so that the timings
     measured the neighbourhood, not the renderer.
     """
+    return in_child_process(_render_mitsuba_here, path, defines, spp, seed)
+
+
+def in_child_process(function, *args):
+    """``function(*args)`` run in a fresh (spawned) child process, for Mitsuba (see :func:`render_mitsuba_file`);
+    its exception is raised here. A child that dies (a crash inside Mitsuba) raises BrokenProcessPool."""
     with concurrent.futures.ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("spawn")) as child:
-        return child.submit(_render_mitsuba_here, path, defines, spp, seed).result()
+        return child.submit(function, *args).result()
 
 
 def _render_mitsuba_here(path: Path, defines: dict[str, str], spp: int, seed: int) -> tuple[np.ndarray, float, float]:
