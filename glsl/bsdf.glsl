@@ -59,17 +59,18 @@ float hit_hash(SurfaceHit s, int level) {
 // A texture's scalar value, as Mitsuba's eval_1 reads a colour texture: its luminance.
 float texture_value(int t, vec2 uv) { return luminance(texture_rgb(t, uv)); }
 
-// d value / d(u, v) by central differences over a step small against a texel: within a texel that is the
-// bilinear filter's exact slope. The step grows with |uv| so that float spacing never swamps it. A
-// checkerboard's value, and a nearest-filtered image's, is flat but for its edges, whose slope is infinite:
-// zero, as Mitsuba's eval_1_grad.
+// d value / d(u, v) by differences over a step small against a texel: within a texel that is the bilinear
+// filter's exact slope. The step grows with |uv| so that float spacing never swamps it. Three lookups in a
+// loop rather than unrolled calls: each inlined lookup is a large piece of a kernel llvmpipe must compile.
+// A checkerboard's value, and a nearest-filtered image's, is flat but for its edges, whose slope is
+// infinite: zero, as Mitsuba's eval_1_grad.
 vec2 texture_value_gradient(int t, vec2 uv) {
     vec4 r0 = materials[texture_base + TEXTURE_ROWS * t], r3 = materials[texture_base + TEXTURE_ROWS * t + 3];
     if (int(r0.x) == TEXTURE_CHECKER || int(r3.z) == TEXTURE_FILTER_NEAREST) return vec2(0.0);
     float h = max(6.1e-5, 1.2e-4 * max(abs(uv.x), abs(uv.y)));
-    vec2 du = vec2(h, 0.0), dv = vec2(0.0, h);
-    return vec2(texture_value(t, uv + du) - texture_value(t, uv - du),
-                texture_value(t, uv + dv) - texture_value(t, uv - dv)) / (2.0 * h);
+    vec3 values;
+    for (int i = 0; i < 3; i++) values[i] = texture_value(t, uv + h * vec2(i == 1, i == 2));
+    return (values.yz - values.x) / h;
 }
 
 // Mitsuba's bumpmap: the surface moves by the height h(u, v) along the normal, so its tangents gain the
@@ -121,13 +122,15 @@ int resolve_material(SurfaceHit s, out vec3 ns, out float terminator) {
         vec4 r0 = material_row(m, 0);
         int type = int(r0.w);
         int inner = inner_material(m);
-        if (type == MATERIAL_BLEND) {
+        // Each kind compiled in only where the scene has it (features.glsl): the maps' code is large.
+        if (HAS_MATERIAL(MATERIAL_BLEND) && type == MATERIAL_BLEND) {
             float weight = r0.y >= 0.0 ? texture_value(int(r0.y), s.uv) : r0.x;
             if (hit_hash(s, level) < weight) inner = int(material_row(m, 2).y);
-        } else if (type == MATERIAL_BUMP_MAP || type == MATERIAL_NORMAL_MAP) {
+        } else if ((HAS_MATERIAL(MATERIAL_BUMP_MAP) && type == MATERIAL_BUMP_MAP) ||
+                   (HAS_MATERIAL(MATERIAL_NORMAL_MAP) && type == MATERIAL_NORMAL_MAP)) {
             if (r0.y >= 0.0) {
-                vec3 t = type == MATERIAL_BUMP_MAP ? bumped_normal(s, n, ng, int(r0.y), r0.x)
-                                                   : mapped_normal(s, n, int(r0.y));
+                vec3 t = (HAS_MATERIAL(MATERIAL_BUMP_MAP) && type == MATERIAL_BUMP_MAP)
+                             ? bumped_normal(s, n, ng, int(r0.y), r0.x) : mapped_normal(s, n, int(r0.y));
                 n = facing_viewer(t, n, wo);
                 tilted = true;
                 shadowing = shadowing || r0.z > 0.5;
