@@ -13,7 +13,7 @@ import pytest
 from lenslab.render.film import read_image
 from lenslab.render.job import RenderJob
 from lenslab.scene.camera import ThinLensCamera
-from lenslab.scene.io.native import load_scene, save_scene
+from lenslab.scene.io.native import FORMAT_VERSION, load_scene, save_scene
 from lenslab.scene.scene import SceneError
 from tests.scenes import axis_camera, point_light_scene
 
@@ -104,7 +104,7 @@ def test_nothing_nearer_than_four_focal_lengths_from_the_sensor(tmp_path):
         load_scene(path)
 
 
-def test_a_version_1_scene_keeps_its_meaning_and_saves_as_version_2(tmp_path):
+def test_a_version_1_scene_keeps_its_meaning_and_saves_as_the_current_version(tmp_path):
     path = tmp_path / "old.json"
     path.write_text(json.dumps({"lenslab_scene": 1, "camera": {"focal_length_mm": 50, "focus_distance_m": 1.5,
                                                                 "resolution": [60, 90]}}))
@@ -112,7 +112,7 @@ def test_a_version_1_scene_keeps_its_meaning_and_saves_as_version_2(tmp_path):
     assert (old.focus_from, old.focus_breathing, old.sensor_fit) == ("lens", False, "horizontal")
     assert old.plane_of_focus_m == 1.5 and old.frame().tan_half_fov[0] == pytest.approx(0.36)
     save_scene(load_scene(path), tmp_path / "new.json")
-    assert json.loads((tmp_path / "new.json").read_text())["lenslab_scene"] == 2
+    assert json.loads((tmp_path / "new.json").read_text())["lenslab_scene"] == FORMAT_VERSION
     again = load_scene(tmp_path / "new.json").camera
     assert again.frame().tan_half_fov == pytest.approx(old.frame().tan_half_fov)
     path.write_text(json.dumps({"lenslab_scene": 1, "camera": {"sensor_fit": "fill"}}))
