@@ -322,3 +322,21 @@ def test_absorption_follows_beer_lambert(renderer):
     expected = np.exp(-sigma * thickness)
     assert np.allclose(expected, np.power(color, thickness / distance))  # the artist's colour at a distance
     np.testing.assert_allclose(image[6:10, 6:10].reshape(-1, 3).mean(axis=0), expected, rtol=0.01)
+
+
+@pytest.mark.parametrize("distribution", ["ggx", "beckmann"])
+def test_a_rough_coatings_transmittance_is_what_neither_reflects_nor_shadows(distribution):
+    # Plastic's single-scattering coating (Mitsuba's roughplastic) lets through the rough interface's
+    # transmittance: the smooth Fresnel value when nearly smooth, never more than what it does not reflect,
+    # and less the rougher it is (its microfacets shadow part of what refracts).
+    from lenslab.render.fresnel import fresnel_dielectric, rough_reflectance_table, rough_transmittance_table
+
+    mu = np.arange(64) / 63
+    smooth = rough_transmittance_table(1.5, 1e-4, distribution)
+    np.testing.assert_allclose(smooth[8:], 1 - fresnel_dielectric(mu[8:], 1.5), atol=2e-3)
+    previous = smooth
+    for alpha in (0.1, 0.3, 0.6, 1.0):
+        t = rough_transmittance_table(1.5, alpha, distribution)
+        assert np.all(t <= 1 - rough_reflectance_table(1.5, alpha, distribution) + 1e-3)
+        assert np.all(t[40:] <= previous[40:] + 1e-3) and t[48] < previous[48]  # (at grazing, roughness lets more in)
+        previous = t

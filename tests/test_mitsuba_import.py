@@ -421,9 +421,9 @@ def test_each_bsdf_maps_to_a_material_with_one_warning_per_approximation(tmp_pat
                            '<float name="alpha" value="0.09"/><rgb name="specular_reflectance" value="0.5"/>',
                            Conductor(metal="copper", tint=(0.5, 0.5, 0.5), roughness=0.3), None),
         "plastic": ('<rgb name="diffuse_reflectance" value="0.1, 0.2, 0.3"/><string name="int_ior" value="bk7"/>',
-                    Plastic((0.1, 0.2, 0.3), ior=1.5046 / 1.000277), None),
+                    Plastic((0.1, 0.2, 0.3), ior=1.5046 / 1.000277, coating="single_scattering"), None),
         "roughplastic": ("", Plastic((0.5, 0.5, 0.5), ior=1.49 / 1.000277, roughness=math.sqrt(0.1),
-                                     distribution="beckmann"), None),
+                                     distribution="beckmann", coating="single_scattering"), None),
         "dielectric": ('<float name="int_ior" value="1.33"/><float name="ext_ior" value="1"/>'
                        '<rgb name="specular_transmittance" value="0.9, 1, 1"/>', Dielectric(1.33, tint=(0.9, 1.0, 1.0)), None),
         "roughdielectric": ('<float name="alpha_u" value="0.04"/><float name="alpha_v" value="0.16"/>'

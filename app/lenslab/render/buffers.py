@@ -16,7 +16,8 @@ from typing import Sequence
 import numpy as np
 
 from lenslab.render.bsp import KdTree, build_kdtree
-from lenslab.render.fresnel import internal_diffuse_reflectance, rough_internal_reflectance, rough_transmittance_table
+from lenslab.render.fresnel import (internal_diffuse_reflectance, rough_internal_reflectance, rough_reflectance_table,
+                                    rough_transmittance_table)
 from lenslab.render.environment import EnvironmentDistribution, environment_power, infinite_light_power
 from lenslab.render.gl import make_current
 from lenslab.limits import SceneTooLarge, format_bytes  # SceneTooLarge: raised here, imported from here
@@ -99,11 +100,15 @@ def pack_material(material: Material, textures: TextureTable, inner: Sequence[in
         alpha = float(record[2, 3])
         record[2, 0] = material.ior
         if alpha > 0:
-            # A rough coating lets through a different share than Fresnel alone says: tabulate it (Mitsuba's
-            # roughplastic), so the diffuse base gets exactly what the coating lets through.
+            # A rough coating lets through a different share than Fresnel alone says: tabulate it, so the
+            # diffuse base gets exactly what the coating lets through (Plastic.coating says which share).
             distribution = material.distribution
             record[2, 1] = rough_internal_reflectance(material.ior, alpha, distribution)
-            table = textures.add_floats(rough_transmittance_table(material.ior, alpha, distribution).astype(np.float32))
+            if material.coating == "single_scattering":
+                through = rough_transmittance_table(material.ior, alpha, distribution)
+            else:
+                through = 1.0 - rough_reflectance_table(material.ior, alpha, distribution)
+            table = textures.add_floats(through.astype(np.float32))
             record[2, 2] = np.int32(table).view(np.float32)
         else:
             record[2, 1] = internal_diffuse_reflectance(material.ior)

@@ -24,6 +24,7 @@ from lenslab.scene.textures import Texture
 RGB = tuple[float, float, float]
 
 MICROFACET_DISTRIBUTIONS = ("ggx", "beckmann")
+COATINGS = ("energy_conserving", "single_scattering")  # Plastic.coating
 _DISTRIBUTION = {"choices": MICROFACET_DISTRIBUTIONS,
                  "doc": "microfacet distribution of a rough surface: GGX (long tails) or Beckmann"}
 
@@ -99,6 +100,11 @@ class Plastic(Material):
     roughness: float = field(default=0.0, metadata={"range": (0.0, 1.0)})
     roughness_texture: Texture | None = None
     distribution: str = field(default="ggx", metadata=_DISTRIBUTION)
+    coating: str = field(default="energy_conserving", metadata={
+        "choices": COATINGS,
+        "doc": "how much light a rough coating lets through to the base: all it does not reflect "
+               "(energy_conserving), or only what refracts unshadowed by its microfacets (single_scattering: "
+               "Mitsuba's roughplastic, darker when very rough)"})
 
 
 @dataclass

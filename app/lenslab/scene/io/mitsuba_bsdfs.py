@@ -203,8 +203,9 @@ def _map_plastic(p: "Props", imp: "_Importer") -> Mapped:
         notes.append("specular_reflectance is not supported: the coat reflects as clear plastic")
     if p.bool("nonlinear", False):
         notes.append("nonlinear colour shift is not supported")
-    return Mapped(Plastic(albedo=albedo, albedo_texture=texture, ior=ior, roughness=roughness, distribution=distribution),
-                  _note(notes))
+    # Mitsuba's roughplastic passes to its base only what refracts unshadowed (its eval_transmittance).
+    return Mapped(Plastic(albedo=albedo, albedo_texture=texture, ior=ior, roughness=roughness, distribution=distribution,
+                          coating="single_scattering"), _note(notes))
 
 
 def _map_dielectric(p: "Props", imp: "_Importer") -> Mapped:
