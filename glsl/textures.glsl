@@ -33,8 +33,9 @@ struct ImageRecord {
     bool full_float;
 };
 
+// The texel at column x, row y, both already wrapped into the image.
 vec3 texel(ImageRecord im, int x, int y) {
-    int n = wrap_texel(y, im.height, im.wrap) * im.width + wrap_texel(x, im.width, im.wrap);
+    int n = y * im.width + x;
     if (im.full_float) {
         int i = im.first + 3 * n;
         return uintBitsToFloat(uvec3(image_data[i], image_data[i + 1], image_data[i + 2]));
@@ -57,13 +58,16 @@ vec3 texture_rgb(int t, vec2 uv) {
     vec2 p = vec2(st.x * float(im.width), (1.0 - st.y) * float(im.height));  // in texels, row 0 at the top
     if (int(r3.z) == TEXTURE_FILTER_NEAREST) {
         ivec2 i = ivec2(floor(p));
-        return texel(im, i.x, i.y);
+        return texel(im, wrap_texel(i.x, im.width, im.wrap), wrap_texel(i.y, im.height, im.wrap));
     }
-    // Bilinear filtering between the four nearest texel centres.
+    // Bilinear filtering between the four nearest texel centres: two columns and two rows, each wrapped once
+    // (every lookup of an environment map comes here: wrapping per texel cost a glass scene 7% of its speed).
     p -= 0.5;
     vec2 f = fract(p);
     ivec2 i = ivec2(floor(p));
-    vec3 a = mix(texel(im, i.x, i.y), texel(im, i.x + 1, i.y), f.x);
-    vec3 b = mix(texel(im, i.x, i.y + 1), texel(im, i.x + 1, i.y + 1), f.x);
+    int x0 = wrap_texel(i.x, im.width, im.wrap), x1 = wrap_texel(i.x + 1, im.width, im.wrap);
+    int y0 = wrap_texel(i.y, im.height, im.wrap), y1 = wrap_texel(i.y + 1, im.height, im.wrap);
+    vec3 a = mix(texel(im, x0, y0), texel(im, x1, y0), f.x);
+    vec3 b = mix(texel(im, x0, y1), texel(im, x1, y1), f.x);
     return mix(a, b, f.y);
 }

@@ -3,7 +3,8 @@
 * **Block bias**: the image cut into 16 x 16 blocks; each block's mean (over pixels and the three channels)
   against the reference's, as a relative difference ``(mean - ref) / ref``. Blocks darker than 1% of the
   reference image's mean are left out (a relative figure means nothing there; their absolute error is
-  still in the relative MSE). Reported: the largest and the median absolute block bias.
+  still in the relative MSE). Reported: the largest, the median and the 95th-percentile absolute block bias.
+* **Total light**: the sum of an image over the reference's, less one: ``+0.01`` is 1% more light in all.
 * **Relative MSE**: ``mean((x - ref)^2 / (ref^2 + eps))`` over pixels and channels, with eps = 0.01, the
   usual guard against division by near-black reference pixels.
 """
@@ -43,6 +44,7 @@ class BiasSummary:
     max_abs: float  # the most biased block, as a fraction (0.02 = 2%)
     median_abs: float
     blocks: int  # blocks counted (bright enough to judge)
+    p95_abs: float = float("nan")  # the 95th percentile: the worst blocks but for a few
 
     def meets(self, max_allowed: float = 0.02, median_allowed: float = 0.01) -> bool:
         return self.max_abs <= max_allowed and self.median_abs <= median_allowed
@@ -52,7 +54,17 @@ def summarize_bias(bias: np.ndarray) -> BiasSummary:
     values = np.abs(bias[np.isfinite(bias)])
     if values.size == 0:
         return BiasSummary(float("nan"), float("nan"), 0)
-    return BiasSummary(float(values.max()), float(np.median(values)), int(values.size))
+    return BiasSummary(float(values.max()), float(np.median(values)), int(values.size),
+                       float(np.percentile(values, 95)))
+
+
+def total_light(image: np.ndarray, reference: np.ndarray) -> float:
+    """``sum(image) / sum(reference) - 1`` over pixels and channels: how much more (or less) light in all."""
+    image, reference = np.asarray(image, np.float64), np.asarray(reference, np.float64)
+    if image.shape != reference.shape:
+        raise ValueError(f"image {image.shape} and reference {reference.shape} differ in shape")
+    total = float(reference.sum())
+    return float(image.sum()) / total - 1.0 if total > 0 else float("nan")
 
 
 def relative_mse(image: np.ndarray, reference: np.ndarray, eps: float = REL_MSE_EPS) -> float:

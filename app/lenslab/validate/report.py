@@ -14,6 +14,7 @@ from lenslab.validate.metrics import BiasSummary
 HEADER = ("scene", "size", "bias max M", "bias med M", "bias max L", "bias med L", "relMSE M", "relMSE L",
           "time M", "time L", "goal")
 DIFF_RANGE = 0.2  # the difference image shows (LensLab - reference) / reference mean, full colour at 20%
+OWN_SCENES_HEADING = "## Mitsuba's own scenes"  # docs/validation.md's section on --files runs, kept by write_docs
 
 
 def _pct(value: float) -> str:
@@ -151,5 +152,104 @@ Difference: red where LensLab is brighter than the reference, blue where darker,
 """ + "\n".join(sections)
     docs_dir.mkdir(parents=True, exist_ok=True)
     path = docs_dir / "validation.md"
+    if path.is_file():  # the --files section is written by hand from its own run: kept
+        old = path.read_text(encoding="utf-8")
+        at = old.find("\n" + OWN_SCENES_HEADING)
+        if at >= 0:
+            text = text.rstrip("\n") + "\n\n" + old[at + 1:]
     path.write_text(text, encoding="utf-8")
     return path
+
+
+# ---------------------------------------------------------------------------------------------------------
+# --files: any scene files against issue 11's goal (validate/files.py)
+# ---------------------------------------------------------------------------------------------------------
+FILES_HEADER = ("scene", "size", "warnings", "drops", "block med", "block p95", "noise med", "total light", "goal",
+                "why")
+
+
+def _signed_pct(value: float) -> str:
+    return "n/a" if value != value else f"{100 * value:+.2f}%"
+
+
+def files_row(result) -> tuple[str, ...]:
+    lb, mb = result.lenslab_bias, result.mitsuba_bias
+    size = "%dx%d" % result.resolution if result.resolution else "-"
+    why = result.error if result.error is not None else ", ".join(result.reasons())
+    return (result.name, size, str(len(result.warnings)), str(len(result.drops)),
+            _pct(lb.median_abs) if lb else "n/a", _pct(lb.p95_abs) if lb else "n/a",
+            _pct(mb.median_abs) if mb else "n/a", _signed_pct(result.total_light), result.verdict, why)
+
+
+def _legend(spp: int, reference_spp: int) -> str:
+    from lenslab.validate.files import GOAL_MEDIAN, GOAL_TOTAL_LIGHT
+
+    return (f"LensLab at {spp} spp against Mitsuba 3 at {reference_spp} spp. block med / p95: the median and 95th "
+            f"percentile of |16x16 block mean - reference| / reference; noise med: Mitsuba's own at {spp} spp (what "
+            f"noise alone gives); total light: LensLab's sum over the reference's, less one. PASS: nothing dropped, "
+            f"block med <= {100 * GOAL_MEDIAN:g}% and |total light| <= {100 * GOAL_TOTAL_LIGHT:g}% (issue 11).")
+
+
+def _failing(results) -> dict[str, list[str]]:
+    return {r.name: r.warnings for r in results if r.verdict != "PASS"}
+
+
+def _refused(results) -> dict[str, str]:
+    """The scenes Mitsuba rendered and LensLab would not open or render: name -> LensLab's reason."""
+    prefix = "LensLab: "
+    return {r.name: r.error[len(prefix):] for r in results
+            if r.error and r.reference is not None and r.error.startswith(prefix)}
+
+
+def format_files_report(results, *, spp: int, reference_spp: int) -> str:
+    """The table, each scene's warnings (one a line, its kind first), and the missing features ranked."""
+    from lenslab.validate import findings
+
+    lines = [format_table([files_row(r) for r in results], FILES_HEADER), "", _legend(spp, reference_spp)]
+    for r in results:
+        if r.warnings:
+            lines += ["", f"{r.name}: {len(r.warnings)} warning{'s' if len(r.warnings) != 1 else ''}"]
+            lines += [f"  {findings.kind_of(w)}: {w}" for w in r.warnings]
+    ranked = findings.rank_missing_features(_failing(results), _refused(results))
+    if ranked:
+        lines += ["", "Missing features, by the number of scenes short of the goal that they appear in "
+                  "(whole: how many would then open with nothing dropped):"]
+        for m in ranked:
+            lines.append(f"  {len(m.scenes):3d} scene{'s' if len(m.scenes) != 1 else ' '}  whole {len(m.sole_blocker):3d}  {m.kind:12s}  {m.feature}")
+            lines.append(f"      {', '.join(m.scenes)}")
+    return "\n".join(lines)
+
+
+def _md(text: str) -> str:
+    return text.replace("|", "\\|").replace("<", "&lt;").replace(">", "&gt;")
+
+
+def markdown_files_report(results, *, spp: int, reference_spp: int) -> str:
+    """The same for docs/validation.md: the table, per scene what LensLab drops or approximates (each feature
+    once, with how many elements), and the missing features ranked."""
+    from collections import Counter
+
+    from lenslab.validate import findings
+
+    rows = [tuple(_md(c) for c in files_row(r)) for r in results]
+    out = [markdown_table(rows, FILES_HEADER), "", _legend(spp, reference_spp), ""]
+    described = [r for r in results if any(f.kind != findings.NOTES for f in findings.findings(r.warnings))]
+    if described:
+        out += ["**What LensLab drops or approximates, per scene** (each element counted once):", ""]
+        for r in described:
+            groups = []
+            for kind in (findings.DROPS, findings.APPROXIMATES):
+                counts = Counter(f.feature for f in findings.findings(r.warnings) if f.kind == kind)
+                if counts:
+                    groups.append(f"{kind}: " + "; ".join(f"`{f}`" + (f" (x{n})" if n > 1 else "")
+                                                          for f, n in counts.items()))
+            out.append(f"- **{_md(r.name)}**: " + ". ".join(groups))
+        out.append("")
+    ranked = findings.rank_missing_features(_failing(results), _refused(results))
+    if ranked:
+        out += ["**Missing features**, by the number of scenes short of the goal that they appear in (*whole*: "
+                "how many of those would then open with nothing dropped):", "",
+                "| feature | kind | scenes | whole | which |", "| --- | --- | --- | --- | --- |"]
+        out += [f"| `{m.feature.replace('|', '/')}` | {m.kind} | {len(m.scenes)} | {len(m.sole_blocker)} | "
+                f"{_md(', '.join(m.scenes))} |" for m in ranked]
+    return "\n".join(out) + "\n"
