@@ -451,11 +451,18 @@ def test_each_bsdf_maps_to_a_material_with_one_warning_per_approximation(tmp_pat
 
 
 def test_conductors_without_a_preset_reflect_their_normal_incidence_colour(tmp_path):
+    # A name Mitsuba 3 knows (amorphous carbon, chromium) takes Mitsuba's own complex index, with no warning;
+    # a name only Mitsuba 0.6 knew (Ti) is matched at normal incidence, with one.
+    for name in ("a-C", "Cr"):
+        scene, warnings = load(tmp_path, camera_xml() + '<shape type="sphere"><bsdf type="conductor">'
+                               f'<string name="material" value="{name}"/></bsdf></shape>')
+        metal = scene.materials[scene.nodes[0].material]
+        assert metal.complex_ior() == mv.MITSUBA_CONDUCTOR_IORS[name] and warnings == []
     scene, warnings = load(tmp_path, camera_xml() + '<shape type="sphere"><bsdf type="conductor">'
-                           '<string name="material" value="Cr"/></bsdf></shape>')
+                           '<string name="material" value="Ti"/></bsdf></shape>')
     metal = scene.materials[scene.nodes[0].material]
-    assert np.allclose(mv.conductor_f0(*metal.complex_ior()), mv.CONDUCTOR_F0["Cr"])
-    assert "normal incidence" in only(warnings, '"Cr"')
+    assert np.allclose(mv.conductor_f0(*metal.complex_ior()), mv.CONDUCTOR_F0["Ti"])
+    assert "normal incidence" in only(warnings, '"Ti"')
     with pytest.raises(SceneError, match='line 3: <string name="int_ior">: unknown index of refraction "glas"'):
         load(tmp_path, camera_xml() + '<shape type="sphere"><bsdf type="plastic"><string name="int_ior" '
              'value="glas"/></bsdf></shape>')
@@ -724,4 +731,14 @@ def test_wrapping_bsdfs_map_onto_layered_materials(tmp_path):
     mask = scene.materials[scene.nodes[1].material]
     assert isinstance(mask, Mask) and mask.opacity == pytest.approx(0.25) and mask.material == Diffuse((0.5,) * 3)
     assert "a mask inside a blend does not cut" in only(warnings, "inside a blend")
+    assert len(warnings) == 1
+
+
+def test_a_top_level_sampler_referred_to_by_the_sensor_is_used_without_a_warning(tmp_path):
+    body = ('<sampler type="stratified" id="s"><integer name="sample_count" value="9"/></sampler>'
+            '<sensor type="perspective"><ref id="s"/><film type="hdrfilm"><integer name="width" value="8"/>'
+            '<integer name="height" value="8"/></film></sensor><shape type="sphere"/>')
+    scene, warnings = load(tmp_path, body)
+    assert scene.render.spp == 9 and scene.render.sampler == "sobol"
+    assert 'sampler "stratified" is rendered with' in only(warnings, "stratified")
     assert len(warnings) == 1

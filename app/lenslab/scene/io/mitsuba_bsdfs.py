@@ -166,6 +166,9 @@ def _map_conductor(p: "Props", imp: "_Importer") -> Mapped:
         elif name == "none":  # Mitsuba's default: a perfect mirror, which eta 0, k 1 gives at every angle
             material = Conductor(metal="custom", eta=(0.0, 0.0, 0.0), k=(1.0, 1.0, 1.0), tint=tint, roughness=roughness,
                                  distribution=distribution)
+        elif name in mv.MITSUBA_CONDUCTOR_IORS:  # Mitsuba 3's own data: exact
+            eta, k = mv.MITSUBA_CONDUCTOR_IORS[name]
+            material = Conductor(metal="custom", eta=eta, k=k, tint=tint, roughness=roughness, distribution=distribution)
         else:
             f0 = mv.CONDUCTOR_F0.get(name)
             if f0 is None:

@@ -747,7 +747,8 @@ class _Importer:
             self.resolve_ref(child)
             self.warn(child, "a top-level <ref> adds nothing: ignored")
         elif tag == "sampler":
-            self.warn(child, "a sampler belongs inside the <sensor> (Mitsuba 3 ignores it here too): ignored")
+            if "id" not in child.attrs:  # with an id it is used where a sensor refers to it
+                self.warn(child, "a sampler belongs inside the <sensor> (Mitsuba 3 ignores it here too): ignored")
         elif tag in OBJECT_TAGS or tag in VALUE_TAGS:
             self.warn(child, "not expected in <scene>: ignored")
         else:
