@@ -51,9 +51,7 @@ struct Bsdf {
 
 // A number in [0, 1) from the hit itself, so that choosing within a blend takes no dimension of the sampler.
 float hit_hash(SurfaceHit s, int level) {
-    uvec3 p = floatBitsToUint(s.p), w = floatBitsToUint(s.wo);
-    uint h = hash_u32(p.x ^ hash_u32(p.y ^ hash_u32(p.z ^ hash_u32(w.x ^ hash_u32(w.y ^ hash_u32(w.z + uint(level)))))));
-    return float(h >> 8) * (1.0 / 16777216.0);
+    return hash_unit(s.p, s.wo.xy, floatBitsToUint(s.wo.z) + uint(level));
 }
 
 // A texture's scalar value, as Mitsuba's eval_1 reads a colour texture: its luminance.

@@ -54,5 +54,14 @@ uint hash_u32(uint x) {  // lowbias32 (Chris Wellons): rng.glsl's scrambles, and
     return x;
 }
 
+// A number in [0, 1) hashed from the bits of a point or direction a, two more words b and a last word x: the
+// choices made by hashing a hit or a ray (a blend's pick, a mask's cut-out), which take no sampler dimension.
+float hash_unit(vec3 a, vec2 b, uint x) {
+    uvec3 ua = floatBitsToUint(a);
+    uvec2 ub = floatBitsToUint(b);
+    uint h = hash_u32(ua.x ^ hash_u32(ua.y ^ hash_u32(ua.z ^ hash_u32(ub.x ^ hash_u32(ub.y ^ hash_u32(x))))));
+    return float(h >> 8) * (1.0 / 16777216.0);
+}
+
 float luminance(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
 float max_component(vec3 c) { return max(c.x, max(c.y, c.z)); }

@@ -42,7 +42,5 @@ bool passes_through(Ray ray, int prim, float t, vec2 bary) {
     }
     float opacity = material_opacity(m, uv);
     if (opacity >= 1.0) return false;
-    uvec3 o = floatBitsToUint(ray.o), d = floatBitsToUint(ray.d);
-    uint h = hash_u32(o.x ^ hash_u32(o.y ^ hash_u32(o.z ^ hash_u32(d.x ^ hash_u32(d.y ^ hash_u32(d.z ^ hash_u32(uint(prim))))))));
-    return float(h >> 8) * (1.0 / 16777216.0) >= opacity;
+    return hash_unit(ray.o, ray.d.xy, floatBitsToUint(ray.d.z) ^ hash_u32(uint(prim))) >= opacity;
 }

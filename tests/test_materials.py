@@ -182,62 +182,53 @@ def test_rough_materials_never_create_energy(renderer, material):
     assert ball.mean() > (0.6 if isinstance(material, Plastic) and material.roughness > 0 else 0.85)
 
 
-def test_rough_conductor_albedo_matches_numerical_integration(renderer):
-    # The directional albedo of a perfect GGX mirror (alpha 0.64), from the GPU's sampling, against a
-    # numpy integral of D G / (4 cos_o cos_i) cos_i over the hemisphere.
-    alpha = 0.64
-    probe = BsdfProbe(renderer, Conductor(roughness=0.8, **PERFECT_MIRROR))
-    rng = np.random.default_rng(3)
+def assert_mirror_albedo_matches_integral(renderer, material, d_of_cos2, lam, seed):
+    """The directional albedo of a perfect microfacet mirror, from the GPU's sampling, against a numpy integral
+    of D G / (4 cos_o cos_i) cos_i over the hemisphere, for D (a function of cos^2 of the microfacet normal)
+    and Smith's Lambda written in the test from the formulas; G is height-correlated, as ours."""
+    probe = BsdfProbe(renderer, material)
+    rng = np.random.default_rng(seed)
     wi = rng.normal(size=(1_000_000, 3))
     wi /= np.linalg.norm(wi, axis=1, keepdims=True)
     wi[:, 2] = np.abs(wi[:, 2])
+    try:
+        for theta in (5.0, 45.0, 75.0):
+            wo = direction(theta)
+            m = wi + wo
+            m /= np.linalg.norm(m, axis=1, keepdims=True)
+            f_cos = d_of_cos2(m[:, 2] ** 2) / (1 + lam(wo) + lam(wi)) / (4 * wo[2])
+            reference = f_cos.mean() * 2 * np.pi
+            sampled = probe.sample(wo, rng.random((400_000, 3))).weight[:, 0].mean()
+            assert sampled == pytest.approx(reference, rel=0.01)
+    finally:
+        probe.release()
+
+
+def test_rough_conductor_albedo_matches_numerical_integration(renderer):
+    # A perfect GGX mirror (alpha 0.64).
+    alpha = 0.64
 
     def lam(w):
         c2 = w[..., 2] ** 2
         return 0.5 * (np.sqrt(1 + alpha**2 * (1 - c2) / c2) - 1)
 
-    try:
-        for theta in (5.0, 45.0, 75.0):
-            wo = direction(theta)
-            m = wi + wo
-            m /= np.linalg.norm(m, axis=1, keepdims=True)
-            d = alpha**2 / (np.pi * (m[:, 2] ** 2 * (alpha**2 - 1) + 1) ** 2)
-            f_cos = d / (1 + lam(wo) + lam(wi)) / (4 * wo[2])
-            reference = f_cos.mean() * 2 * np.pi
-            sampled = probe.sample(wo, rng.random((400_000, 3))).weight[:, 0].mean()
-            assert sampled == pytest.approx(reference, rel=0.01)
-    finally:
-        probe.release()
+    assert_mirror_albedo_matches_integral(
+        renderer, Conductor(roughness=0.8, **PERFECT_MIRROR),
+        lambda cos2: alpha**2 / (np.pi * (cos2 * (alpha**2 - 1) + 1) ** 2), lam, seed=3)
 
 
 def test_beckmann_albedo_matches_numerical_integration(renderer):
     # The same check for Beckmann (Mitsuba's default distribution), whose normals are drawn from D cos rather
-    # than from the visible normals: the sampled albedo of a perfect mirror against a numpy integral with
-    # Beckmann's D and Walter et al.'s Lambda, written here from the formulas.
+    # than from the visible normals: Beckmann's D and Walter et al.'s Lambda.
     alpha = 0.5
-    probe = BsdfProbe(renderer, Conductor(roughness=math.sqrt(alpha), distribution="beckmann", **PERFECT_MIRROR))
-    rng = np.random.default_rng(4)
-    wi = rng.normal(size=(1_000_000, 3))
-    wi /= np.linalg.norm(wi, axis=1, keepdims=True)
-    wi[:, 2] = np.abs(wi[:, 2])
 
     def lam(w):
         a = 1 / (alpha * np.sqrt(np.maximum(1 - w[..., 2] ** 2, 1e-12)) / w[..., 2])
         return np.where(a >= 1.6, 0.0, (1 - 1.259 * a + 0.396 * a**2) / (3.535 * a + 2.181 * a**2))
 
-    try:
-        for theta in (5.0, 45.0, 75.0):
-            wo = direction(theta)
-            m = wi + wo
-            m /= np.linalg.norm(m, axis=1, keepdims=True)
-            cos2 = m[:, 2] ** 2
-            d = np.exp(-(1 - cos2) / cos2 / alpha**2) / (np.pi * alpha**2 * cos2**2)
-            f_cos = d / (1 + lam(wo) + lam(wi)) / (4 * wo[2])
-            reference = f_cos.mean() * 2 * np.pi
-            sampled = probe.sample(wo, rng.random((400_000, 3))).weight[:, 0].mean()
-            assert sampled == pytest.approx(reference, rel=0.01)
-    finally:
-        probe.release()
+    assert_mirror_albedo_matches_integral(
+        renderer, Conductor(roughness=math.sqrt(alpha), distribution="beckmann", **PERFECT_MIRROR),
+        lambda cos2: np.exp(-(1 - cos2) / cos2 / alpha**2) / (np.pi * alpha**2 * cos2**2), lam, seed=4)
 
 
 def test_beckmann_evaluates_as_mitsuba(renderer, mitsuba):

@@ -121,13 +121,7 @@ def test_usage_errors(capsys):
 # ---------------------------------------------------------------------------------------------------------
 # With Mitsuba 3: the command itself, on tiny images
 # ---------------------------------------------------------------------------------------------------------
-@pytest.fixture(scope="module")
-def mitsuba():
-    pytest.importorskip("mitsuba", reason="Mitsuba 3 is not installed (pip install 'lenslab[validate]')")
-    works, why = mitsuba_env.mitsuba_works()
-    if not works:
-        pytest.skip(why)
-    return mitsuba_env.load_mitsuba()
+# The `mitsuba` fixture (tests/conftest.py) gives Mitsuba's module, or skips saying why it cannot render here.
 
 
 @pytest.mark.gl

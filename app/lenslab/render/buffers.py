@@ -32,7 +32,7 @@ from lenslab.render.gpu_layout import (ENV_CONSTANT, ENV_MAP, GEOMETRY_BINDING, 
 from lenslab.render.textures import TextureTable, read_texture_image
 from lenslab.scene.flatten import FlatScene
 from lenslab.scene.materials import (Blend, BumpMap, Conductor, Diffuse, Dielectric, Emissive, Mask, Material,
-                                     NormalMap, Plastic, ThinDielectric, inner_materials)
+                                     NormalMap, Plastic, ThinDielectric, WRAPPER_TYPES, inner_materials)
 from lenslab.render.gpu_layout import LIGHT_SPOT, SPOT_PARAMS
 from lenslab.scene.lights import Light, PointLight, SpotLight, SunLight
 from lenslab.scene.scene import ConstantEnvironment, Environment, EnvironmentMap, SceneError
@@ -75,7 +75,7 @@ def pack_material(material: Material, textures: TextureTable, inner: Sequence[in
         record[2, :2] = -1.0  # holds no material
     for slot, index in enumerate(inner):
         record[2, slot] = index
-    if isinstance(material, (Blend, Mask, BumpMap, NormalMap)):
+    if isinstance(material, WRAPPER_TYPES):
         value, texture = {Blend: ("weight", "weight_texture"), Mask: ("opacity", "opacity_texture"),
                           BumpMap: ("scale", "texture"), NormalMap: (None, "texture")}[type(material)]
         record[0, 0] = getattr(material, value) if value else 0.0
@@ -165,7 +165,8 @@ def held_materials(records: np.ndarray, used: Sequence[int]) -> set[int]:
     return seen
 
 
-HOLDING_CODES = (MATERIAL_EMISSIVE, MATERIAL_BLEND, MATERIAL_MASK, MATERIAL_BUMP_MAP, MATERIAL_NORMAL_MAP)
+WRAPPER_CODES = tuple(MATERIAL_CODES[cls] for cls in WRAPPER_TYPES)  # parameter and texture in row 0
+HOLDING_CODES = (MATERIAL_EMISSIVE, *WRAPPER_CODES)  # the records whose row 2 names records they hold
 
 
 def _emitted_power(flat: FlatScene) -> np.ndarray:

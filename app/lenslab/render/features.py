@@ -16,9 +16,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lenslab.render.buffers import HOLDING_CODES, MATERIAL_CODES, PackedScene, held_materials
+from lenslab.render.buffers import HOLDING_CODES, MATERIAL_CODES, WRAPPER_CODES, PackedScene, held_materials
 from lenslab.render.gpu_layout import (ENV_MAP, GEOMETRY_ROWS, LIGHT_AREA, LIGHT_ENVIRONMENT, LIGHT_POINT, LIGHT_ROWS,
-                                       LIGHT_SPOT, LIGHT_SUN, MATERIAL_BLEND, MATERIAL_ROWS,
+                                       LIGHT_SPOT, LIGHT_SUN, MATERIAL_ROWS,
                                        MICROFACET_BECKMANN)
 
 ALL_MATERIAL_TYPES = frozenset(MATERIAL_CODES.values())
@@ -82,7 +82,7 @@ def scene_features(packed: PackedScene) -> KernelFeatures:
     return KernelFeatures(
         spheres=prim_count > triangle_count,
         textures=bool((records[:, 3, 3] >= 0).any() or (records[:, 4, 3] >= 0).any()
-                      or ((records[:, 0, 3] >= MATERIAL_BLEND) & (records[:, 0, 1] >= 0)).any()),
+                      or (np.isin(records[:, 0, 3], WRAPPER_CODES) & (records[:, 0, 1] >= 0)).any()),
         environment_map=int(uniforms["env_type"]) == ENV_MAP,
         environment_light=LIGHT_ENVIRONMENT in light_kinds,
         area_lights=LIGHT_AREA in light_kinds,

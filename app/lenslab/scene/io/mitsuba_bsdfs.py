@@ -259,16 +259,10 @@ def _scalar_or_texture(p: "Props", imp: "_Importer", name: str, default: float,
                        notes: list[str]) -> tuple[float, Texture | None]:
     """A property Mitsuba reads with eval_1: a number, a colour (its luminance) or a texture (its luminance,
     looked up where the ray hits)."""
-    node = p.take(name)
-    if node is None:
-        return default, None
-    if node.tag in ("float", "integer"):
-        text = node.attrs.get("value", "")
-        try:
-            return mv.parse_number(text), None
-        except ValueError:
-            raise node.error(f'could not parse "{text}" as a finite floating point value') from None
-    return _texture_or_mean(imp, node, notes)
+    node = p.values.get(name)
+    if node is None or node.tag in ("float", "integer"):
+        return p.float(name, default), None
+    return _texture_or_mean(imp, p.take(name), notes)
 
 
 def _texture_or_mean(imp: "_Importer", node, notes: list[str]) -> tuple[float, Texture | None]:

@@ -48,11 +48,10 @@ def stencil(size: int = SIZE) -> np.ndarray:
 def _write(path: Path, pixels: np.ndarray, fmt: str) -> None:
     import OpenImageIO as oiio
 
+    from lenslab.render.film import write_pixels
+
     pixels = np.ascontiguousarray(pixels)
-    out = oiio.ImageOutput.create(str(path))
-    out.open(str(path), oiio.ImageSpec(pixels.shape[1], pixels.shape[0], pixels.shape[2], fmt))
-    out.write_image(pixels)
-    out.close()
+    write_pixels(path, pixels, oiio.ImageSpec(pixels.shape[1], pixels.shape[0], pixels.shape[2], fmt))
 
 
 def write(folder: Path) -> None:

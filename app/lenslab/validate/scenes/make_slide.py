@@ -26,13 +26,10 @@ def slide(size: int = SIZE) -> np.ndarray:
 def write(path: Path) -> None:
     import OpenImageIO as oiio
 
+    from lenslab.render.film import write_pixels
+
     image = slide()
-    out = oiio.ImageOutput.create(str(path))
-    if out is None:
-        raise OSError(oiio.geterror())
-    out.open(str(path), oiio.ImageSpec(image.shape[1], image.shape[0], 3, oiio.UINT8))
-    out.write_image(image)
-    out.close()
+    write_pixels(path, image, oiio.ImageSpec(image.shape[1], image.shape[0], 3, oiio.UINT8))
 
 
 if __name__ == "__main__":
