@@ -98,6 +98,11 @@ class Viewport(QWidget):
         self.message = ""  # an error to show over the image
         self.status_text = ""  # e.g. "Preview" in the corner
         self.focus_pending = False
+        # Drawn over the picture in order, each by ``layer.paint(painter, viewport, image_rect)`` where it is
+        # ``visible``: the sensor's gate and guides, focus peaking, clipping warnings, the loupe.
+        self.layers: list = []
+        # The export's frame (the sensor's gate) in image pixels of the viewport's picture; None: the whole picture.
+        self.gate_rect: QRectF | None = None
         self._fade_timer = QTimer(self)
         self._fade_timer.setInterval(40)
         self._fade_timer.timeout.connect(self._fade_tick)
@@ -278,6 +283,9 @@ class Viewport(QWidget):
                 p.drawImage(rect, self._overlay)
                 self._draw_tag(p, QPointF(rect.left() + 10, rect.bottom() - 12), self._overlay_label, theme.FOCUS)
                 p.setOpacity(1.0)
+            for layer in self.layers:
+                if getattr(layer, "visible", True):
+                    layer.paint(p, self, rect)
         self._draw_hud(p)
         if self.message:
             p.setPen(QColor("#f0c0a0"))
