@@ -40,6 +40,11 @@
 #ifndef HAS_BECKMANN
 #define HAS_BECKMANN 1
 #endif
+// Not a scene feature but an output: the denoiser's albedo and normal buffers (feature_buffers.glsl), off
+// unless the host asks (render/tracer.py's feature_buffers), so a render without them pays nothing.
+#ifndef HAS_FEATURE_BUFFERS
+#define HAS_FEATURE_BUFFERS 0
+#endif
 #ifndef MATERIAL_TYPES
 #define MATERIAL_TYPES 0xFFFF
 #endif

@@ -13,12 +13,18 @@ vec3 path_radiance(Ray ray, inout Sampler sampler) {
     vec3 prev_p = ray.o;
     float prev_light_weights = 1.0;  // LightChoice.weights at prev_p: MIS needs the light choice made there
     float eta_scale = 1.0;  // radiance compression by refraction so far (see bsdf_eta_scale)
+#if HAS_FEATURE_BUFFERS
+    features_begin();  // the denoiser's guides (feature_buffers.glsl): they read the path, never change it
+#endif
 
     for (int segments = 1; ; segments++) {
         Hit hit;
         if (!trace_bsp(ray, 0.0, INFINITY, false, hit)) {
             // The ray leaves the scene: the sky, and the sun's disk if it looks straight at it.
             vec3 le = environment_radiance(ray.d);
+#if HAS_FEATURE_BUFFERS
+            features_at_miss(le);
+#endif
             float w = prev_delta ? 1.0 : power_heuristic(prev_bsdf_pdf, environment_pdf(ray.d,
                                                           light_choice_pmf(env_light, prev_p, prev_light_weights)));
             radiance += throughput * le * w;
@@ -45,9 +51,18 @@ vec3 path_radiance(Ray ray, inout Sampler sampler) {
             }
             radiance += throughput * le * w;
         }
-        if (segments >= max_depth || !material_scatters(s.material)) break;
+        if (segments >= max_depth || !material_scatters(s.material)) {
+#if HAS_FEATURE_BUFFERS
+            if (features_open && material_scatters(s.material)) features_at_surface(bsdf_at(s), false);
+            else features_at_light(s, le);
+#endif
+            break;
+        }
 
         Bsdf bsdf = bsdf_at(s);
+#if HAS_FEATURE_BUFFERS
+        features_at_surface(bsdf, true);
+#endif
         vec4 u_light = sample4(sampler);
         vec4 u_bsdf = sample4(sampler);
 
@@ -84,6 +99,9 @@ vec3 path_radiance(Ray ray, inout Sampler sampler) {
         if (!bsdf_sample(s, bsdf, u_bsdf.xyz, wi, weight, pdf, delta)) break;
         throughput *= weight;
         eta_scale *= bsdf_eta_scale(s, bsdf, wi);
+#if HAS_FEATURE_BUFFERS
+        features_follow(weight * bsdf_eta_scale(s, bsdf, wi));  // glass's tint, not its 1/eta^2
+#endif
         prev_bsdf_pdf = pdf;
         prev_delta = delta;
         prev_p = s.p;

@@ -25,14 +25,23 @@ layout(local_size_x = LOCAL_SIZE_X) in;
 #include "microfacet.glsl"
 #include "bsdf.glsl"
 #include "lights.glsl"
+#include "feature_buffers.glsl"
 #include "integrator.glsl"
 
 // splat_pixels == 0: rgb = sum of radiance samples, a = their count (the film's accumulation).
 // splat_pixels > 0: one sample per slot, slot = (sample index - sample_start) * splat_pixels + pixel: its
 // radiance, and where in the pixel it was taken (encode_pixel_position).
 layout(std430, binding = ACCUMULATION_BINDING) buffer Accumulation { vec4 accumulation[]; };
+#if HAS_FEATURE_BUFFERS
+// The denoiser's guides (feature_buffers.glsl), FEATURE_ROWS vec4 per pixel: (albedo sum, samples), (normal
+// sum, 0). Each sample adds to the pixel it was taken for, weight 1, whatever the pixel filter: with a box or
+// a gaussian by importance sampling that is the beauty's own filter; a splatted gaussian spreads the beauty
+// over neighbours, which OIDN does not support anyway (it correlates the noise of neighbouring pixels).
+layout(std430, binding = FEATURES_BINDING) buffer Features { vec4 features[]; };
+#endif
 
-uniform int tile_start;   // first pixel (row-major index) of this dispatch
+uniform ivec4 region;     // the pixels rendered: x, y, width, height (the whole image, or the studio's render region)
+uniform int tile_start;   // first pixel of this dispatch (row-major index within the region)
 uniform int tile_pixels;
 uniform uint sample_start;
 uniform int sample_count;
@@ -77,16 +86,26 @@ float encode_pixel_position(vec2 u) { return floor(u.x * 4096.0) + min(u.y, 0.99
 void main() {
     int local = int(gl_GlobalInvocationID.x);
     if (local >= tile_pixels) return;
-    int pixel_index = tile_start + local;
-    uvec2 pixel = uvec2(pixel_index % image_size.x, pixel_index / image_size.x);
+    int region_index = tile_start + local;
+    uvec2 pixel = uvec2(region.xy + ivec2(region_index % region.z, region_index / region.z));
+    int pixel_index = int(pixel.y) * image_size.x + int(pixel.x);
 
     vec4 sum = splat_pixels > 0 ? vec4(0.0) : accumulation[pixel_index];
+#if HAS_FEATURE_BUFFERS
+    vec4 albedo_sum = features[FEATURE_ROWS * pixel_index], normal_sum = features[FEATURE_ROWS * pixel_index + 1];
+#endif
     for (int k = 0; k < sample_count; k++) {
         Sampler sampler = sampler_start(pixel, sample_start + uint(k), seed);
         vec4 u = sample4(sampler);  // pixel position and lens position, jointly stratified
         float lens_weight;  // 0 where the lens barrel blocks the ray (cat's-eye bokeh, optical vignetting)
         Ray ray = camera_ray(vec2(pixel) + 0.5 + pixel_offset(u.xy), u.zw, lens_weight);
         vec3 l = lens_weight > 0.0 ? lens_weight * path_radiance(ray, sampler) : vec3(0.0);
+#if HAS_FEATURE_BUFFERS
+        if (lens_weight > 0.0) {  // a ray the barrel blocks shows no surface: it is not counted
+            albedo_sum += vec4(feature_albedo, 1.0);
+            normal_sum.xyz += feature_normal;
+        }
+#endif
         // A NaN or infinity (a degenerate triangle, say) would poison the pixel forever: count it as black.
         if (any(isnan(l)) || any(isinf(l))) l = vec3(0.0);
         if (clamp_max > 0.0 && max_component(l) > clamp_max) l *= clamp_max / max_component(l);
@@ -97,4 +116,8 @@ void main() {
         }
     }
     if (splat_pixels == 0) accumulation[pixel_index] = sum;
+#if HAS_FEATURE_BUFFERS
+    features[FEATURE_ROWS * pixel_index] = albedo_sum;
+    features[FEATURE_ROWS * pixel_index + 1] = normal_sum;
+#endif
 }

@@ -44,3 +44,14 @@ def test_batch_scaling_prints_shots_per_minute_with_and_without_the_engine(rende
         line = next(line for line in out.splitlines() if line.startswith(row))
         assert float(line.split()[-2]) > 0  # shots per minute
     assert "engine cost per shot" in out and "split across 2 workers" in out
+
+
+@pytest.mark.gl
+def test_denoise_convergence_prints_seconds_per_scene_and_metric(renderer, tmp_path):
+    pytest.importorskip("pyoidn")
+    out = run("denoise_convergence.py", "--size", 16, "--seconds", 0.2, "--reference-spp", 4, "--scenes",
+              "cornell_box,dof_chart", "--cache", tmp_path / "cache", "--denoise-sizes", "16x16", tmp_path=tmp_path)
+    rows = [line.split() for line in out.splitlines() if line.split()[:1] in (["cornell_box"], ["dof_chart"])]
+    assert len(rows) == 8 and {row[2] for row in rows} == {"relMSE", "display"}  # two thresholds each
+    assert len(list((tmp_path / "cache").glob("denoise_reference_*.npy"))) == 2
+    assert "16x16" in out and "Open Image Denoise" in out

@@ -55,3 +55,23 @@ def test_pixels_without_samples_are_transparent(renderer):
 def test_an_unknown_tone_map_is_refused_by_name(half_rendered):
     with pytest.raises(ValueError, match="sepia"):
         half_rendered.display(0.0, "sepia")
+
+
+@pytest.mark.parametrize("operator", TONE_MAPS)
+def test_another_linear_image_is_displayed_as_the_film_would(half_rendered, operator):
+    """display_image: the denoiser's image tone-mapped on the GPU, the same as film.py would on the CPU."""
+    rng = np.random.default_rng(3)
+    image = (rng.random((30, 40, 3)) ** 3 * 8).astype(np.float32)  # values from black to well past white
+    picture = half_rendered.display_image(image, 1.5, operator)
+    expected = to_8bit(tone_map(image, 1.5, operator))
+    difference = np.abs(picture[..., :3].astype(int) - expected.astype(int))
+    assert difference.max() <= 1 and (difference == 0).mean() > 0.99
+    assert (picture[..., 3] == 255).all()
+    # The session's own picture is untouched by it.
+    again = half_rendered.display(0.0, operator)
+    assert (again[..., :3] == to_8bit(tone_map(resolve(half_rendered.accumulation()), 0.0, operator))).mean() > 0.99
+
+
+def test_an_image_of_another_size_is_refused(half_rendered):
+    with pytest.raises(ValueError, match="41 x 30"):
+        half_rendered.display_image(np.zeros((30, 41, 3), np.float32))

@@ -133,6 +133,7 @@ def build_parser() -> argparse.ArgumentParser:
         "opens the studio window; with --headless it renders SCENE to a file and exits.",
         epilog="Examples:\n"
         "  lenslab cornell_box --headless -o cornell.png --spp 64\n"
+        "  lenslab dof_chart --headless -o dof.exr --spp 16 --denoise\n"
         "  lenslab my_scene.json --headless -o shot.exr --f-stop 1.4 --focus-distance 2.5 --time-limit 60\n"
         "  lenslab product_shot --headless -o p.exr --lens '85mm f/1.4' --f-stop 2 --iso 400 --shutter 1/60\n"
         "The camera settings override the scene's camera for this render only. A marked stop (--f-stop 11) is\n"
@@ -147,7 +148,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("scene", nargs="?", help="a scene file (.json), a folder holding scene.json, or a shipped scene name")
     p.add_argument("--headless", action="store_true", help="render to a file without opening a window")
-    p.add_argument("-o", "--output", metavar="FILE", help="where to write the image: .exr (linear, float) or .png (sRGB)")
+    p.add_argument("-o", "--output", metavar="FILE", help="with --headless: where to write the image, .exr (linear, float) or .png (sRGB)")
     p.add_argument("--spp", type=_declared(int, RenderSettings, "spp"), metavar="N",
                    help="samples per pixel (default: the scene's; with --time-limit alone, as many as fit)")
     p.add_argument("--time-limit", type=number_argument(float, 0.001, 1e7), metavar="SECONDS",
@@ -204,6 +205,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--tone-map", choices=("clamp", "reinhard", "filmic"),
                    help="PNG only: how radiance above 1 is brought into the displayable range (default: clamp; the "
                         "studio shows and exports filmic unless told otherwise)")
+    p.add_argument("--denoise", action="store_true",
+                   help="write the image denoised (Intel Open Image Denoise, guided by the first-hit albedo and normal "
+                        "rendered beside it); an EXR also keeps the noisy image and the guides as layers")
     p.add_argument("-D", dest="defines", action="append", default=[], metavar="NAME=VALUE",
                    help="Mitsuba XML scenes: set the parameter $NAME, as mitsuba -D does (repeatable)")
     p.add_argument("--device", type=number_argument(int, 0, 64), metavar="N", help="which GPU to use (EGL device index)")
@@ -339,6 +343,13 @@ def render_headless(args) -> int:
             if given:
                 _warn(f"{option} applies to PNG only: an EXR keeps the linear radiance")
     overrides = scene_overrides(args)
+    if args.denoise:  # a denoiser that cannot run says so now, not after the render
+        from lenslab.render.denoise import DenoiseError, describe
+
+        try:
+            describe()
+        except DenoiseError as exc:
+            raise CliError(f"--denoise: {exc}") from None
     console = _terminal_console()
     loading_start = time.perf_counter()
     with _loading_status(console, f"loading {args.scene}"):
@@ -347,7 +358,7 @@ def render_headless(args) -> int:
     try:
         with _loading_status(console, "building the kd-tree and compiling the kernel"):
             job = RenderJob(renderer, scene, spp=args.spp, time_limit=args.time_limit,
-                            dispatch_seconds=HEADLESS_DISPATCH_SECONDS)
+                            dispatch_seconds=HEADLESS_DISPATCH_SECONDS, feature_buffers=args.denoise)
     except (SceneError, SceneTooLarge, ValueError) as exc:  # found only when the scene is packed: name its file
         raise SceneError.in_file(scene.source_path or args.scene, exc) from None
     session = job.session
@@ -380,9 +391,9 @@ def render_headless(args) -> int:
               f"{job.overran_time_limit:.1f} s later")
     # Once the image is whole and about to take its name, a stop signal could only misreport it.
     job.write(output, exposure_stops=args.exposure, tone_map=args.tone_map or "clamp",
-              before_rename=_ignore_stop_signals)
+              before_rename=_ignore_stop_signals, denoise=args.denoise)
     print(one_line(f"wrote {output} ({session.width}x{session.height}, {job.samples_per_pixel} spp, "
-                   f"{job.elapsed_seconds:.1f} s)"), file=sys.stderr)
+                   f"{job.elapsed_seconds:.1f} s{', denoised' if args.denoise else ''})"), file=sys.stderr)
     job.release()
     renderer.release()
     return EXIT_OK
@@ -442,15 +453,44 @@ def run(argv: list[str] | None = None) -> int:
             raise CliError("--info prints the device and exits without rendering: leave out --headless and -o, "
                            "or --info", EXIT_USAGE)
         return _print_info(args.device)
+    if args.output and not args.headless:
+        # -o means a file, not a window: say how to get one rather than open the studio and ignore it.
+        raise CliError(f"-o writes an image without the studio: add --headless (lenslab {args.scene or 'SCENE'} "
+                       f"--headless -o {args.output})", EXIT_USAGE)
     if args.headless:
         if not args.scene:
             raise CliError("--headless needs a scene to render", EXIT_USAGE)
         if argv is None:  # the process's own command
             _stop_on_sigterm_as_on_ctrl_c()
         return render_headless(args)
+    problem = display_problem()
+    if problem:
+        raise CliError(problem)
     from lenslab.gui.app import run_studio  # only the studio imports Qt
 
     return run_studio(args.scene, scene_overrides(args), device_index=args.device)
+
+
+#: Qt platforms that draw on a display server; any other (offscreen, minimal, eglfs, vnc ...) needs none.
+DISPLAY_PLATFORMS = ("xcb", "wayland", "wayland-egl")
+
+
+def display_problem(environ=None, platform: str | None = None) -> str | None:
+    """Why the studio cannot open its window here, in a line that says what to do instead; None when it can.
+    On Linux and the BSDs a window needs an X or Wayland display: without one Qt aborts with a hint about
+    libxcb-cursor that leads nowhere. Windows and macOS always have their own."""
+    environ = os.environ if environ is None else environ
+    platform = sys.platform if platform is None else platform
+    if platform.startswith(("win", "darwin", "cygwin")):
+        return None
+    wanted = [name.split(":")[0].strip() for name in environ.get("QT_QPA_PLATFORM", "").split(";") if name.strip()]
+    if any(name not in DISPLAY_PLATFORMS for name in wanted):
+        return None  # a platform of Qt's that needs no display server (QT_QPA_PLATFORM=offscreen)
+    if environ.get("DISPLAY") or environ.get("WAYLAND_DISPLAY"):
+        return None
+    return ("the studio needs a display, and there is none here (DISPLAY and WAYLAND_DISPLAY are not set): to "
+            "render without a window add --headless -o OUT.png (lenslab --help); for the studio, run it on the "
+            "desktop or over ssh -X")
 
 
 class _WarningLine(logging.Handler):

@@ -21,7 +21,12 @@ def settings(tmp_path):
     """A QSettings file of the test's own, so that no test reads or writes the user's layout or recent files."""
     from PySide6.QtCore import QSettings
 
-    return QSettings(str(tmp_path / "studio.ini"), QSettings.IniFormat)
+    settings = QSettings(str(tmp_path / "studio.ini"), QSettings.IniFormat)
+    # The studio's tests render the export's tiny pixels (not the viewport widget's, which the tests of the
+    # viewport's own size choose), without the denoiser (whose tests turn it on).
+    settings.setValue("viewport/quality", "export")
+    settings.setValue("viewport/denoise", False)
+    return settings
 
 
 @pytest.fixture

@@ -60,7 +60,7 @@ def test_run_studio_opens_the_window_on_a_scene(qtbot, monkeypatch, tmp_path, gl
     # Through the command line, as a user starts it: the studio applies every override a headless render does.
     assert cli.run(["cornell_box", "--f-stop", "8", "--width", "48", "--clamp", "5", "--seed", "3"]) == 0
     qtbot.waitUntil(lambda: "title" in seen, timeout=10000)
-    assert seen["title"].startswith("cornell_box")
+    assert seen["title"].startswith("Cornell Box (example)")
     assert seen["f"] == 8.0 and seen["resolution"] == (48, 48)
     assert seen["render"].clamp == 5.0 and seen["render"].seed == 3
     assert QGuiApplication.desktopFileName() == studio.DESKTOP_ID

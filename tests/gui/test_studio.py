@@ -445,7 +445,7 @@ def test_point_lights_and_suns_are_in_the_outliner_editable_and_undoable(qtbot, 
     window = make_window(small_scene)
     doc, model = window.doc, window.scene_tree.tree_model
     group = model.index_of(LIGHTS)
-    assert model.data(group) == "Lights" and model.rowCount(group) == 1
+    assert model.data(group) == "Lights" and model.rowCount(group) == 2  # and the ceiling light, an object
     assert model.data(model.index(0, 0, group)) == "late sun"
     wait_for_frame(qtbot, window)
 
@@ -460,7 +460,7 @@ def test_point_lights_and_suns_are_in_the_outliner_editable_and_undoable(qtbot, 
     assert model.setData(model.index(0, 0, group), "noon sun")
     assert doc.scene.lights[0].name == "noon sun"
     window.delete_selection()
-    assert doc.scene.lights == [] and model.rowCount(model.index_of(LIGHTS)) == 0
+    assert doc.scene.lights == [] and model.rowCount(model.index_of(LIGHTS)) == 1
     for _ in range(3):
         doc.undo_stack.undo()
     assert doc.scene.lights == [SunLight(name="late sun", direction=(1.0, 1.0, 0.5))]

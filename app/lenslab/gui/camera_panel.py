@@ -437,7 +437,8 @@ class CameraPanel(QWidget):
         self.rotation = NumberEdit(*declared_range(ThinLensCamera, "blade_rotation_deg"), decimals=1, step=1.0,
                                    suffix=" °")
         self.rotation.setToolTip("Rotation of the blade polygon")
-        self.rotation.edited.connect(lambda v, merge: self.doc.set_camera("Blade rotation", merge, blade_rotation_deg=v))
+        self.rotation.edited.connect(lambda v, merge: self.doc.set_camera(f"Blade rotation {v:g}°", merge,
+                                                                          blade_rotation_deg=v))
         self.curvature = self._camera_number("blade_curvature", "Blade curvature", 2, 0.05,
                                              "Blade edges: 0 straight (polygonal bokeh) to 1 round")
         self.squeeze = self._camera_number("anamorphic_squeeze", "Anamorphic squeeze", 2, 0.05,
@@ -477,7 +478,7 @@ class CameraPanel(QWidget):
         """A number field that edits one of the camera's fields, within the range the field declares."""
         edit = NumberEdit(*declared_range(ThinLensCamera, field), decimals=decimals, step=step)
         edit.setToolTip(tip)
-        edit.edited.connect(lambda v, merge: self.doc.set_camera(undo_text, merge, **{field: float(v)}))
+        edit.edited.connect(lambda v, merge: self.doc.set_camera(f"{undo_text} {v:g}", merge, **{field: float(v)}))
         return edit
 
     def _focal_section(self) -> Section:
@@ -609,7 +610,8 @@ class CameraPanel(QWidget):
                             "diagonal of the sensor area the image shows / 1500; type a value for a stricter or "
                             "looser standard, or 0 for auto")
         self.coc.edited.connect(lambda v, merge: self.doc.set_camera(
-            "Circle of confusion", merge, circle_of_confusion_mm=float(v) if v >= low else None))
+            f"Circle of confusion {f'{v:g} mm' if v >= low else 'auto'}", merge,
+            circle_of_confusion_mm=float(v) if v >= low else None))
         grid.addWidget(QLabel("Fit"), 0, 0)
         grid.addWidget(self.sensor_fit, 0, 1)
         coc_label = QLabel("CoC")
@@ -691,8 +693,9 @@ class CameraPanel(QWidget):
         """The focus distances the camera (and its lens) can set, in its reference."""
         return closest_focus(self.doc.scene.camera, self.doc.lens), FOCUS_RANGE[1]
 
-    def set_focus(self, metres: float, merge: bool = False, text: str = "Focus distance") -> bool:
-        """Focus at ``metres`` (in the camera's reference), or refuse and say why when the lens cannot."""
+    def set_focus(self, metres: float, merge: bool = False, text: str | None = None) -> bool:
+        """Focus at ``metres`` (in the camera's reference), or refuse and say why when the lens cannot. The undo
+        step reads ``text``, by default "Focus" and the distance."""
         closest, _ = self.focus_limits()
         if metres < closest * (1 - 1e-9):
             lens = self.doc.lens
@@ -704,7 +707,7 @@ class CameraPanel(QWidget):
             self.status_message.emit(f"Cannot focus at {format_distance(metres)}: {why}")
             self.refresh()
             return False
-        self.doc.set_camera(text, merge, focus_distance_m=float(metres))
+        self.doc.set_camera(text or f"Focus {format_distance(metres)}", merge, focus_distance_m=float(metres))
         return True
 
     def _focus_from_chosen(self, index: int) -> None:
@@ -866,14 +869,15 @@ class CameraPanel(QWidget):
             return
         closest, far = self.focus_limits()
         metres = max(closest, float(f"{slider_to_log(position, closest, far):.3g}"))
-        self.doc.set_camera("Focus distance", True, focus_distance_m=metres)
+        self.doc.set_camera(f"Focus {format_distance(metres)}", True, focus_distance_m=metres)
 
     def _blades_edited(self, value: int, merge: bool) -> None:
         current = self.doc.scene.camera.aperture_blades
         if value in (1, 2):  # not a polygon: jump over, in the direction of travel
             value = 3 if current < value else 0
             self.blades.set_quietly(value)
-        self.doc.set_camera("Aperture blades", merge, aperture_blades=int(value))
+        self.doc.set_camera(f"Aperture blades {value}" if value else "Round aperture", merge,
+                            aperture_blades=int(value))
 
     def _sensor_chosen(self, index: int) -> None:
         if self._updating:
@@ -888,7 +892,8 @@ class CameraPanel(QWidget):
     def _sensor_edited(self, merge: bool) -> None:
         if self._updating:
             return
-        self.doc.set_camera("Sensor size", merge, sensor_mm=(self.sensor_w.value(), self.sensor_h.value()))
+        w, h = self.sensor_w.value(), self.sensor_h.value()
+        self.doc.set_camera(f"Sensor size {w:g} × {h:g} mm", merge, sensor_mm=(w, h))
 
     # -- following the document ---------------------------------------------------------------------------------
     def _on_change(self, change) -> None:

@@ -5,7 +5,9 @@ objects, so that any order of undo and redo finds the right thing. Values are de
 announces what it changed on the scene's own events (``doc.model``), whichever way it runs.
 
 Consecutive edits of the same fields from a slider or a spin box drag merge into one step (``mergeWith``) when
-they arrive within :data:`MERGE_SECONDS` of each other, so one Ctrl+Z undoes one gesture.
+they arrive within :data:`MERGE_SECONDS` of each other, so one Ctrl+Z undoes one gesture. A step's text (the
+History panel's row) names the value it sets, and a merged step takes the text of the last edit it took in: a drag
+from f/4 to f/22 reads "Aperture f/22", the value that row restores.
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ from typing import Any
 
 from PySide6.QtGui import QUndoCommand
 
-from lenslab.optics import LensPreset
+from lenslab.optics import LensPreset, format_distance, format_f_number, format_focal_length
 from lenslab.scene.editing import camera_changes_keeping_focus
 from lenslab.scene.events import SceneChange
 from lenslab.scene.lights import Light
@@ -28,23 +30,68 @@ _SET_VALUES_ID = 1001
 _FIELD_LABELS = {
     "f_number": "Aperture", "focal_length_mm": "Focal length", "focus_distance_m": "Focus distance",
     "sensor_mm": "Sensor", "aperture_blades": "Aperture blades", "blade_rotation_deg": "Blade rotation",
-    "translate": "Move", "rotate_deg": "Rotate", "scale": "Scale", "name": "Rename",
+    "translate": "Move", "position": "Move", "rotate_deg": "Rotate", "scale": "Scale", "name": "Rename",
 }
+#: Labels that name what they act on: "Move tall box to ...", "Move camera to ...".
+_NAMING_FIELDS = {"translate", "position", "rotate_deg", "scale", "name"}
 
 
-def _label(target: tuple, changes: dict) -> str:
+#: How a value reads in a History row, for the fields photographers know by their own notation.
+_VALUE_FORMATS = {"f_number": format_f_number, "focal_length_mm": format_focal_length,
+                  "focus_distance_m": format_distance}
+_VALUE_TEXT_LIMIT = 48
+
+
+def _value_text(field: str, value: Any) -> str:
+    """A value as a History row shows it: short, rounded, never a dataclass's repr."""
+    if field in _VALUE_FORMATS and isinstance(value, (int, float)):
+        return _VALUE_FORMATS[field](value)
+    if isinstance(value, bool):
+        return "on" if value else "off"
+    if isinstance(value, float):
+        return f"{value:.4g}"
+    if isinstance(value, (tuple, list)) and all(isinstance(v, (int, float)) for v in value):
+        return "(" + ", ".join(f"{v:.4g}" for v in value) + ")"
+    if isinstance(value, str):
+        text = value or "none"
+    elif value is None:
+        text = "none"
+    else:
+        text = getattr(value, "type_name", "") or type(value).__name__
+    return text if len(text) <= _VALUE_TEXT_LIMIT else "…" + text[-(_VALUE_TEXT_LIMIT - 1):]
+
+
+def _target_name(doc, target: tuple) -> str:
+    if target[0] in ("node", "light"):
+        return doc.model.resolve(target).name
+    if target[0] == "material":
+        return str(target[1])
+    return {"render": "render settings"}.get(target[0], target[0])
+
+
+def _label(doc, target: tuple, changes: dict) -> str:
+    """The History text of an edit: what it sets and to what ("Move tall box to (0.2, 0.3, -0.1)")."""
     fields = list(changes)
-    if len(fields) == 1:
-        leaf = fields[0][-1] if fields[0] else target[0]
-        return _FIELD_LABELS.get(leaf, "Set " + leaf.replace("_", " "))
-    return "Edit " + target[0]
+    if len(fields) != 1:
+        return "Edit " + _target_name(doc, target)
+    field = fields[0]
+    if not field:  # the whole thing: a material of another type, a camera put back as it was
+        kind = getattr(changes[field], "type_name", "")
+        return f"Set {_target_name(doc, target)}" + (f" to {kind}" if kind else "")
+    leaf = field[-1]
+    value = _value_text(leaf, changes[field])
+    if leaf in _NAMING_FIELDS:
+        return f"{_FIELD_LABELS[leaf]} {_target_name(doc, target)} to {value}"
+    if leaf in _FIELD_LABELS:
+        return f"{_FIELD_LABELS[leaf]} {value}"
+    return f"Set {leaf.replace('_', ' ')} of {_target_name(doc, target)} to {value}"
 
 
 class SetValuesCommand(QUndoCommand):
     """Set one or more fields of one target."""
 
     def __init__(self, doc, target: tuple, changes: dict[tuple, Any], text: str | None = None, merge: bool = False):
-        super().__init__(text or _label(target, changes))
+        super().__init__(text or _label(doc, target, changes))
         self.doc = doc
         self.target = tuple(target)
         self.new = {tuple(k): copy.deepcopy(v) for k, v in changes.items()}
@@ -76,6 +123,7 @@ class SetValuesCommand(QUndoCommand):
             return False
         self.new = other.new
         self.stamp = other.stamp
+        self.setText(other.text())  # the value this step now sets, and its History row restores
         if self.new == self.old:
             self.setObsolete(True)
         return True

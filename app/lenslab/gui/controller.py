@@ -3,8 +3,8 @@
 It listens to the scene's own events (``doc.model.events``) and sends the worker the cheapest message that
 brings it up to date (a camera, the render settings, or a copy of the whole scene), numbering each edit (its
 *generation*) so that the GUI can tell which frames already show it. It also decides the viewport's render size
-from the camera's resolution and the chosen viewport quality, routes pick answers to whoever asked, and runs
-exports.
+(the widget's size times the chosen resolution scale, independent of the export's resolution; or the export's
+own pixels), routes pick answers to whoever asked, and runs exports.
 """
 
 from __future__ import annotations
@@ -20,17 +20,27 @@ from lenslab.gui.document import copy_scene, listen
 from lenslab.gui.worker import VIEWPORT_DISPATCH_SECONDS, ExportRequest, Frame, RenderWorker
 from lenslab.render.film import check_tone_map
 
-#: Viewport quality: a fraction of the camera's resolution, or "auto" (at most AUTO_LONG_EDGE pixels wide).
-QUALITIES = {"auto": None, "full": 1.0, "half": 0.5, "quarter": 0.25}
+#: Viewport resolution: a fraction of the viewport widget's pixels; "auto" (all of them on a GPU, at most
+#: AUTO_LONG_EDGE on the long side on a CPU device such as llvmpipe); or "export", the export's own pixels.
+QUALITIES = {"auto": None, "full": 1.0, "half": 0.5, "quarter": 0.25, "export": None}
 AUTO_LONG_EDGE = 800
+#: Around the sensor's gate the viewport shows this much more of the scene (a fraction of the frame, each side).
+VIEW_MARGIN = 0.04
 SAMPLE_LIMITS = (16, 64, 256, 1024, 4096, None)
 
 
-def viewport_size(resolution: tuple[int, int], quality: str) -> tuple[int, int]:
-    w, h = resolution
-    fraction = QUALITIES.get(quality)
-    if fraction is None:
-        fraction = min(1.0, AUTO_LONG_EDGE / max(w, h))
+def viewport_size(resolution: tuple[int, int], quality: str, widget_size: tuple[int, int] | None = None,
+                  cpu_device: bool = True) -> tuple[int, int]:
+    """The viewport's picture in pixels: the widget's size scaled by the quality (the export's resolution with
+    "export", or while the widget's size is not known yet)."""
+    if quality == "export" or widget_size is None:
+        w, h = resolution
+        fraction = 1.0 if quality == "export" else min(1.0, AUTO_LONG_EDGE / max(w, h))
+    else:
+        w, h = widget_size
+        fraction = QUALITIES.get(quality)
+        if fraction is None:
+            fraction = min(1.0, AUTO_LONG_EDGE / max(w, h)) if cpu_device else 1.0
     return max(1, round(w * fraction)), max(1, round(h * fraction))
 
 
@@ -60,7 +70,10 @@ class RenderController(QObject):
         self.last_gbuffer = None
         self._ids = itertools.count(1)
         self._pick_callbacks: dict[int, Callable] = {}
-        self._size = viewport_size(doc.scene.camera.resolution, self.quality)
+        self._widget_size: tuple[int, int] | None = None
+        self._size = self._view_size()
+        self.region: tuple[int, int, int, int] | None = None
+        self.denoise = False
         self._error_generation = -1
         self._shut_down = False
         self.worker = RenderWorker(device_index, dispatch_seconds)
@@ -91,16 +104,51 @@ class RenderController(QObject):
     def size(self) -> tuple[int, int]:
         return self._size
 
+    @property
+    def margin(self) -> float | None:
+        """How the viewport frames the camera: None, as the export; else the margin around the sensor's gate."""
+        return None if self.quality == "export" or self._widget_size is None else VIEW_MARGIN
+
+    def _view_size(self) -> tuple[int, int]:
+        cpu = self.device is None or "llvmpipe" in str(self.device.get("renderer", "")).lower()
+        return viewport_size(self.doc.scene.camera.resolution, self.quality, self._widget_size, cpu)
+
     def send_scene(self) -> None:
-        self._size = viewport_size(self.doc.scene.camera.resolution, self.quality)
-        self.worker.set_scene(copy_scene(self.doc.scene), *self._size, self._next_generation())
+        self._size = self._view_size()
+        self.region = None
+        self.worker.set_scene(copy_scene(self.doc.scene), *self._size, self._next_generation(), self.margin)
+
+    def set_widget_size(self, width: int, height: int) -> None:
+        """The viewport widget's size in device pixels: the picture follows it (except at "export" quality)."""
+        size = (max(1, int(width)), max(1, int(height)))
+        if size == self._widget_size:
+            return
+        self._widget_size = size
+        if self._view_size() != self._size or self.quality != "export":
+            self._send_camera(moved=True)
+
+    def _send_camera(self, moved: bool) -> None:
+        size = self._view_size()
+        moved = moved or size != self._size
+        if size != self._size:
+            self.region = None
+        self._size = size
+        self.worker.set_camera(dataclasses.replace(self.doc.scene.camera), *size, self._next_generation(), moved,
+                               self.margin)
+
+    def set_region(self, region: tuple[int, int, int, int] | None) -> None:
+        """Refine only this rectangle of the viewport's picture (x, y, width, height in its pixels), or all."""
+        self.region = None if region is None else tuple(int(v) for v in region)
+        self.worker.set_region(self.region, self._next_generation())
+
+    def set_denoise(self, on: bool) -> None:
+        """The viewport's pictures through the denoiser (display only: the render goes on as it was)."""
+        self.denoise = bool(on)
+        self.worker.set_denoise(self.denoise)
 
     def _on_change(self, change) -> None:
         if change.kind == "camera":
-            size = viewport_size(self.doc.scene.camera.resolution, self.quality)
-            moved = change.geometry or size != self._size
-            self._size = size
-            self.worker.set_camera(dataclasses.replace(self.doc.scene.camera), *size, self._next_generation(), moved)
+            self._send_camera(change.geometry or change.field[:1] == ("resolution",))
         elif change.kind == "render":
             if change.field == ("spp",):
                 return  # the export default; the viewport has its own sample limit
@@ -131,6 +179,8 @@ class RenderController(QObject):
     # -- answers from the worker ---------------------------------------------------------------------------
     def _device_ready(self, info: dict) -> None:
         self.device = info
+        if self._view_size() != self._size:  # "auto" renders more pixels on a GPU than on the CPU
+            self._send_camera(moved=True)
         self.device_ready.emit(info)
 
     def _device_failed(self, message: str) -> None:

@@ -122,6 +122,10 @@ class ExportDialog(QDialog):
         self.tone_combo = QComboBox()
         self.tone_combo.addItems(TONE_MAPS)
         self.tone_combo.setCurrentText(tone_map)
+        self.denoise_check = QCheckBox("Denoise")  # never on unless asked: an export is the render as it is
+        self.denoise_check.setToolTip("Write the image denoised by Intel Open Image Denoise, guided by the albedo "
+                                      "and normal rendered beside it. An EXR also keeps the noisy image, the albedo "
+                                      "and the normal as layers (noisy, albedo, normal).")
         self.png_note = QLabel("Exposure and tone map apply to PNG only; EXR keeps the linear radiance.")
         self.png_note.setObjectName("hint")
         self.png_note.setWordWrap(True)
@@ -139,6 +143,7 @@ class ExportDialog(QDialog):
         form.addRow("Stop at", quality)
         form.addRow("Exposure", self.exposure_spin)
         form.addRow("Tone map", self.tone_combo)
+        form.addRow("", self.denoise_check)
         form.addRow("", self.png_note)
         buttons = QDialogButtonBox(QDialogButtonBox.Cancel)
         self.render_button = buttons.addButton("Render", QDialogButtonBox.AcceptRole)
@@ -224,6 +229,7 @@ class ExportDialog(QDialog):
             target_spp=self.spp_spin.value() if by_samples else None,
             seconds=None if by_samples else self.seconds_spin.value(),
             exposure_stops=self.exposure_spin.value(), tone_map=self.tone_combo.currentText(),
+            denoise=self.denoise_check.isChecked(),
         )
 
     def validate(self) -> str | None:

@@ -10,7 +10,7 @@ import os
 import threading
 from pathlib import Path
 
-from PySide6.QtCore import QPointF, QSettings, Qt, QTimer, Signal
+from PySide6.QtCore import QPointF, QRectF, QSettings, Qt, QTimer, Signal
 from PySide6.QtGui import QAction, QActionGroup, QKeySequence
 from PySide6.QtWidgets import (
     QComboBox,
@@ -24,8 +24,8 @@ from PySide6.QtWidgets import (
     QProgressDialog,
     QScrollArea,
     QSizePolicy,
-    QSlider,
     QToolBar,
+    QToolButton,
     QUndoView,
     QVBoxLayout,
     QWidget,
@@ -39,17 +39,22 @@ from lenslab.gui.commands import (AddLightCommand, AddMaterialCommand, AddNodeCo
 from lenslab.gui.controller import SAMPLE_LIMITS, RenderController, elapsed_text, rate_text, samples_text
 from lenslab.gui.defaults import studio_scene
 from lenslab.gui.document import Document, is_shipped, listen
-from lenslab.gui.export_dialog import ExportDialog
+from lenslab.gui.navigation import CameraNavigator
+from lenslab.gui.export_dialog import ExportDialog, default_export_path
 from lenslab.gui.properties import PropertyEditor
 from lenslab.gui.scene_tree import SceneTreeView, node_context_menu
+from lenslab.gui.snapshot_panel import StudioSnapshots
+from lenslab.gui.viewing_aids import ViewingAids
 from lenslab.gui.viewport import Viewport
+from lenslab.gui.widgets import ResetSlider, SignedNumberEdit
 from lenslab.gui.worker import VIEWPORT_DISPATCH_SECONDS
+from lenslab.color import luminance
 from lenslab.messages import one_line
 from lenslab.optics import format_camera_settings, format_distance
 from lenslab.optics.exposure import format_shutter
 from lenslab.render.film import TONE_MAPS
 from lenslab.scene import editing
-from lenslab.scene.io.loader import open_scene, resolve_scene_path, shipped_scene_names
+from lenslab.scene.io.loader import open_scene, resolve_scene_path, scene_title, shipped_scene_names
 from lenslab.scene.io.meshes import MESH_SUFFIXES, MeshLoadError, load_mesh
 from lenslab.scene.io.native import SCENE_SUFFIX, save_scene
 from lenslab.scene.scene import SceneError
@@ -99,12 +104,24 @@ class MainWindow(QMainWindow):
         self.viewport = Viewport()
         self.viewport.set_display(*self._saved_look())
         self.controller.set_display(self.viewport.exposure, self.viewport.tone_map)
+        self.controller.set_denoise(self.settings.value("viewport/denoise", True) not in (False, "false", "0", 0))
+        self.navigator = CameraNavigator(self.doc, self.viewport, self._view_frame, self)
+        # The picture follows the viewport's size, once the size has settled (a window being dragged larger
+        # would otherwise restart the render at every step).
+        self._resize_timer = QTimer(self)
+        self._resize_timer.setSingleShot(True)
+        self._resize_timer.setInterval(120)
+        self._resize_timer.timeout.connect(self._send_viewport_size)
+        self._viewport_size: tuple[int, int] | None = None
         self._create_actions()
         self.setCentralWidget(self._central())
         self._create_docks()
         self._create_menus()
         self._create_status_bar()
         self._connect()
+        self.snapshots = StudioSnapshots(self)  # its dock exists before the saved layout is restored
+        # The sensor's gate and guides, aspect presets, focus peaking, the histogram and clipping warnings, the loupe.
+        self.viewing = ViewingAids(self)
         self.setAcceptDrops(True)
         self.setWindowIcon(app_icon())
         self.resize(1480, 920)
@@ -183,10 +200,22 @@ class MainWindow(QMainWindow):
         act["zoom_in"] = a("Zoom &In", lambda: self.viewport.zoom_step(1), [QKeySequence.ZoomIn, "Ctrl+="])
         act["zoom_out"] = a("Zoom &Out", lambda: self.viewport.zoom_step(-1), QKeySequence.ZoomOut)
         act["reset_layout"] = a("Reset Panel Layout", self.reset_layout)
+        act["denoise"] = a("&Denoise Preview", self.set_denoise, "D", "denoise", True,
+                           "Show the viewport through Intel Open Image Denoise (never applied to an export "
+                           "unless the export asks)")
+        act["denoise"].setChecked(self.controller.denoise)
+        act["frame_selection"] = a("&Frame Selection", self.frame_selection, ".",
+                                   tip="Point the camera at the selection, fill the frame with it and focus on it")
+        act["frame_all"] = a("Frame &All", lambda: self.frame_selection(everything=True), "Home",
+                             tip="Point the camera at the whole scene")
+        act["clear_region"] = a("&Clear Render Region", lambda: self.controller.set_region(None), "Alt+R",
+                                tip="Refine the whole picture again")
         tools = QActionGroup(self)
         for name, key, icon_name, tip in (("select", "Q", "select", "Select: click an object"),
                                           ("focus", "F", "focus", "Focus: click to focus there"),
-                                          ("pan", "H", "pan", "Pan: drag the image")):
+                                          ("pan", "H", "pan", "Pan: drag the image"),
+                                          ("region", "R", "region", "Render region: drag a rectangle to refine "
+                                                                     "only that part of the picture")):
             action = a(name.capitalize(), lambda _c=False, n=name: self.set_tool(n), key, icon_name, True, tip)
             tools.addAction(action)
             act["tool_" + name] = action
@@ -203,7 +232,7 @@ class MainWindow(QMainWindow):
         bar = QToolBar()
         bar.setObjectName("viewportBar")
         bar.setMovable(False)
-        for name in ("tool_select", "tool_focus", "tool_pan"):
+        for name in ("tool_select", "tool_focus", "tool_pan", "tool_region"):
             bar.addAction(self.actions[name])
         bar.addSeparator()
         bar.addAction(self.actions["fit"])
@@ -215,32 +244,49 @@ class MainWindow(QMainWindow):
         exposure_label = QLabel(" EV ")
         exposure_label.setToolTip("Display exposure")
         bar.addWidget(exposure_label)
-        self.exposure_slider = QSlider(Qt.Horizontal)
+        # The slider, a field to type a value into (1.5 is +1.5 EV; the arrows step a tenth) and a reset to 0,
+        # all three the same setting (display only).
+        self.exposure_slider = ResetSlider(Qt.Horizontal, default=0)
         self.exposure_slider.setRange(round(-10 * DISPLAY_EXPOSURE_STOPS), round(10 * DISPLAY_EXPOSURE_STOPS))
         self.exposure_slider.setFixedWidth(110)
         self.exposure_slider.setValue(round(self.viewport.exposure * 10))
-        self.exposure_slider.setToolTip("Display exposure in stops (display only: the render is not restarted)")
-        self.exposure_label = QLabel()
-        self.exposure_label.setObjectName("readout")
-        self.exposure_label.setMinimumWidth(44)
+        self.exposure_slider.setToolTip("Display exposure in stops (display only: the render is not restarted); "
+                                        "double-click: back to 0")
+        self.exposure_spin = SignedNumberEdit(-DISPLAY_EXPOSURE_STOPS, DISPLAY_EXPOSURE_STOPS, 1, 0.1, " EV")
+        self.exposure_spin.setObjectName("displayExposure")
+        self.exposure_spin.setFixedWidth(70)
+        self.exposure_spin.setToolTip("Display exposure in stops: type a value (1.5 is +1.5 EV); the arrow keys "
+                                      "and the wheel step a tenth")
+        self.exposure_reset = QToolButton()
+        self.exposure_reset.setObjectName("exposureReset")
+        self.exposure_reset.setText("\u21ba")  # ↺
+        self.exposure_reset.setStyleSheet("QToolButton { border: 1px solid #45464b; padding: 0px 5px; }"
+                                          "QToolButton:disabled { color: #5c5e62; border-color: #38393c; }")
+        self.exposure_reset.setToolTip("Display exposure back to 0 EV (or double-click the slider)")
         bar.addWidget(self.exposure_slider)
-        bar.addWidget(self.exposure_label)
+        bar.addWidget(self.exposure_spin)
+        bar.addWidget(self.exposure_reset)
         self.tone_combo = QComboBox()
         self.tone_combo.setObjectName("toneMap")
         for name in TONE_MAPS:
             self.tone_combo.addItem(name.capitalize(), name)
         self.tone_combo.setCurrentIndex(max(0, self.tone_combo.findData(self.viewport.tone_map)))
-        self.tone_combo.setToolTip("Tone map: how radiance above 1 is brought into the displayable range")
+        self.tone_combo.setToolTip("Tone map: how radiance above 1 is brought into the displayable range "
+                                   "(filmic by default)")
         bar.addWidget(self.tone_combo)
         spacer = QWidget()
         spacer.setSizePolicy(QSizePolicy.Expanding, QSizePolicy.Preferred)
         bar.addWidget(spacer)
         self.quality_combo = QComboBox()
-        for name, label in (("auto", "Auto res"), ("full", "Full res"), ("half", "½ res"), ("quarter", "¼ res")):
+        for name, label in (("auto", "Auto res"), ("full", "Full res"), ("half", "½ res"), ("quarter", "¼ res"),
+                            ("export", "Export res")):
             self.quality_combo.addItem(label, name)
         self.quality_combo.setCurrentIndex(max(0, self.quality_combo.findData(self.controller.quality)))
-        self.quality_combo.setToolTip("Viewport resolution relative to the camera's (Auto: at most 800 px wide)")
+        self.quality_combo.setToolTip("The viewport's resolution: a fraction of its own size in pixels (Auto: all "
+                                      "of them on a GPU, at most 800 on the long side on the CPU), or the "
+                                      "export's own pixels")
         bar.addWidget(self.quality_combo)
+        bar.addAction(self.actions["denoise"])
         self.limit_combo = QComboBox()
         for spp in SAMPLE_LIMITS:
             self.limit_combo.addItem(f"{spp} spp" if spp else "∞ spp", spp)
@@ -268,6 +314,7 @@ class MainWindow(QMainWindow):
         self.setDockOptions(QMainWindow.AnimatedDocks | QMainWindow.AllowTabbedDocks)
         self.scene_tree = SceneTreeView(self.doc)
         self.properties = PropertyEditor(self.doc)
+        self.properties.picture_height = self._frame_height_on_screen  # a scrubbed object follows the mouse
         self.camera_panel = CameraPanel(self.doc, self.actions["tool_focus"], settings=self.settings)
         self.camera_panel.stop_scale_changed.connect(self._name_stop_actions)
         self._name_stop_actions(self.camera_panel.scale_name)
@@ -311,7 +358,7 @@ class MainWindow(QMainWindow):
         file_menu.addAction(act["open"])
         self.shipped_menu = file_menu.addMenu("Open Example")
         for name in shipped_scene_names():
-            self.shipped_menu.addAction(name.replace("_", " ").capitalize(), lambda n=name: self.open_path(n))
+            self.shipped_menu.addAction(scene_title(name), lambda n=name: self.open_path(n))
         self.recent_menu = file_menu.addMenu("Open &Recent")
         self.recent_menu.aboutToShow.connect(self._fill_recent_menu)
         file_menu.addSeparator()
@@ -343,6 +390,8 @@ class MainWindow(QMainWindow):
         for name in ("fit", "actual", "zoom_in", "zoom_out"):
             view.addAction(act[name])
         view.addSeparator()
+        view.addAction(act["denoise"])
+        view.addSeparator()
         for dock in self.docks.values():
             view.addAction(dock.toggleViewAction())
         view.addAction(act["reset_layout"])
@@ -350,6 +399,9 @@ class MainWindow(QMainWindow):
         camera = bar.addMenu("&Camera")
         for name in ("tool_select", "tool_focus", "tool_pan"):
             camera.addAction(act[name])
+        camera.addSeparator()
+        camera.addAction(act["frame_selection"])
+        camera.addAction(act["frame_all"])
         camera.addSeparator()
         camera.addAction(act["open_up"])
         camera.addAction(act["stop_down"])
@@ -368,6 +420,9 @@ class MainWindow(QMainWindow):
         render = bar.addMenu("&Render")
         render.addAction(act["pause"])
         render.addAction(act["restart"])
+        render.addSeparator()
+        render.addAction(act["tool_region"])
+        render.addAction(act["clear_region"])
         render.addSeparator()
         render.addAction(act["export"])
 
@@ -410,7 +465,11 @@ class MainWindow(QMainWindow):
         v.focus_clicked.connect(self._focus_clicked)
         v.focus_preview.connect(self._focus_preview)
         v.zoom_changed.connect(lambda s: self.zoom_label.setText("Fit" if v.zoom is None else f"{s * 100:.0f}%"))
-        self.exposure_slider.valueChanged.connect(self._exposure_changed)
+        v.resized.connect(self._viewport_resized)
+        v.region_drawn.connect(self._region_drawn)
+        self.exposure_slider.valueChanged.connect(lambda tenths: self.set_display_exposure(tenths / 10))
+        self.exposure_spin.valueChanged.connect(self.set_display_exposure)
+        self.exposure_reset.clicked.connect(lambda: self.set_display_exposure(0.0))
         self.tone_combo.currentIndexChanged.connect(self._tone_changed)
         self.quality_combo.currentIndexChanged.connect(self._quality_changed)
         self.limit_combo.currentIndexChanged.connect(self._limit_changed)
@@ -443,8 +502,9 @@ class MainWindow(QMainWindow):
 
     # -- title, actions, HUD -----------------------------------------------------------------------------------
     def _update_title(self) -> None:
-        name = self.doc.display_name
-        suffix = " (example)" if self.doc.path is None and self.doc.scene.source_path and is_shipped(self.doc.scene.source_path) else ""
+        example = self.doc.path is None and self.doc.scene.source_path and is_shipped(self.doc.scene.source_path)
+        name = scene_title(self.doc.display_name) if example else self.doc.display_name
+        suffix = " (example)" if example else ""
         self.setWindowTitle(f"{name}{suffix}[*] — {APP_NAME}")
         self.setWindowModified(self.doc.modified)
         if self.doc.path is not None:
@@ -497,6 +557,10 @@ class MainWindow(QMainWindow):
 
     # -- render events -------------------------------------------------------------------------------------------
     def _frame(self, frame) -> None:
+        export_pixels = self.controller.quality == "export"
+        self.viewport.fit_margin = 24 if export_pixels else 0
+        self.viewport.gate_rect = QRectF(*frame.gate) if frame.gate is not None and not export_pixels else None
+        self.viewport.region_rect = QRectF(*frame.region) if frame.region is not None else None
         self.viewport.set_frame(frame.display, frame.display_settings, frame.image)
         if self.viewport.zoom is None:
             self.zoom_label.setText("Fit")
@@ -506,9 +570,7 @@ class MainWindow(QMainWindow):
         self.progress_bar.setVisible(bool(frame.target_spp))
         self.rate_label.setText(rate_text(frame.samples_per_second) if frame.samples_per_second else "")
         self.elapsed_label.setText(elapsed_text(frame.elapsed_seconds))
-        state = "paused" if self.controller.paused else ("preview" if frame.preview else
-                                                          ("done" if frame.converged else f"{frame.samples_per_pixel} spp"))
-        self.viewport.status_text = state
+        self._update_corner_state(frame)
         if self._hover is not None:
             self._hovered(self._hover)
 
@@ -535,7 +597,8 @@ class MainWindow(QMainWindow):
         self.viewport.set_tool(tool)
         hints = {"select": "Select: click an object in the picture; Shift adds to the selection.",
                  "focus": "Focus: click a point to focus there; hold the button to preview the plane of focus.",
-                 "pan": "Pan: drag the picture; the wheel zooms."}
+                 "pan": "Pan: drag the picture; the wheel zooms.",
+                 "region": "Render region: drag a rectangle to refine only it; Alt+R renders everything again."}
         self.statusBar().showMessage(hints[tool], 4000)
 
     def _hovered(self, xy) -> None:
@@ -550,7 +613,7 @@ class MainWindow(QMainWindow):
             self.readout.setText(" ")
             return
         r, g, b = (float(c) for c in image[y, x])
-        lum = 0.2126 * r + 0.7152 * g + 0.0722 * b
+        lum = luminance((r, g, b))
         parts = [f"x {x}  y {y}",
                  f"<span style='color:#e06c6c'>R</span> {r:.4f}  <span style='color:#7fc56b'>G</span> {g:.4f}  "
                  f"<span style='color:#6b9be0'>B</span> {b:.4f}",
@@ -617,13 +680,29 @@ class MainWindow(QMainWindow):
             return
         self.viewport.show_focus_overlay(depth, dof.near_m, dof.far_m, hold)
 
-    def _exposure_changed(self, value: int) -> None:
-        self.viewport.set_display(exposure=value / 10)
-        self.controller.set_display(self.viewport.exposure, self.viewport.tone_map)
+    def _frame_height_on_screen(self) -> float:
+        """The export frame's height as the viewport draws it, in screen pixels (0 before the first picture):
+        what the camera's frame spans at an object's depth is spread over this many pixels."""
+        gate = self.viewport.gate_rect
+        height = gate.height() if gate is not None else self.viewport.image_size()[1]
+        return height * self.viewport.scale()
+
+    def set_display_exposure(self, stops: float) -> None:
+        """The viewport's display exposure, from the slider, the field or the reset: each shows it after."""
+        stops = min(DISPLAY_EXPOSURE_STOPS, max(-DISPLAY_EXPOSURE_STOPS, round(float(stops), 1)))
+        if stops != self.viewport.exposure:
+            self.viewport.set_display(exposure=stops)
+            self.controller.set_display(self.viewport.exposure, self.viewport.tone_map)
         self._update_exposure_label()
 
     def _update_exposure_label(self) -> None:
-        self.exposure_label.setText(f"{self.viewport.exposure:+.1f} EV")
+        """The slider and the field show the viewport's exposure (without telling anyone again)."""
+        for widget, value in ((self.exposure_slider, round(self.viewport.exposure * 10)),
+                              (self.exposure_spin, self.viewport.exposure)):
+            widget.blockSignals(True)
+            widget.setValue(value)
+            widget.blockSignals(False)
+        self.exposure_reset.setEnabled(self.viewport.exposure != 0)
 
     def _tone_changed(self, _index: int) -> None:
         self.viewport.set_display(operator=self.tone_combo.currentData())
@@ -635,11 +714,55 @@ class MainWindow(QMainWindow):
     def _limit_changed(self, _index: int) -> None:
         self.controller.set_target_spp(self.limit_combo.currentData())
 
+    # -- the viewport's picture: size, render region, denoiser, camera moves ----------------------------------------
+    def _viewport_resized(self, width: int, height: int) -> None:
+        self._viewport_size = (width, height)
+        self._resize_timer.start()
+
+    def _send_viewport_size(self) -> None:
+        if self._viewport_size is not None:
+            self.controller.set_widget_size(*self._viewport_size)
+
+    def _region_drawn(self, region) -> None:
+        self.controller.set_region(region)
+        self.statusBar().showMessage("Refining the render region; Alt+R renders the whole picture again.", 5000)
+
+    def set_denoise(self, on: bool) -> None:
+        self.controller.set_denoise(bool(on))
+        self.actions["denoise"].setChecked(bool(on))
+        self.settings.setValue("viewport/denoise", bool(on))
+
+    def _view_frame(self):
+        """The CameraFrame of the picture on screen."""
+        camera = self.doc.scene.camera
+        w, h = self.controller.size
+        margin = self.controller.margin
+        return camera.frame(w, h) if margin is None else camera.view_frame(w, h, margin)
+
+    def frame_selection(self, everything: bool = False) -> None:
+        paths = [] if everything else self.doc.selected_node_paths()
+        if not self.navigator.frame_selection(paths):
+            self.statusBar().showMessage("Nothing to frame", 4000)
+
     def set_paused(self, paused: bool) -> None:
         self.controller.set_paused(bool(paused))
         self.actions["pause"].setIcon(theme.icon("play" if paused else "pause"))
         self.actions["pause"].setText("Resume Rendering" if paused else "Pause Rendering")
-        self.viewport.status_text = "paused" if paused else self.viewport.status_text
+        self._update_corner_state(self.controller.last_frame)
+
+    def _update_corner_state(self, frame) -> None:
+        """The viewport's corner tag: the status bar's sample count (one text for both, so they never disagree),
+        and whether the render is paused or done and the picture denoised."""
+        if frame is None:
+            return
+        state = [samples_text(frame)]
+        if self.controller.paused:
+            state.append("paused")
+        elif frame.converged:
+            state.append("done")
+        if frame.denoised:
+            state.append("denoised")
+        self.viewport.status_text = " · ".join(state)
         self.viewport.update()
 
     # -- files ---------------------------------------------------------------------------------------------------
@@ -669,7 +792,7 @@ class MainWindow(QMainWindow):
     def open_dialog(self) -> None:
         if not self.maybe_save():
             return
-        start = str(self.doc.path.parent) if self.doc.path else str(Path.home())
+        start = str(self.last_folder("scenes") or (self.doc.path.parent if self.doc.path else Path.home()))
         name, _ = QFileDialog.getOpenFileName(self, "Open scene", start, f"LensLab scenes (*{SCENE_SUFFIX});;All files (*)")
         if name:
             self.open_path(name, ask=False)
@@ -686,6 +809,7 @@ class MainWindow(QMainWindow):
         self.doc.replace(scene, path)
         if not is_shipped(path):
             self._add_recent(path)
+            self.remember_folder("scenes", path)
         self.statusBar().showMessage(f"Opened {path}", 4000)
         return True
 
@@ -695,7 +819,8 @@ class MainWindow(QMainWindow):
         return self._write(self.doc.path)
 
     def save_as(self) -> bool:
-        start = str(self.doc.path or (Path.home() / f"{self.doc.display_name}{SCENE_SUFFIX}"))
+        folder = self.last_folder("scenes") or Path.home()
+        start = str(self.doc.path or (folder / f"{self.doc.display_name}{SCENE_SUFFIX}"))
         name, _ = QFileDialog.getSaveFileName(self, "Save scene", start, f"LensLab scenes (*{SCENE_SUFFIX})")
         if not name:
             return False
@@ -718,8 +843,19 @@ class MainWindow(QMainWindow):
             return False
         self.doc.saved_as(path, file_paths)
         self._add_recent(path)
+        self.remember_folder("scenes", path)
         self.statusBar().showMessage(f"Saved {path}", 4000)
         return True
+
+    def last_folder(self, kind: str) -> Path | None:
+        """The folder the last file of ``kind`` ("scenes": opened or saved; "meshes": imported; "images":
+        exported) was in, remembered between runs, if it is still there."""
+        value = self.settings.value(f"folders/{kind}")
+        folder = Path(str(value)) if value else None
+        return folder if folder is not None and folder.is_dir() else None
+
+    def remember_folder(self, kind: str, file: str | os.PathLike) -> None:
+        self.settings.setValue(f"folders/{kind}", str(Path(file).expanduser().resolve().parent))
 
     def recent_files(self) -> list[str]:
         value = self.settings.value("recent_files", [])
@@ -770,9 +906,11 @@ class MainWindow(QMainWindow):
 
     def import_dialog(self) -> None:
         self._warm_up_mesh_library()
-        start = str(self.doc.scene.base_dir())
+        start = str(self.last_folder("meshes") or self.doc.scene.base_dir())
         pattern = "Meshes (" + " ".join("*" + s for s in MESH_SUFFIXES) + ");;All files (*)"
         names, _ = QFileDialog.getOpenFileNames(self, "Import mesh", start, pattern)
+        if names:
+            self.remember_folder("meshes", names[0])
         for name in names:
             self.import_mesh(Path(name))
 
@@ -878,13 +1016,16 @@ class MainWindow(QMainWindow):
         if self.export_id is not None:
             return
         frame = self.controller.last_frame
+        folder = self.last_folder("images")
+        last = self.last_export_path or (folder / default_export_path(self.doc).name if folder else None)
         dialog = ExportDialog(self.doc, self.viewport.exposure, self.viewport.tone_map,
-                              frame.samples_per_second if frame else None, self.last_export_path, self)
+                              frame.samples_per_second if frame else None, last, self)
         if dialog.exec() == ExportDialog.Accepted:
             self.start_export(dialog.request())
 
     def start_export(self, request) -> int:
         self.last_export_path = Path(request.path)
+        self.remember_folder("images", request.path)
         self.export_id = self.controller.start_export(request)
         w, h = request.scene.camera.resolution
         dialog = QProgressDialog(f"Rendering {w}×{h} to {Path(request.path).name}…", "Cancel", 0, 1000, self)

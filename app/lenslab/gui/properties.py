@@ -34,7 +34,7 @@ from lenslab.gui import theme
 from lenslab.gui.commands import AddMaterialCommand, RenameMaterialCommand
 from lenslab.gui.document import listen
 from lenslab.gui.widgets import ColorEdit, IntEdit, NumberEdit, Section, VectorEdit, hint
-from lenslab.scene.editing import file_reference
+from lenslab.scene.editing import file_reference, screen_drag_rate
 from lenslab.scene.lights import LIGHT_TYPES, Light
 from lenslab.scene.materials import MATERIAL_TYPES, Diffuse, Material
 from lenslab.scene.textures import TEXTURE_TYPES, Texture
@@ -59,6 +59,11 @@ COLOUR_FIELDS = {"albedo", "radiance", "color", "colour", "reflectance", "transm
 SKIP_FIELDS = {"children", "source_path"}
 
 _UNITS = {"_mm": " (mm)", "_m": " (m)", "_deg": " (°)"}
+
+#: Places (a node's translate, a light's position) that scrub at the speed of the picture: the object follows the
+#: mouse on screen (``lenslab.scene.editing.screen_drag_rate``); shown to a tenth of a millimetre.
+PLACE_FIELDS = {"node": ("transform", "translate"), "light": ("position",)}
+PLACE_DECIMALS = 4
 
 
 #: Field names that read badly when merely capitalised.
@@ -141,6 +146,9 @@ class PropertyEditor(QWidget):
         self.target: tuple | None = None
         self._signature = None
         self._editors: dict[tuple, FieldEditor] = {}
+        # The height of the picture on screen, in pixels (the main window asks its viewport); a place scrubs by
+        # what one such pixel spans at the object's depth. None: the camera's image at 100 %.
+        self.picture_height: Callable[[], float] | None = None
         self.title = QLabel()
         self.title.setObjectName("bigReadout")
         self.title.setStyleSheet("font-size: 14px;")
@@ -438,7 +446,11 @@ class PropertyEditor(QWidget):
             labels = ("X", "Y", "Z") if n == 3 else (("W", "H") if n == 2 else tuple(str(i) for i in range(n)))
             colours = None if n != 3 else ("#e06c6c", "#7fc56b", "#6b9be0")
             step = 1.0 if path[-1] == "rotate_deg" else _step_for(lo, hi)
-            vec = VectorEdit(labels, lo, hi, integer=integer, step=None if integer else step, colours=colours)
+            place = PLACE_FIELDS.get(target[0]) == tuple(path)
+            vec = VectorEdit(labels, lo, hi, integer=integer, step=None if integer else step, colours=colours,
+                             decimals=PLACE_DECIMALS if place else None)
+            if place:
+                vec.set_scrub_rate(lambda: self.drag_rate(target))
             vec.set_value(value)
             nonzero = meta.get("nonzero", False)
 
@@ -478,6 +490,15 @@ class PropertyEditor(QWidget):
         layout.addWidget(line, 1)
         layout.addWidget(browse)
         return FieldEditor(row, lambda v: line.setText(v) if not line.hasFocus() else None)
+
+    def drag_rate(self, target) -> float | None:
+        """Metres (in the parent's units) per pixel of scrubbing the place of ``target``: see PLACE_FIELDS."""
+        if target is None or not self.doc.model.exists(target):
+            return None
+        height = self.picture_height() if self.picture_height is not None else 0.0
+        if not height or height <= 0:
+            height = self.doc.scene.camera.resolution[1]
+        return screen_drag_rate(self.doc.model, target, height)
 
     # -- editing and refreshing ----------------------------------------------------------------------------------
     def _commit(self, target, path, value, merge, text=None) -> None:

@@ -1,7 +1,12 @@
-"""The outliner: a Qt item model over the scene (camera, environment, the node tree, materials, point lights and
-suns, render settings) and the tree view that shows it. Selecting here selects in the viewport and the property
-editor and back; nodes can be renamed in place (F2 or double click) and dragged onto another node to parent them,
-keeping where they are in the world, as in Blender's outliner."""
+"""The outliner: a Qt item model over the scene (camera, environment, the node tree, materials, the lights, render
+settings) and the tree view that shows it. Selecting here selects in the viewport and the property editor and
+back; nodes can be renamed in place (F2 or double click) and dragged onto another node to parent them, keeping
+where they are in the world, as in Blender's outliner.
+
+Lights lists every light there is: point lights, spots and suns, and the objects that glow (area lights: a shape
+with an emissive material, which live in the node tree), each of those an entry that stands for its object
+(selecting or renaming it selects or renames the object; both its rows show it selected). A scene with no light at
+all has no Lights group."""
 
 from __future__ import annotations
 
@@ -22,7 +27,8 @@ NODE_MIME = "application/x-lenslab-node-paths"
 
 OBJECTS = ("objects",)
 MATERIALS = ("materials",)
-LIGHTS = ("lights",)  # point lights, spots and suns; area lights are objects with an emissive material
+LIGHTS = ("lights",)  # point lights, spots and suns; and ("emitter", path): an object that glows, listed here too
+EMITTER = "emitter"
 LIGHT_KIND_NAMES = {"point": "point light", "spot": "spot light", "sun": "sun"}
 GROUPS = {OBJECTS: "Objects", MATERIALS: "Materials", LIGHTS: "Lights"}
 TARGET_KINDS = ("camera", "environment", "render", "material", "node", "light")  # rows that select something
@@ -76,11 +82,22 @@ class SceneTreeModel(QAbstractItemModel):
         materials = add(root, MATERIALS)
         for name in self.doc.scene.materials:
             add(materials, ("material", name))
-        lights = add(root, LIGHTS)
-        for i in range(len(self.doc.scene.lights)):
-            add(lights, ("light", i))
+        emitters = self.emitter_paths()
+        if emitters or self.doc.scene.lights:
+            lights = add(root, LIGHTS)
+            for i in range(len(self.doc.scene.lights)):
+                add(lights, ("light", i))
+            for path in emitters:
+                add(lights, (EMITTER, path))
+        self._emitters = emitters
         add(root, ("render",))
         self._root, self._by_key = root, by_key
+
+    def emitter_paths(self) -> list[tuple]:
+        """The objects that glow: a shape whose material emits (the area lights), in the tree's order."""
+        materials = self.doc.scene.materials
+        return [path for path, node in self.doc.model.walk_nodes()
+                if node.shape is not None and getattr(materials.get(node.material), "emits", False)]
 
     def rebuild(self) -> None:
         self.beginResetModel()
@@ -88,13 +105,15 @@ class SceneTreeModel(QAbstractItemModel):
         self.endResetModel()
 
     def _on_change(self, change) -> None:
-        if change.kind in ("structure", "scene"):
-            self.rebuild()
+        if change.kind in ("structure", "scene") or \
+                (change.kind in ("node", "material") and self.emitter_paths() != self._emitters):
+            self.rebuild()  # a node given a glowing material (or a material made to glow) joins the lights
         elif change.kind in ("node", "light"):
-            item = self._by_key.get(change.target)
-            if item is not None:
-                index = self.createIndex(item.row, 0, item)
-                self.dataChanged.emit(index, index)
+            for key in (change.target, (EMITTER,) + tuple(change.target[1:])):
+                item = self._by_key.get(key)
+                if item is not None:
+                    index = self.createIndex(item.row, 0, item)
+                    self.dataChanged.emit(index, index)
         elif change.kind == "material":
             # Swatches of the material and light icons of the nodes that use it.
             self.dataChanged.emit(self.index(0, 0), self.index(self.rowCount() - 1, 0))
@@ -145,6 +164,8 @@ class SceneTreeModel(QAbstractItemModel):
             return None
         key = index.internalPointer().key
         kind = key[0]
+        if kind == EMITTER:
+            return self._emitter_data(key, role)
         try:
             obj = self.doc.model.resolve(key) if kind in TARGET_KINDS else None
         except (KeyError, IndexError):
@@ -177,6 +198,22 @@ class SceneTreeModel(QAbstractItemModel):
             return font
         return None
 
+    def _emitter_data(self, key: tuple, role: int):
+        """A glowing object's entry under Lights: its name, the light icon, and what it is."""
+        try:
+            node = self.doc.model.node(key[1])
+        except (KeyError, IndexError):
+            return None
+        if role in (Qt.DisplayRole, Qt.EditRole):
+            return node.name
+        if role == Qt.DecorationRole:
+            return theme.icon("light")
+        if role == Qt.ToolTipRole:
+            shape = getattr(node.shape, "type_name", "shape")
+            return (f"<b>{node.name}</b><br>area light: a {shape} with the emissive material {node.material}"
+                    "<br>the object itself, listed under Objects")
+        return None
+
     def _node_icon(self, node) -> str:
         material = self.doc.scene.materials.get(node.material)
         if material is not None and getattr(material, "emits", False):
@@ -198,7 +235,8 @@ class SceneTreeModel(QAbstractItemModel):
         if kind == "light":
             return f"<b>{obj.name}</b><br>{LIGHT_KIND_NAMES.get(obj.type_name, obj.type_name)}"
         if key == LIGHTS:
-            return "Point lights, spots and suns. Area lights are objects with an emissive material."
+            return ("Every light: the objects that glow (area lights: objects with an emissive material, also "
+                    "under Objects) and the point lights, spots and suns.")
         if kind == "material":
             users = len(self.doc.model.material_users(key[1]))
             return f"<b>{key[1]}</b><br>{obj.type_name} · used by {users} node{'s' * (users != 1)}"
@@ -216,7 +254,7 @@ class SceneTreeModel(QAbstractItemModel):
         flags = Qt.ItemIsEnabled | Qt.ItemIsSelectable
         if key[0] == "node":
             flags |= Qt.ItemIsEditable | Qt.ItemIsDragEnabled | Qt.ItemIsDropEnabled
-        elif key[0] in ("material", "light"):
+        elif key[0] in ("material", "light", EMITTER):
             flags |= Qt.ItemIsEditable
         elif key == OBJECTS:
             flags |= Qt.ItemIsDropEnabled
@@ -229,6 +267,7 @@ class SceneTreeModel(QAbstractItemModel):
         text = str(value).strip()
         if not text:
             return False
+        key = target_of(key)
         if key[0] in ("node", "light"):
             if text != self.doc.model.resolve(key).name:
                 self.doc.set_value(key, ("name",), text, text=f"Rename to {text}")
@@ -274,6 +313,11 @@ class SceneTreeModel(QAbstractItemModel):
         index = count if row < 0 else min(row, count)
         move_node(self.doc, paths[0], dst_parent, index)
         return False  # we moved it ourselves; Qt must not remove the source row
+
+
+def target_of(key: tuple) -> tuple:
+    """What a row stands for: a glowing object's entry under Lights is the object."""
+    return ("node",) + tuple(key[1:]) if key and key[0] == EMITTER else key
 
 
 def move_node(doc, src: tuple, dst_parent: tuple, index: int) -> bool:
@@ -335,16 +379,42 @@ class SceneTreeView(QTreeView):
             self._syncing = False
         self._selection_from_doc()
 
-    def _selection_to_doc(self, *_args) -> None:
+    def _selection_to_doc(self, _selected=None, deselected=None) -> None:
         if self._syncing:
             return
-        keys = [self.tree_model.key(i) for i in self.selectionModel().selectedRows()]
-        keys = [k for k in keys if k and k[0] in TARGET_KINDS]
+        # The row just clicked let go of (Ctrl-click) lets go of what it stands for, though its twin row (a glowing
+        # object's other row) is still selected.
+        current = self.selectionModel().currentIndex()
+        dropped = {target_of(self.tree_model.key(current))} if deselected is not None and current.isValid() and \
+            deselected.contains(current) else set()
+        keys = [target_of(self.tree_model.key(i)) for i in self.selectionModel().selectedRows()]
+        keys = [k for k in keys if k and k[0] in TARGET_KINDS and k not in dropped]
         self._syncing = True
         try:
             self.doc.set_selection(keys)
+            self._match_twins(dropped)
         finally:
             self._syncing = False
+
+    def _match_twins(self, dropped: set) -> None:
+        """A glowing object has two rows, under Objects and under Lights: both show whether it is selected. Only
+        the twins are touched (no clearing, no new current row), so a Shift-click's anchor stays where it was."""
+        model, selection = self.tree_model, self.selectionModel()
+        add, remove = QItemSelection(), QItemSelection()
+        for path in model.emitter_paths():
+            node = ("node", path)
+            for key in (node, (EMITTER, path)):
+                index = model.index_of(key)
+                if not index.isValid():
+                    continue
+                if node in self.doc.selection and not selection.isSelected(index):
+                    add.select(index, index)
+                elif node in dropped and selection.isSelected(index):
+                    remove.select(index, index)
+        if not add.isEmpty():
+            selection.select(add, QItemSelectionModel.Select | QItemSelectionModel.Rows)
+        if not remove.isEmpty():
+            selection.select(remove, QItemSelectionModel.Deselect | QItemSelectionModel.Rows)
 
     def _selection_from_doc(self) -> None:
         if self._syncing:
@@ -362,6 +432,10 @@ class SceneTreeView(QTreeView):
                     while parent.isValid():
                         self.setExpanded(parent, True)
                         parent = parent.parent()
+                if key[0] == "node":  # its entry under Lights too, if it glows
+                    entry = self.tree_model.index_of((EMITTER,) + tuple(key[1:]))
+                    if entry.isValid():
+                        selection.select(entry, entry)
             self.selectionModel().select(selection, QItemSelectionModel.ClearAndSelect | QItemSelectionModel.Rows)
             if first is not None:
                 self.selectionModel().setCurrentIndex(first, QItemSelectionModel.NoUpdate)

@@ -88,6 +88,10 @@ _ICONS = {
              '<path d="M12 2 V6 M12 18 V22 M2 12 H6 M18 12 H22" {s}/>',
     "pan": '<path d="M12 3 V21 M3 12 H21 M12 3 L9.5 5.5 M12 3 L14.5 5.5 M12 21 L9.5 18.5 M12 21 L14.5 18.5 '
            'M3 12 L5.5 9.5 M3 12 L5.5 14.5 M21 12 L18.5 9.5 M21 12 L18.5 14.5" {s}/>',
+    "region": '<path d="M4 8 V4 H8 M11 4 H13 M16 4 H20 V8 M20 11 V13 M20 16 V20 H16 M13 20 H11 M8 20 H4 V16 M4 13 V11" {s}/>'
+              '<rect x="9" y="9" width="6" height="6" fill="{c}"/>',
+    "denoise": '<path d="M3 17 L5 14 L7 18 L9 12 L11 16" {s}/><path d="M13 14 C15 12 17 12 21 14" {s}/>'
+               '<path d="M11 6 H17 M14 3 V9" {s}/>',
     "fit": '<path d="M4 9 V4 H9 M15 4 H20 V9 M20 15 V20 H15 M9 20 H4 V15" {s}/><rect x="8" y="8" width="8" height="8" {s}/>',
     "pause": '<path d="M8 5 V19 M16 5 V19" fill="none" stroke="{c}" stroke-width="3" stroke-linecap="round"/>',
     "play": '<path d="M7 4.5 L19 12 L7 19.5 Z" fill="{c}"/>',

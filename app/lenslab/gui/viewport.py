@@ -13,7 +13,7 @@ import time
 
 import numpy as np
 from PySide6.QtCore import QPointF, QRectF, Qt, QTimer, Signal
-from PySide6.QtGui import QColor, QFont, QImage, QPainter
+from PySide6.QtGui import QColor, QFont, QImage, QPainter, QPen
 from PySide6.QtWidgets import QWidget
 
 from lenslab.gui import theme
@@ -69,6 +69,14 @@ class Viewport(QWidget):
     node_clicked = Signal(int, bool)  # depth-first node index (-1: background), add to selection
     focus_clicked = Signal(float, float)  # (u, v) in [0, 1], a click of the focus tool
     zoom_changed = Signal(float)
+    resized = Signal(int, int)  # the widget's new size in device pixels
+    region_drawn = Signal(object)  # (x, y, width, height) in image pixels, drawn with the region tool
+    # Moving the camera with the mouse (docs/studio.md, "Moving the camera"): a gesture starts, moves by
+    # (dx, dy) widget pixels since its start, and ends. The kind is "orbit", "pan" or "dolly".
+    navigation_started = Signal(str, object)  # kind, the (x, y) image pixel it started on, or None
+    navigation_moved = Signal(str, float, float)
+    navigation_finished = Signal()
+    dolly_wheel = Signal(float)  # wheel steps (+ towards the subject) with Ctrl held
 
     def __init__(self, parent=None):
         super().__init__(parent)
@@ -82,6 +90,13 @@ class Viewport(QWidget):
         self.exposure = 0.0
         self.tone_map = "filmic"
         self.zoom: float | None = None  # None: fit the window
+        # Space left around a fitted picture: none when the picture is rendered at the widget's size (it
+        # carries its own margin around the sensor's gate), some when it is the export's pixels.
+        self.fit_margin = 24
+        self.region_rect: QRectF | None = None  # the render region being refined, image pixels
+        self._region_start: QPointF | None = None
+        self._region_end: QPointF | None = None
+        self._navigation: tuple[str, QPointF] | None = None  # (kind, where it started)
         self.pan = QPointF(0, 0)
         self.tool = "select"
         self.gbuffer = None
@@ -103,6 +118,9 @@ class Viewport(QWidget):
         self.layers: list = []
         # The export's frame (the sensor's gate) in image pixels of the viewport's picture; None: the whole picture.
         self.gate_rect: QRectF | None = None
+        # The A/B comparison with a snapshot (lenslab.gui.compare.Comparison): it draws the picture in the live
+        # one's place and, side by side, has the live picture laid out in the right half; None: live alone.
+        self.compare = None
         self._fade_timer = QTimer(self)
         self._fade_timer.setInterval(40)
         self._fade_timer.timeout.connect(self._fade_tick)
@@ -207,8 +225,16 @@ class Viewport(QWidget):
         w, h = self.image_size()
         if w == 0:
             return 1.0
-        margin = 24
-        return max(0.01, min((self.width() - margin) / w, (self.height() - margin) / h))
+        margin = self.fit_margin
+        area = self.picture_area()
+        return max(0.01, min((area.width() - margin) / w, (area.height() - margin) / h))
+
+    def picture_area(self) -> QRectF:
+        """Where the live picture is fitted and centred: the whole widget, or its right half while a snapshot is
+        compared side by side (the left half shows the snapshot)."""
+        if self.compare is not None and self.compare.side_by_side():
+            return QRectF(self.width() / 2, 0, self.width() / 2, self.height())
+        return QRectF(0, 0, self.width(), self.height())
 
     def scale(self) -> float:
         return self.fit_scale() if self.zoom is None else self.zoom
@@ -216,7 +242,7 @@ class Viewport(QWidget):
     def image_rect(self) -> QRectF:
         w, h = self.image_size()
         s = self.scale()
-        centre = QPointF(self.width() / 2, self.height() / 2) + (self.pan if self.zoom is not None else QPointF())
+        centre = self.picture_area().center() + (self.pan if self.zoom is not None else QPointF())
         return QRectF(centre.x() - w * s / 2, centre.y() - h * s / 2, w * s, h * s)
 
     def widget_to_image(self, pos: QPointF) -> tuple[float, float] | None:
@@ -224,6 +250,8 @@ class Viewport(QWidget):
         rect = self.image_rect()
         if rect.width() <= 0 or not rect.contains(pos):
             return None
+        if self.compare is not None and self.compare.side_by_side() and pos.x() < self.width() / 2:
+            return None  # the snapshot's half, into which a zoomed live picture may reach
         s = self.scale()
         return (pos.x() - rect.left()) / s, (pos.y() - rect.top()) / s
 
@@ -270,10 +298,12 @@ class Viewport(QWidget):
         p.fillRect(self.rect(), QColor(theme.BACKGROUND))
         if self.qimage is not None:
             rect = self.image_rect()
-            smooth = self.scale() < 2.0  # pixel-peeping at 200% and above shows the pixels as they are
+            # Pixel-peeping at 200% and above shows the pixels as they are; a fitted picture is always smooth.
+            smooth = self.zoom is None or self.scale() < 2.0
             p.setRenderHint(QPainter.SmoothPixmapTransform, smooth)
             p.fillRect(rect.adjusted(-1, -1, 1, 1), QColor("#000000"))
-            p.drawImage(rect, self.qimage)
+            if self.compare is None or not self.compare.paint_picture(p, rect):
+                p.drawImage(rect, self.qimage)
             if self.message:
                 p.fillRect(rect, QColor(0, 0, 0, 140))
             if self._outline is not None and self._outline.size() == self.qimage.size():
@@ -286,6 +316,9 @@ class Viewport(QWidget):
             for layer in self.layers:
                 if getattr(layer, "visible", True):
                     layer.paint(p, self, rect)
+            self._draw_region(p)
+            if self.compare is not None:
+                self.compare.paint_over(p, rect)
         self._draw_hud(p)
         if self.message:
             p.setPen(QColor("#f0c0a0"))
@@ -298,6 +331,29 @@ class Viewport(QWidget):
             p.setPen(QColor(theme.DIM_TEXT))
             p.drawText(self.rect(), Qt.AlignCenter, "Starting the renderer…")
         p.end()
+
+    def _draw_region(self, p: QPainter) -> None:
+        """The render region: the one being refined, and the one being drawn with the region tool."""
+        rects = []
+        if self.region_rect is not None:
+            rects.append((self.region_rect, theme.ACCENT))
+        if self._region_start is not None and self._region_end is not None:
+            rects.append((self._drawn_region(), "#ffffff"))
+        for region, colour in rects:
+            top_left = self.image_to_widget(region.left(), region.top())
+            bottom_right = self.image_to_widget(region.right(), region.bottom())
+            pen = QPen(QColor(colour))
+            pen.setStyle(Qt.DashLine)
+            p.setPen(pen)
+            p.setBrush(Qt.NoBrush)
+            p.drawRect(QRectF(top_left, bottom_right))
+
+    def _drawn_region(self) -> QRectF:
+        a, b = self._region_start, self._region_end
+        w, h = self.image_size()
+        x0, x1 = sorted((min(max(a.x(), 0), w), min(max(b.x(), 0), w)))
+        y0, y1 = sorted((min(max(a.y(), 0), h), min(max(b.y(), 0), h)))
+        return QRectF(x0, y0, x1 - x0, y1 - y0)
 
     def _draw_tag(self, p: QPainter, at: QPointF, text: str, colour: str) -> None:
         if not text:
@@ -328,18 +384,54 @@ class Viewport(QWidget):
     # -- interaction --------------------------------------------------------------------------------------------
     def set_tool(self, tool: str) -> None:
         self.tool = tool
-        self.setCursor({"select": Qt.ArrowCursor, "focus": Qt.CrossCursor, "pan": Qt.OpenHandCursor}[tool])
+        self.setCursor({"select": Qt.ArrowCursor, "focus": Qt.CrossCursor, "pan": Qt.OpenHandCursor,
+                        "region": Qt.CrossCursor}[tool])
         self.update()
+
+    def resizeEvent(self, event) -> None:
+        super().resizeEvent(event)
+        ratio = self.devicePixelRatioF()
+        self.resized.emit(round(self.width() * ratio), round(self.height() * ratio))
 
     def wheelEvent(self, event) -> None:
         steps = event.angleDelta().y()
-        if steps:
+        if steps and event.modifiers() & Qt.ControlModifier:
+            self.dolly_wheel.emit(steps / 120)
+        elif steps:
             self.zoom_step(1 if steps > 0 else -1, event.position())
+
+    @staticmethod
+    def navigation_kind(button, modifiers) -> str | None:
+        """The camera move a mouse button starts (Blender's middle button, Maya's Alt), or None."""
+        alt = bool(modifiers & Qt.AltModifier)
+        if button == Qt.MiddleButton:
+            if alt:
+                return "pan"  # Maya: Alt + middle
+            if modifiers & Qt.ShiftModifier:
+                return "pan"  # Blender: Shift + middle
+            if modifiers & Qt.ControlModifier:
+                return "dolly"  # Blender: Ctrl + middle
+            return "orbit"  # Blender: middle
+        if alt and button == Qt.LeftButton:
+            return "orbit"  # Maya: Alt + left
+        if alt and button == Qt.RightButton:
+            return "dolly"  # Maya: Alt + right
+        return None
 
     def mousePressEvent(self, event) -> None:
         pos = event.position()
-        panning = event.button() == Qt.MiddleButton or (event.button() == Qt.LeftButton and
-                                                          (self.tool == "pan" or self._space_down))
+        kind = self.navigation_kind(event.button(), event.modifiers())
+        if kind is not None and self._navigation is None:
+            self._navigation = (kind, pos)
+            xy = self.widget_to_image(pos)
+            self.setCursor(Qt.SizeAllCursor)
+            self.navigation_started.emit(kind, None if xy is None else (int(xy[0]), int(xy[1])))
+            return
+        if event.button() == Qt.LeftButton and self.tool == "region" and not self._space_down:
+            start = self.widget_to_image_unclamped(pos)
+            self._region_start = self._region_end = QPointF(*start)
+            return
+        panning = event.button() == Qt.LeftButton and (self.tool == "pan" or self._space_down)
         if panning:
             if self.zoom is None:
                 self.zoom = self.fit_scale()
@@ -355,6 +447,14 @@ class Viewport(QWidget):
 
     def mouseMoveEvent(self, event) -> None:
         pos = event.position()
+        if self._navigation is not None:
+            kind, start = self._navigation
+            self.navigation_moved.emit(kind, pos.x() - start.x(), pos.y() - start.y())
+            return
+        if self._region_start is not None:
+            self._region_end = QPointF(*self.widget_to_image_unclamped(pos))
+            self.update()
+            return
         if self._drag_start is not None:
             self.pan = self._pan_start + (pos - self._drag_start)
             self.update()
@@ -366,6 +466,19 @@ class Viewport(QWidget):
 
     def mouseReleaseEvent(self, event) -> None:
         pos = event.position()
+        if self._navigation is not None:
+            self._navigation = None
+            self.set_tool(self.tool)
+            self.navigation_finished.emit()
+            return
+        if self._region_start is not None:
+            self._region_end = QPointF(*self.widget_to_image_unclamped(pos))
+            region = self._drawn_region()
+            self._region_start = self._region_end = None
+            self.update()
+            if region.width() >= 4 and region.height() >= 4:  # a click is not a region
+                self.region_drawn.emit((region.left(), region.top(), region.width(), region.height()))
+            return
         if self._drag_start is not None:
             self._drag_start = None
             self.set_tool(self.tool)

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import math
 
+from typing import Callable
+
 from PySide6.QtCore import QPoint, QSize, Qt, Signal
 from PySide6.QtGui import QColor, QCursor, QPainter
 from PySide6.QtWidgets import (
@@ -13,6 +15,7 @@ from PySide6.QtWidgets import (
     QHBoxLayout,
     QLabel,
     QSizePolicy,
+    QSlider,
     QSpinBox,
     QToolButton,
     QVBoxLayout,
@@ -63,7 +66,9 @@ class Section(QWidget):
 
 
 class ScrubLabel(QLabel):
-    """A label that drags the value of a spin box: one step per few pixels."""
+    """A label that drags the value of a spin box: one step per few pixels, or ``rate()`` per pixel where the
+    field has a rate of its own (a position: as far as the object moves on screen, see ``properties.py``).
+    Shift scrubs a tenth as fast, Ctrl ten times as fast."""
 
     scrub_started = Signal()
     scrub_finished = Signal()
@@ -78,25 +83,30 @@ class ScrubLabel(QLabel):
         if colour:
             self.setStyleSheet(f"color: {colour}; font-weight: 600;")
         self._origin: QPoint | None = None
-        self._start_value = 0.0
+        self._value = 0.0
+        self.rate: Callable[[], float] | None = None  # value per pixel; None: a step per PIXELS_PER_STEP
+        self._per_pixel = 0.0
 
     def mousePressEvent(self, event) -> None:
         if event.button() == Qt.LeftButton and self.spin.isEnabled():
             self._origin = event.globalPosition().toPoint()
-            self._start_value = self.spin.value()
+            self._value = self.spin.value()
+            # Asked once per drag: the object's depth, and so the rate, changes as it moves.
+            rate = self.rate() if self.rate is not None else None
+            self._per_pixel = rate if rate else self.spin.singleStep() / self.PIXELS_PER_STEP
             self.scrub_started.emit()
         super().mousePressEvent(event)
 
     def mouseMoveEvent(self, event) -> None:
         if self._origin is None:
             return
-        dx = event.globalPosition().toPoint().x() - self._origin.x()
+        # Each move adds its own pixels at the speed of the keys held now: pressing Shift mid-drag slows the
+        # rest of the drag down, it does not make the value jump.
+        x = event.globalPosition().toPoint().x()
+        dx, self._origin = x - self._origin.x(), QPoint(x, self._origin.y())
         factor = 0.1 if event.modifiers() & Qt.ShiftModifier else 10.0 if event.modifiers() & Qt.ControlModifier else 1.0
-        steps = dx / self.PIXELS_PER_STEP * factor
-        value = self._start_value + steps * self.spin.singleStep()
-        if isinstance(self.spin, QSpinBox):
-            value = round(value)
-        self.spin.setValue(value)
+        self._value = min(max(self._value + dx * factor * self._per_pixel, self.spin.minimum()), self.spin.maximum())
+        self.spin.setValue(round(self._value) if isinstance(self.spin, QSpinBox) else self._value)
 
     def mouseReleaseEvent(self, event) -> None:
         if self._origin is not None:
@@ -181,6 +191,48 @@ class IntEdit(QSpinBox):
             self.edited.emit(value, True)
 
 
+class SignedNumberEdit(QDoubleSpinBox):
+    """A number shown with its sign, as a camera shows exposure compensation: +1.5, -0.7, 0.0. Commits on Enter,
+    focus out, the arrows and the wheel (a focused field only)."""
+
+    def __init__(self, lo: float, hi: float, decimals: int = 1, step: float = 0.1, suffix: str = "",
+                 parent: QWidget | None = None):
+        super().__init__(parent)
+        self.setRange(lo, hi)
+        self.setDecimals(decimals)
+        self.setSingleStep(step)
+        self.setKeyboardTracking(False)
+        self.setFocusPolicy(Qt.StrongFocus)
+        self.setAlignment(Qt.AlignRight)
+        if suffix:
+            self.setSuffix(suffix)
+
+    def textFromValue(self, value: float) -> str:
+        places = self.decimals()
+        return f"{value:+.{places}f}" if round(value, places) else f"{0:.{places}f}"
+
+    def wheelEvent(self, event) -> None:
+        if self.hasFocus():
+            super().wheelEvent(event)
+        else:
+            event.ignore()
+
+
+class ResetSlider(QSlider):
+    """A slider that goes back to ``default`` on a double click (as Lightroom's sliders do)."""
+
+    def __init__(self, orientation=Qt.Horizontal, default: int = 0, parent: QWidget | None = None):
+        super().__init__(orientation, parent)
+        self.default = default
+
+    def mouseDoubleClickEvent(self, event) -> None:
+        if event.button() == Qt.LeftButton:
+            self.setValue(self.default)
+            event.accept()
+        else:
+            super().mouseDoubleClickEvent(event)
+
+
 AXIS_COLOURS = ("#e06c6c", "#7fc56b", "#6b9be0")
 
 
@@ -197,6 +249,7 @@ class VectorEdit(QWidget):
         layout.setContentsMargins(0, 0, 0, 0)
         layout.setSpacing(3)
         self.spins = []
+        self.labels: list[ScrubLabel] = []
         for i, text in enumerate(labels):
             spin = IntEdit(int(lo), int(hi)) if integer else NumberEdit(lo, hi, decimals, step)
             spin.setMinimumWidth(48)
@@ -206,9 +259,15 @@ class VectorEdit(QWidget):
             layout.addWidget(label)
             layout.addWidget(spin, 1)
             self.spins.append(spin)
+            self.labels.append(label)
 
     def value(self) -> tuple:
         return tuple(s.value() for s in self.spins)
+
+    def set_scrub_rate(self, rate: Callable[[], float] | None) -> None:
+        """Scrub every number at ``rate()`` per pixel of drag (None: a step per few pixels)."""
+        for label in self.labels:
+            label.rate = rate
 
     def set_value(self, values) -> None:
         for spin, v in zip(self.spins, values):
@@ -314,5 +373,5 @@ def slider_to_log(position: int, lo: float, hi: float, steps: int = 1000) -> flo
     return math.exp(math.log(lo) + position / steps * (math.log(hi) - math.log(lo)))
 
 
-__all__ = ["Section", "ScrubLabel", "NumberEdit", "IntEdit", "VectorEdit", "ColorEdit", "ColorSwatch", "hint",
-           "readout", "log_to_slider", "slider_to_log", "DIM_TEXT"]
+__all__ = ["Section", "ScrubLabel", "NumberEdit", "IntEdit", "SignedNumberEdit", "ResetSlider", "VectorEdit",
+           "ColorEdit", "ColorSwatch", "hint", "readout", "log_to_slider", "slider_to_log", "DIM_TEXT"]

@@ -5,9 +5,14 @@ camera, render settings) through a queue; the worker applies only the latest of 
 goes on rendering in bounded dispatches (``RenderSession.step``), publishing the image several times a second.
 Edits are therefore seen within one dispatch (about a sixtieth of a second) however long a render has run.
 
-After each restart the worker first renders one pass at a quarter of the resolution (a preview that appears
-within a fraction of a second), then the full resolution, whose first pass fills in over the preview tile by
-tile. Each frame's picture is tone-mapped to 8 bits on the GPU with the viewport's exposure and tone curve
+The viewport's image is the widget's size (times a resolution scale), framed by ``ThinLensCamera.view_frame``:
+the export's frame (the sensor's gate) with some of the scene around it. After each restart the worker first
+renders one pass at a quarter of the resolution (a preview, enlarged smoothly), then the full resolution, whose
+first pass fills in over the preview tile by tile. The picture on screen is never thrown away for a worse one:
+after an edit the previous picture stays up until the new render has as many samples (up to HOLD_SPP), or for
+at most HOLD_SECONDS, so a drag still shows the newest state several times a second. Pixels not rendered yet
+(a first pass under way, or outside a render region) show the last picture. With the denoiser on, the pictures
+are Intel Open Image Denoise's, from the beauty and the first-hit albedo and normal the tracer accumulates. Each frame's picture is tone-mapped to 8 bits on the GPU with the viewport's exposure and tone curve
 (``RenderSession.display``), so neither thread does per-pixel work on the CPU; the linear image, for the
 viewport's pixel readout, comes along a few times a second. Once per change of view it casts one ray per pixel through the same kd-tree to find the node and the depth
 under every pixel: the viewport outlines the selection with the first and shows the plane of focus with the
@@ -33,6 +38,7 @@ import numpy as np
 from PySide6.QtCore import QThread, Signal
 
 from lenslab.messages import one_line
+from lenslab.render.film import resolve, to_8bit, tone_map
 
 PREVIEW_DIVISOR = 4  # the preview pass renders at 1/4 of the width and height
 PREVIEW_MIN_PIXELS = 256 * 256  # images smaller than this skip the preview pass
@@ -41,6 +47,14 @@ PREVIEW_MIN_PIXELS = 256 * 256  # images smaller than this skip the preview pass
 VIEWPORT_DISPATCH_SECONDS = 1 / 60
 FRAME_INTERVAL = 0.25  # seconds between published frames while a pass is in progress
 LINEAR_INTERVAL = 0.5  # seconds between linear images (the pixel readout's) while the render goes on
+# After an edit the previous picture stays up until the new render has this many samples per pixel (or as many
+# as the previous picture had, if fewer), or until HOLD_SECONDS have passed since the first edit it does not show.
+HOLD_SPP = 4
+HOLD_SECONDS = 0.15
+# The denoiser runs at most every DENOISE_MIN_INTERVAL seconds, and never more than a third of the time: it waits
+# twice as long as it took the last time before it runs again.
+DENOISE_MIN_INTERVAL = 0.25
+GBUFFER_INTERVAL = 0.3  # during a drag, the selection's outline and the depth buffer follow this often
 EXPORT_PROGRESS_INTERVAL = 0.1
 
 
@@ -58,6 +72,9 @@ class Frame:
     generation: int
     preview: bool  # only the quarter-resolution preview so far
     converged: bool  # reached the target sample count
+    gate: tuple[float, float, float, float] | None = None  # the export's frame in the picture: x, y, w, h pixels
+    region: tuple[int, int, int, int] | None = None  # the render region being refined, pixels
+    denoised: bool = False  # the picture (and linear image) are the denoiser's
 
 
 @dataclass(frozen=True)
@@ -87,6 +104,7 @@ class ExportRequest:
     seconds: float | None = None  # ... or after this long (whichever comes first when both are given)
     exposure_stops: float = 0.0
     tone_map: str = "clamp"
+    denoise: bool = False  # write the denoised image (and, in an EXR, the noisy one and the guides as layers)
 
 
 @dataclass(frozen=True)
@@ -101,6 +119,7 @@ class SceneEdit:
     scene: object  # a Scene copy
     size: tuple[int, int]  # the viewport image, pixels
     generation: int
+    margin: float | None = None  # framing: None, the export's; else ThinLensCamera.view_frame with this margin
 
 
 @dataclass(frozen=True)
@@ -109,6 +128,7 @@ class CameraEdit:
     size: tuple[int, int]
     generation: int
     view_changed: bool  # what the camera sees moved (not only its aperture or focus): refresh the g-buffer
+    margin: float | None = None  # as SceneEdit's
 
 
 @dataclass(frozen=True)
@@ -121,6 +141,17 @@ class SettingsEdit:
 class DisplayEdit:
     exposure: float  # stops
     tone_map: str  # one of lenslab.render.film.TONE_MAPS
+
+
+@dataclass(frozen=True)
+class RegionEdit:
+    region: tuple[int, int, int, int] | None  # x, y, width, height in viewport pixels; None: the whole picture
+    generation: int
+
+
+@dataclass(frozen=True)
+class DenoiseEdit:
+    on: bool
 
 
 @dataclass(frozen=True)
@@ -160,11 +191,25 @@ def preview_size(width: int, height: int) -> tuple[int, int]:
     return max(1, math.ceil(width / PREVIEW_DIVISOR)), max(1, math.ceil(height / PREVIEW_DIVISOR))
 
 
-def upscale_nearest(image: np.ndarray, width: int, height: int) -> np.ndarray:
+def upscale_smooth(image: np.ndarray, width: int, height: int) -> np.ndarray:
+    """``image`` (h, w, c) enlarged to (height, width, c) by bilinear interpolation between pixel centres (the
+    preview pass seen as a soft picture, not as blocks); uint8 in, uint8 out."""
     h, w = image.shape[:2]
-    rows = np.minimum((np.arange(height) * h) // height, h - 1)
-    cols = np.minimum((np.arange(width) * w) // width, w - 1)
-    return image[rows][:, cols]
+    ys = np.clip((np.arange(height) + 0.5) * h / height - 0.5, 0, h - 1)
+    xs = np.clip((np.arange(width) + 0.5) * w / width - 0.5, 0, w - 1)
+    y0, x0 = np.floor(ys).astype(int), np.floor(xs).astype(int)
+    y1, x1 = np.minimum(y0 + 1, h - 1), np.minimum(x0 + 1, w - 1)
+    fy, fx = (ys - y0)[:, None, None], (xs - x0)[None, :, None]
+    src = image.astype(np.float32)
+    top = src[y0][:, x0] * (1 - fx) + src[y0][:, x1] * fx
+    bottom = src[y1][:, x0] * (1 - fx) + src[y1][:, x1] * fx
+    out = top * (1 - fy) + bottom * fy
+    return np.clip(np.rint(out), 0, 255).astype(np.uint8) if image.dtype == np.uint8 else out.astype(image.dtype)
+
+
+def opaque(rgb8: np.ndarray) -> np.ndarray:
+    """RGBA8 with alpha 255 from RGB8."""
+    return np.concatenate([rgb8, np.full(rgb8.shape[:2] + (1,), 255, np.uint8)], axis=2)
 
 
 class RenderWorker(QThread):
@@ -208,17 +253,37 @@ class RenderWorker(QThread):
         self._last_linear = 0.0
         self._gbuffer_due = False
         self._gbuffer_size: tuple[int, int] | None = None
+        self._gbuffer_time = 0.0
+        self._margin: float | None = None
+        self._region: tuple[int, int, int, int] | None = None
+        self._denoise = False
+        self._denoiser = None  # lenslab.render.denoise's, made on first use
+        self._denoised: tuple | None = None  # (generation, spp, picture, linear): the last denoised frame
+        self._denoise_ready_at = 0.0
+        # Never blank: the last picture shown at the viewport's size fills what the new render has not reached.
+        self._backdrop: np.ndarray | None = None  # RGBA8
+        self._backdrop_linear: np.ndarray | None = None
+        self._stale_since: float | None = None  # when the picture on screen stopped showing the latest edit
+        self._shown_quality = -1  # its samples per pixel; -1 for a preview
         self._restart_time = 0.0
         self._last_publish = 0.0
         self._published_spp = -1
         self._export = None
 
     # -- the GUI thread's side ---------------------------------------------------------------------------------
-    def set_scene(self, scene, width: int, height: int, generation: int) -> None:
-        self._queue.put(SceneEdit(scene, (int(width), int(height)), generation))
+    def set_scene(self, scene, width: int, height: int, generation: int, margin: float | None = None) -> None:
+        self._queue.put(SceneEdit(scene, (int(width), int(height)), generation, margin))
 
-    def set_camera(self, camera, width: int, height: int, generation: int, view_changed: bool = True) -> None:
-        self._queue.put(CameraEdit(camera, (int(width), int(height)), generation, view_changed))
+    def set_camera(self, camera, width: int, height: int, generation: int, view_changed: bool = True,
+                   margin: float | None = None) -> None:
+        self._queue.put(CameraEdit(camera, (int(width), int(height)), generation, view_changed, margin))
+
+    def set_region(self, region: tuple[int, int, int, int] | None, generation: int) -> None:
+        """Refine only this rectangle of the viewport's picture (pixels), or the whole picture again (None)."""
+        self._queue.put(RegionEdit(None if region is None else tuple(int(v) for v in region), generation))
+
+    def set_denoise(self, on: bool) -> None:
+        self._queue.put(DenoiseEdit(bool(on)))
 
     def set_settings(self, settings, generation: int) -> None:
         self._queue.put(SettingsEdit(settings, generation))
@@ -308,6 +373,8 @@ class RenderWorker(QThread):
         camera_edit: CameraEdit | None = None
         settings_edit: SettingsEdit | None = None
         display_edit: DisplayEdit | None = None
+        region_edit: RegionEdit | None = None
+        denoise_edit: DenoiseEdit | None = None
         holding = False  # the viewport is about to stop making frames by itself
         for message in messages:
             if isinstance(message, Stop):
@@ -323,6 +390,10 @@ class RenderWorker(QThread):
                 settings_edit = message
             elif isinstance(message, DisplayEdit):
                 display_edit = message
+            elif isinstance(message, RegionEdit):
+                region_edit = message
+            elif isinstance(message, DenoiseEdit):
+                denoise_edit = message
             elif isinstance(message, Pause):
                 holding = holding or (message.paused and not self._paused)
                 self._paused = message.paused
@@ -340,6 +411,10 @@ class RenderWorker(QThread):
             self._apply_settings(settings_edit)
         if display_edit is not None:
             self._apply_display(display_edit)
+        if denoise_edit is not None:
+            self._apply_denoise(denoise_edit)
+        if region_edit is not None:
+            self._apply_region(region_edit)
         for message in messages:
             if isinstance(message, PickRequest):
                 self._pick(message)
@@ -361,8 +436,12 @@ class RenderWorker(QThread):
             if self._session is None:
                 self._session = RenderSession(self._renderer, scene, width=size[0], height=size[1],
                                               dispatch_seconds=self.dispatch_seconds)
+                # The viewport always gathers the denoiser's albedo and normal, so that turning it on or off
+                # shows at once, without a restart.
+                self._session.set_feature_buffers(True)
             else:
                 self._session.set_scene(scene, width=size[0], height=size[1])
+            self._session.set_view(*size, edit.margin)
         except Exception as exc:  # SceneError, SceneTooLarge, a camera ValueError, a mesh that fails to load
             self._scene_ok = False
             self._phase = "error"
@@ -370,7 +449,7 @@ class RenderWorker(QThread):
             self.scene_failed.emit(generation, _one_line(exc))
             return
         self._scene_ok = self._camera_ok = True
-        self._size = size
+        self._set_size(size, edit.margin)
         self._restart(generation, view_changed=True)
 
     def _apply_camera(self, edit: CameraEdit) -> None:
@@ -389,7 +468,7 @@ class RenderWorker(QThread):
         if not self._scene_ok:
             self._generation = generation
             return
-        self._size = edit.size
+        self._set_size(edit.size, edit.margin)
         self._restart(generation, view_changed=edit.view_changed or edit.size != self._gbuffer_size)
 
     def _apply_settings(self, edit: SettingsEdit) -> None:
@@ -398,6 +477,22 @@ class RenderWorker(QThread):
         self._session.set_settings(edit.settings)
         if self._scene_ok and self._camera_ok:
             self._restart(edit.generation, view_changed=False)
+
+    def _set_size(self, size: tuple[int, int], margin: float | None) -> None:
+        if size != self._size or margin != self._margin:
+            self._region = None  # its pixels were another picture's
+        self._size, self._margin = size, margin
+
+    def _apply_region(self, edit: RegionEdit) -> None:
+        self._region = edit.region
+        if self._session is not None and self._scene_ok and self._camera_ok:
+            self._restart(edit.generation, view_changed=False)
+
+    def _apply_denoise(self, edit: DenoiseEdit) -> None:
+        if edit.on != self._denoise:
+            self._denoise = edit.on
+            self._denoised = None
+            self._republish(with_linear=True)
 
     def _apply_display(self, edit: DisplayEdit) -> None:
         self._display_settings = (edit.exposure, edit.tone_map)
@@ -410,12 +505,12 @@ class RenderWorker(QThread):
                 and self._published_spp >= 0:
             self._publish_session(converged=self._phase == "done", with_linear=with_linear)
 
-    def _resize(self, width: int, height: int) -> None:
-        # RenderSession keeps the scene on the GPU; a new size only needs a new accumulation buffer, which
-        # reset() allocates when width * height changed.
-        session = self._session
-        session.width, session.height = int(width), int(height)
-        session.reset()
+    def _resize(self, width: int, height: int, region=None) -> None:
+        # RenderSession keeps the scene on the GPU; a new size needs the camera framed again for it and a new
+        # accumulation buffer (set_view does both).
+        self._session.set_view(width, height, self._margin)
+        if region is not None:
+            self._session.set_region(region)
 
     def _restart(self, generation: int, view_changed: bool) -> None:
         self._generation = generation
@@ -424,12 +519,14 @@ class RenderWorker(QThread):
         self._last_linear = 0.0
         self._published_spp = -1
         self._restart_time = time.perf_counter()
+        if self._stale_since is None:
+            self._stale_since = self._restart_time
         w, h = self._size
-        if w * h >= PREVIEW_MIN_PIXELS:
+        if self._region is None and w * h >= PREVIEW_MIN_PIXELS:
             self._resize(*preview_size(w, h))
             self._phase = "preview"
         else:
-            self._resize(w, h)
+            self._resize(w, h, self._region)
             self._phase = "full"
         if view_changed:
             self._gbuffer_due = True
@@ -441,15 +538,17 @@ class RenderWorker(QThread):
         if self._phase == "preview":
             session.step(self.dispatch_seconds / 2, target_spp=1)
             if session.samples_per_pixel >= 1:
-                self._preview_image = session.image()
+                image = session.image()
+                if self._denoise:
+                    image = self._denoise_image(image, *session.features_image())
+                self._preview_image = image
                 w, h = self._size
-                self._publish(self._preview_picture(), upscale_nearest(self._preview_image, w, h), preview=True)
+                self._offer(self._preview_picture(), upscale_smooth(image, w, h), preview=True)
                 self._resize(w, h)
                 self._phase = "full"
+                self._gbuffer_if_due()  # during a drag every edit restarts here: the outline must keep up
             return
-        if self._gbuffer_due and self._queue.empty():
-            self._gbuffer_due = False
-            self._compute_gbuffer()
+        if self._gbuffer_if_due():
             return
         target = self._target_spp
         progress = session.step(self.dispatch_seconds, target)
@@ -460,16 +559,24 @@ class RenderWorker(QThread):
         if done:
             self._phase = "done"
 
+    def _gbuffer_if_due(self) -> bool:
+        """Remake the depth and selection buffer if the view moved: between edits, or every GBUFFER_INTERVAL
+        while they keep coming (a drag), so that the selection's outline follows a lens change."""
+        if not self._gbuffer_due:
+            return False
+        if not self._queue.empty() and time.perf_counter() - self._gbuffer_time < GBUFFER_INTERVAL:
+            return False
+        self._gbuffer_due = False
+        self._compute_gbuffer()
+        return True
+
     def _preview_picture(self) -> np.ndarray:
         """The preview pass tone-mapped at its own quarter size, then enlarged: RGBA8 at the viewport's size."""
-        from lenslab.render.film import to_8bit, tone_map
-
         look = self._display_look()
         if self._preview_display is None or self._preview_display[0] != look:
             rgb = to_8bit(tone_map(self._preview_image, *look))
-            rgba = np.concatenate([rgb, np.full(rgb.shape[:2] + (1,), 255, np.uint8)], axis=2)
             w, h = self._size
-            self._preview_display = (look, upscale_nearest(rgba, w, h))
+            self._preview_display = (look, opaque(upscale_smooth(rgb, w, h)))
         return self._preview_display[1]
 
     def _display_look(self) -> tuple[float, str]:
@@ -481,36 +588,107 @@ class RenderWorker(QThread):
         return exposure + math.log2(scale), tone
 
     def _publish_session(self, converged: bool, with_linear: bool = False) -> None:
-        from lenslab.render.film import resolve
-
         session = self._session
+        now = time.perf_counter()
+        if self._denoise and session.samples_per_pixel >= 1:
+            picture, image = self._denoised_frame(converged)
+            self._offer(picture, image, preview=False, converged=converged, denoised=True)
+            return
         picture = session.display(*self._display_look())
-        empty = picture[..., 3] == 0  # pixels the first full pass has not reached yet
+        empty = picture[..., 3] == 0  # pixels without a sample: a first pass under way, or outside the region
         has_empty = bool(empty.any())
-        if has_empty and self._preview_image is not None:
-            picture[empty] = self._preview_picture()[empty]
+        fill, fill_linear = self._fill_pictures()
+        if has_empty and fill is not None:
+            picture[empty] = fill[empty]
         elif has_empty:
             picture[empty, 3] = 255  # black
         image = None
-        now = time.perf_counter()
         if with_linear or converged or self._paused or not self._busy() or now - self._last_linear >= LINEAR_INTERVAL:
-            accumulation = session.accumulation()
-            image = resolve(accumulation)
-            if has_empty and self._preview_image is not None:
-                w, h = self._size
-                image[empty] = upscale_nearest(self._preview_image, w, h)[empty]
+            image = resolve(session.accumulation())
+            if has_empty and fill_linear is not None:
+                image[empty] = fill_linear[empty]
             self._last_linear = now
-        self._publish(picture, image, preview=False, converged=converged)
+        self._offer(picture, image, preview=False, converged=converged)
 
-    def _publish(self, picture: np.ndarray, image: np.ndarray | None, preview: bool, converged: bool = False) -> None:
+    def _fill_pictures(self) -> tuple[np.ndarray | None, np.ndarray | None]:
+        """What shows where the render has no sample yet: this edit's preview, else the last picture shown."""
+        w, h = self._size
+        if self._preview_image is not None:
+            return self._preview_picture(), upscale_smooth(self._preview_image, w, h)
+        if self._backdrop is not None and self._backdrop.shape[:2] == (h, w):
+            linear = self._backdrop_linear
+            return self._backdrop, linear if linear is not None and linear.shape[:2] == (h, w) else None
+        return None, None
+
+    # -- the denoiser ------------------------------------------------------------------------------------------
+    def _denoise_image(self, image: np.ndarray, albedo: np.ndarray, normal: np.ndarray) -> np.ndarray:
+        from lenslab.render.denoise import denoise
+
+        # OIDN's "fast" quality is the one its documentation gives interactive previews: about half the time of
+        # "high" on the CPU. Exports that ask for the denoiser take "high" (render/job.py).
+        return denoise(image, albedo, normal, quality="fast")
+
+    def _denoised_frame(self, converged: bool) -> tuple[np.ndarray, np.ndarray]:
+        """The picture and linear image through the denoiser: the render region's pixels over the last picture,
+        or the whole image. The denoiser is not cheap (a CPU network): between runs the last result of this
+        edit is shown again (see DENOISE_MIN_INTERVAL)."""
+        session = self._session
+        spp = session.samples_per_pixel
+        cached = self._denoised
+        now = time.perf_counter()
+        if cached is not None and cached[0] == self._generation and cached[3] == self._display_look() \
+                and (cached[1] == spp or (not converged and now < self._denoise_ready_at)):
+            return cached[2], cached[4]
+        start = time.perf_counter()
+        image = session.image()
+        albedo, normal = session.features_image()
+        x, y, w, h = session.region_pixels
+        crop = self._denoise_image(image[y:y + h, x:x + w], albedo[y:y + h, x:x + w], normal[y:y + h, x:x + w])
+        _fill, fill_linear = self._fill_pictures()
+        if session.region is not None and fill_linear is not None:
+            image = fill_linear.copy()
+        image[y:y + h, x:x + w] = crop
+        look = self._display_look()
+        picture = session.display_image(image, *look)  # tone-mapped on the GPU, as the raw pictures are
+        cost = time.perf_counter() - start
+        self._denoise_ready_at = time.perf_counter() + max(DENOISE_MIN_INTERVAL, 2.0 * cost)
+        self._denoised = (self._generation, spp, picture, look, image)
+        return picture, image
+
+    # -- what the viewport shows -------------------------------------------------------------------------------
+    def _offer(self, picture: np.ndarray, image: np.ndarray | None, preview: bool, converged: bool = False,
+               denoised: bool = False) -> None:
+        """Show this picture of the latest edit, unless the one on screen is still the better (HOLD_SPP and
+        HOLD_SECONDS): the viewport never trades a clean picture for a worse one of the same view at once."""
+        quality = -1 if preview else self._session.samples_per_pixel
+        if self._stale_since is not None:
+            on_screen = self._backdrop
+            comparable = on_screen is not None and on_screen.shape[:2] == picture.shape[:2]
+            enough = quality >= min(self._shown_quality, HOLD_SPP)
+            waited = time.perf_counter() - self._stale_since >= HOLD_SECONDS
+            if comparable and not (enough or waited or converged):
+                return
+            self._stale_since = None
+        self._shown_quality = quality
+        self._backdrop = picture
+        if image is not None:
+            self._backdrop_linear = image
+        self._publish(picture, image, preview=preview, converged=converged, denoised=denoised)
+
+    def _publish(self, picture: np.ndarray, image: np.ndarray | None, preview: bool, converged: bool = False,
+                 denoised: bool = False) -> None:
         session = self._session
         progress = session.progress(self._target_spp)
         spp = 0 if preview else session.samples_per_pixel
+        w, h = self._size
+        gx, gy, gw, gh = session.frame.gate_pixels
+        sx, sy = w / session.width, h / session.height  # the preview pass is smaller than the picture
         frame = Frame(display=picture, display_settings=self._display_settings, image=image,
                       width=picture.shape[1], height=picture.shape[0], samples_per_pixel=spp,
                       target_spp=self._target_spp, samples_per_second=progress.samples_per_second,
                       elapsed_seconds=time.perf_counter() - self._restart_time, generation=self._generation,
-                      preview=preview, converged=converged)
+                      preview=preview, converged=converged, gate=(gx * sx, gy * sy, gw * sx, gh * sy),
+                      region=session.region, denoised=denoised)
         self._published_spp = spp
         self._last_publish = time.perf_counter()
         with self._frame_lock:
@@ -530,7 +708,8 @@ class RenderWorker(QThread):
 
         session = self._session
         w, h = self._size
-        frame = session.camera.frame(w, h)
+        frame = session.frame  # the full-size picture's, as the g-buffer is only made between full passes
+        self._gbuffer_time = time.perf_counter()
         origins, directions = frame.rays(frame.pixel_centres())
         hits = cast_rays(self._renderer, session.gpu_scene, origins, directions)
         prim_node = session.flat_scene.prim_node
@@ -566,7 +745,8 @@ class RenderWorker(QThread):
             # An export's dispatches are the headless render's: long enough to keep the device busy, short
             # enough for a cancel to be felt within a tenth of a second.
             job = RenderJob(self._renderer, request.scene, spp=request.target_spp, time_limit=request.seconds,
-                            dispatch_seconds=max(self.dispatch_seconds, DEFAULT_DISPATCH_SECONDS))
+                            dispatch_seconds=max(self.dispatch_seconds, DEFAULT_DISPATCH_SECONDS),
+                            feature_buffers=request.denoise)
         except Exception as exc:
             self.export_failed.emit(start.request_id, _one_line(exc))
             return False
@@ -595,7 +775,7 @@ class RenderWorker(QThread):
         self._export = None
         try:
             path = job.write(export.request.path, exposure_stops=export.request.exposure_stops,
-                             tone_map=export.request.tone_map)
+                             tone_map=export.request.tone_map, denoise=export.request.denoise)
         except Exception as exc:
             self.export_failed.emit(export.request_id, _one_line(exc))
         else:

@@ -15,6 +15,7 @@ from typing import Sequence
 
 import numpy as np
 
+from lenslab.color import luminance
 from lenslab.render.bsp import KdTree, build_kdtree
 from lenslab.render.fresnel import (internal_diffuse_reflectance, rough_internal_reflectance, rough_reflectance_table,
                                     rough_transmittance_table)
@@ -51,11 +52,6 @@ BINDINGS = {"kd_nodes": KD_NODES_BINDING, "prim_refs": PRIM_REFS_BINDING, "geome
             "image_data": IMAGE_DATA_BINDING}
 UNIFORM_BINDINGS = {"light_choice": LIGHT_CHOICE_BINDING}  # uniform blocks (glsl/lights.glsl's LightPlaces)
 MISSING_SKY = (0.2, 0.0, 0.2)  # what a scene whose environment map cannot be read is lit by
-
-
-def _luminance(rgb) -> float:
-    r, g, b = rgb
-    return 0.2126 * r + 0.7152 * g + 0.0722 * b
 
 
 def pack_material(material: Material, textures: TextureTable, inner: Sequence[int] = ()) -> np.ndarray:
@@ -179,7 +175,7 @@ def _emitted_power(flat: FlatScene) -> np.ndarray:
         if not (isinstance(material, Emissive) and material.emits):
             continue
         sides = 2.0 if material.two_sided else 1.0
-        radiance = _luminance(material.radiance) * sides * math.pi
+        radiance = luminance(material.radiance) * sides * math.pi
         tri = np.flatnonzero(flat.triangle_material == index)
         if len(tri):
             t = flat.triangles[tri].astype(np.float64)
@@ -233,7 +229,7 @@ def _spot_light_entry(light: SpotLight, textures: TextureTable) -> _LightEntry:
                       np.float32)
     assert params.size == SPOT_PARAMS
     solid_angle = light.weighted_solid_angle()
-    power = _luminance(light.intensity) * solid_angle * _texture_mean(light.texture)
+    power = luminance(light.intensity) * solid_angle * _texture_mean(light.texture)
     return _LightEntry(LIGHT_SPOT, power, prim=textures.add_floats(params), vector=tuple(light.position),
                        rgb=tuple(light.intensity), falloff=0.25 / solid_angle,
                        w=(math.cos(cutoff), math.cos(beam)))
@@ -243,10 +239,10 @@ def _texture_mean(texture) -> float:
     """The mean luminance of a spot's texture where it is at hand (a checkerboard, pixels in memory); 1 for an
     image file, which the texture table reads."""
     if isinstance(texture, Checkerboard):
-        return 0.5 * (_luminance(texture.color_a) + _luminance(texture.color_b))
+        return 0.5 * (luminance(texture.color_a) + luminance(texture.color_b))
     if isinstance(texture, InlineImageTexture) and texture.pixels is not None:
         pixels = np.asarray(texture.pixels, np.float64)[..., :3]
-        return float(0.2126 * pixels[..., 0].mean() + 0.7152 * pixels[..., 1].mean() + 0.0722 * pixels[..., 2].mean())
+        return float(luminance(pixels.reshape(-1, 3).mean(axis=0)))
     return 1.0
 
 
@@ -277,7 +273,7 @@ def _environment_uniforms(environment: Environment, textures: TextureTable, scen
                 "env_table_size": (1, 1), "env_rows_pole_to_pole": 0}
     if isinstance(environment, ConstantEnvironment):
         uniforms["env_radiance"] = tuple(float(v) for v in environment.radiance)
-        return uniforms, infinite_light_power(4.0 * math.pi * _luminance(environment.radiance), scene_radius)
+        return uniforms, infinite_light_power(4.0 * math.pi * luminance(environment.radiance), scene_radius)
     if isinstance(environment, EnvironmentMap):
         path = Path(environment.file)
         path = path if path.is_absolute() else textures.base_dir / path
@@ -287,7 +283,7 @@ def _environment_uniforms(environment: Environment, textures: TextureTable, scen
             message = str(exc) if os.path.exists(path) else f"{path}: environment map not found"
             textures.warnings.append(f"{message}; lighting with a dim magenta sky instead")
             uniforms["env_radiance"] = MISSING_SKY
-            return uniforms, infinite_light_power(4.0 * math.pi * _luminance(MISSING_SKY), scene_radius)
+            return uniforms, infinite_light_power(4.0 * math.pi * luminance(MISSING_SKY), scene_radius)
         # Without importance sampling (for comparisons) the tables describe a uniform image.
         distribution = EnvironmentDistribution.from_image(rgb if importance else np.ones_like(rgb))
         uniforms.update(
@@ -358,7 +354,7 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
         raise ValueError(f"lights: only one sun per scene (found {', '.join(repr(name) for name in suns)})")
     for light in lights:
         if isinstance(light, PointLight):
-            entries.append(_LightEntry(LIGHT_POINT, 4.0 * math.pi * _luminance(light.intensity),
+            entries.append(_LightEntry(LIGHT_POINT, 4.0 * math.pi * luminance(light.intensity),
                                        vector=light.position, rgb=light.intensity))
         elif isinstance(light, SpotLight):
             entries.append(_spot_light_entry(light, textures))
@@ -367,7 +363,7 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
             sun_uniforms = {"sun_direction": light.unit_direction(), "sun_one_minus_cos": 2 * math.sin(half_angle / 2) ** 2,
                             "sun_radiance": tuple(float(v) for v in light.radiance())}
             # pbrt-v4's DistantLight::Phi: the irradiance falling on a disk of the scene's radius.
-            entries.append(_LightEntry(LIGHT_SUN, math.pi * scene_radius**2 * _luminance(light.irradiance),
+            entries.append(_LightEntry(LIGHT_SUN, math.pi * scene_radius**2 * luminance(light.irradiance),
                                        vector=light.unit_direction(), rgb=light.radiance(), **sun_at_infinity))
     env_uniforms, env_power = _environment_uniforms(environment, textures, scene_radius, environment_importance)
     if env_power > 0:

@@ -15,6 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from lenslab.color import luminance
+
 
 Rotation = float | np.ndarray  # a turn about +Y in radians, or a 3x3 rotation matrix
 
@@ -44,8 +46,6 @@ def uv_to_direction(uv: np.ndarray, rotation: Rotation = 0.0) -> np.ndarray:
     return local @ world_from_map(rotation).T
 
 
-def luminance(rgb: np.ndarray) -> np.ndarray:
-    return rgb[..., 0] * 0.2126 + rgb[..., 1] * 0.7152 + rgb[..., 2] * 0.0722
 
 
 TABLE_MAX_SIZE = (1024, 512)  # cells of the sampling tables: a third of a degree on a side at the horizon

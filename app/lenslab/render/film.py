@@ -9,8 +9,9 @@ half-written.
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Sequence
 
 import numpy as np
 
@@ -40,6 +41,18 @@ def resolve(accumulation: np.ndarray) -> np.ndarray:
     image = np.zeros(accumulation.shape[:-1] + (3,), np.float32)
     np.divide(accumulation[..., :3], weight, out=image, where=weight > 0)
     return image
+
+
+def resolve_features(features: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(albedo, normal), each (H, W, 3) float32, from the denoiser's guide sums (H, W, 2, 4): (albedo sum, sample
+    count) and (normal sum, 0), as glsl/trace.comp accumulates them; pixels with no samples yet are zero."""
+    count = features[:, :, 0, 3:4]
+    albedo = np.zeros(features.shape[:2] + (3,), np.float32)
+    normal = np.zeros_like(albedo)
+    np.divide(features[:, :, 0, :3], count, out=albedo, where=count > 0)
+    np.divide(features[:, :, 1, :3], count, out=normal, where=count > 0)
+    # Means of values in [0, 1] and of unit vectors stay in range but for float rounding: OIDN expects them in it.
+    return np.clip(albedo, 0.0, 1.0), np.clip(normal, -1.0, 1.0)
 
 
 def merge(*accumulations: np.ndarray) -> np.ndarray:
@@ -75,15 +88,27 @@ REC709_CHROMATICITIES = (0.64, 0.33, 0.30, 0.60, 0.15, 0.06, 0.3127, 0.3290)
 MATRIX_ATTRIBUTES = ("worldtocamera", "worldtoNDC")
 
 
+@dataclass(frozen=True)
+class Layer:
+    """An image an EXR carries beside its main RGB, as OpenEXR's layers are named: channel ``name.R`` and so on
+    (how OpenImageIO, Nuke and Blender group channels into layers). A PNG has no room for layers."""
+
+    name: str  # "noisy", "albedo", "normal"
+    pixels: np.ndarray  # (H, W, len(channels)), the main image's size
+    channels: tuple[str, ...] = ("R", "G", "B")  # a normal's are X, Y, Z, as Blender's Normal pass
+    radiance: bool = True  # scaled by the camera's exposure as the main image is (albedo and normal are not)
+
+
 def write_image(path: str | os.PathLike, linear: np.ndarray, metadata: dict[str, object] | None = None,
                 *, sensor_exposure: float = 1.0, exposure_stops: float = 0.0, tone_map_operator: str = "clamp",
-                before_rename: Callable[[], None] | None = None) -> Path:
+                before_rename: Callable[[], None] | None = None, layers: Sequence[Layer] = ()) -> Path:
     """Write ``linear`` (H, W, 3) to an .exr (linear float) or .png (sRGB, tone mapped), whole or not at all.
 
     ``sensor_exposure`` multiplies the radiance first, in both: the camera's physical exposure, part of the
     capture. ``exposure_stops`` and the tone map are the PNG's display look. An EXR carries Rec. 709
-    chromaticities and the camera matrices; a PNG carries Exif (its eXIf chunk: f-number, exposure time, ISO,
-    focal length) and LensLab's own values as text chunks. ``before_rename``: see lenslab.atomic.atomic_path."""
+    chromaticities and the camera matrices, and ``layers`` after its R, G, B (a PNG leaves them out); a PNG
+    carries Exif (its eXIf chunk: f-number, exposure time, ISO, focal length) and LensLab's own values as text
+    chunks. ``before_rename``: see lenslab.atomic.atomic_path."""
     import OpenImageIO as oiio  # imported here: only exporting needs it
 
     path = Path(path)
@@ -96,8 +121,17 @@ def write_image(path: str | os.PathLike, linear: np.ndarray, metadata: dict[str,
     linear = linear[..., :3] * np.float32(sensor_exposure) if sensor_exposure != 1.0 else linear[..., :3]
     metadata = dict(metadata or {})
     if suffix == ".exr":
-        pixels = np.ascontiguousarray(linear, dtype=np.float32)
-        spec = oiio.ImageSpec(width, height, 3, oiio.FLOAT)
+        planes, names = [linear], ["R", "G", "B"]
+        for layer in layers:
+            if layer.pixels.shape != (height, width, len(layer.channels)):
+                raise ValueError(f"layer {layer.name} is {layer.pixels.shape}, not ({height}, {width}, "
+                                 f"{len(layer.channels)})")
+            exposed = layer.radiance and sensor_exposure != 1.0
+            planes.append(layer.pixels * np.float32(sensor_exposure) if exposed else layer.pixels)
+            names += [f"{layer.name}.{channel}" for channel in layer.channels]
+        pixels = np.ascontiguousarray(np.concatenate(planes, axis=2) if layers else linear, dtype=np.float32)
+        spec = oiio.ImageSpec(width, height, len(names), oiio.FLOAT)
+        spec.channelnames = tuple(names)
         spec.attribute("compression", "zip")
         spec.attribute("chromaticities", oiio.TypeDesc("float[8]"), REC709_CHROMATICITIES)
     else:

@@ -89,6 +89,10 @@ LIGHT_CHOICE_BINDING = 0  # a uniform block: uniform-block bindings are numbered
 SPLAT_IMAGE_BINDING = 0
 # display.comp reads the image's sums at ACCUMULATION_BINDING and writes 8-bit display pixels here.
 DISPLAY_BINDING = 8
+# trace.comp's denoiser guides (glsl/feature_buffers.glsl), when a session has feature buffers: FEATURE_ROWS
+# vec4 per pixel, (albedo sum, sample count) and (normal sum, 0).
+FEATURES_BINDING = 9
+FEATURE_ROWS = 2
 # display.comp's tone maps, in the order of lenslab.render.film.TONE_MAPS.
 TONE_MAP_CLAMP = 0
 TONE_MAP_REINHARD = 1

@@ -54,10 +54,13 @@ class JobProgress:
 class RenderJob:
     """Render ``scene`` to ``spp`` samples per pixel, or for ``time_limit`` seconds, or both (whichever comes
     first). With neither, the scene's own sample count. The image is the scene camera's resolution.
-    ``first_sample`` starts the sample indices elsewhere than 0: one part of a render split across workers."""
+    ``first_sample`` starts the sample indices elsewhere than 0: one part of a render split across workers.
+    ``feature_buffers`` accumulates the denoiser's albedo and normal guides beside the image, for
+    ``write(denoise=True)``; the image itself is the same with or without them."""
 
     def __init__(self, renderer: Renderer, scene: Scene, *, spp: int | None = None, time_limit: float | None = None,
-                 dispatch_seconds: float = DEFAULT_DISPATCH_SECONDS, first_sample: int = 0):
+                 dispatch_seconds: float = DEFAULT_DISPATCH_SECONDS, first_sample: int = 0,
+                 feature_buffers: bool = False):
         if spp is not None and spp < 1:
             raise ValueError(f"a render needs at least 1 sample per pixel, not {spp}")
         if time_limit is not None and not time_limit > 0:
@@ -65,7 +68,8 @@ class RenderJob:
         self.scene = scene
         self.target_spp = spp if spp is not None else (None if time_limit else scene.render.spp)
         self.time_limit = time_limit
-        self.session = RenderSession(renderer, scene, dispatch_seconds=dispatch_seconds, first_sample=first_sample)
+        self.session = RenderSession(renderer, scene, dispatch_seconds=dispatch_seconds, first_sample=first_sample,
+                                     feature_buffers=feature_buffers)
         self.overran_time_limit = 0.0  # seconds past the time limit spent finishing the first full pass
         self._start = time.perf_counter()  # the time limit counts sampling, not building and compiling
 
@@ -126,15 +130,44 @@ class RenderJob:
         return image_metadata(self.scene, self.session.samples_per_pixel, self.session.frame)
 
     def write(self, path: str | os.PathLike, *, exposure_stops: float = 0.0, tone_map: str = "clamp",
-              before_rename: Callable[[], None] | None = None) -> Path:
+              before_rename: Callable[[], None] | None = None, denoise: bool = False) -> Path:
         """Write the finished image with its metadata (.exr linear, .png tone mapped), whole or not at all. A
         camera in the physical exposure mode exposes both (docs/architecture.md, "Exposure"). ``before_rename``
-        runs once the file is whole, just before it takes the name (lenslab.atomic.atomic_path)."""
-        from lenslab.render.film import write_image
+        runs once the file is whole, just before it takes the name (lenslab.atomic.atomic_path).
+
+        ``denoise``: the main image is the denoised one (:meth:`denoised`), and the metadata says so; an EXR also
+        keeps the noisy image and the guides as layers ``noisy.RGB``, ``albedo.RGB`` and ``normal.XYZ``. Never
+        without being asked."""
+        from lenslab.render.film import ExportError, write_image
+        from lenslab.render.denoise import DenoiseError
 
         metadata = self.metadata()
-        return write_image(path, self.image(), metadata, sensor_exposure=metadata["lenslab:ExposureScale"],
-                           exposure_stops=exposure_stops, tone_map_operator=tone_map, before_rename=before_rename)
+        if not denoise:
+            image, layers = self.image(), ()
+        else:
+            try:
+                image, layers, metadata["lenslab:Denoiser"] = self.denoised()
+            except DenoiseError as exc:  # before anything is written: the file is not touched
+                raise ExportError(f"{path}: cannot denoise ({exc})") from None
+            metadata["lenslab:Denoised"] = 1
+        return write_image(path, image, metadata, sensor_exposure=metadata["lenslab:ExposureScale"],
+                           exposure_stops=exposure_stops, tone_map_operator=tone_map, before_rename=before_rename,
+                           layers=layers)
+
+    def denoised(self) -> tuple[np.ndarray, tuple, str]:
+        """(the denoised image, the EXR layers to keep beside it, how it was denoised). A final frame: the guides
+        are prefiltered (render/denoise.py); a job without feature buffers is denoised from its colour alone."""
+        from lenslab.render.denoise import denoise, describe
+        from lenslab.render.film import Layer
+
+        noisy = self.image()
+        if not self.session.feature_buffers:
+            return denoise(noisy), (Layer("noisy", noisy),), f"{describe()}; RT filter, no guides"
+        albedo, normal = self.session.features_image()
+        layers = (Layer("noisy", noisy), Layer("albedo", albedo, radiance=False),
+                  Layer("normal", normal, ("X", "Y", "Z"), radiance=False))
+        return (denoise(noisy, albedo, normal, prefilter=True), layers,
+                f"{describe()}; RT filter, first-hit albedo and normal guides, prefiltered")
 
     def release(self) -> None:
         self.session.release()

@@ -25,7 +25,8 @@ from lenslab.optics.aperture import APERTURE_KINDS, Aperture
 from lenslab.render import film, gl
 from lenslab.render.buffers import GpuScene, pack_scene
 from lenslab.render.features import GENERAL, KernelFeatures, scene_features
-from lenslab.render.gpu_layout import (ACCUMULATION_BINDING, APERTURE_TABLE_UNIT, DISPLAY_BINDING, SHADING_ROWS,
+from lenslab.render.gpu_layout import (ACCUMULATION_BINDING, APERTURE_TABLE_UNIT, DISPLAY_BINDING, FEATURE_ROWS,
+                                      FEATURES_BINDING, SHADING_ROWS,
                                       SPLAT_IMAGE_BINDING, TONE_MAP_CLAMP, TONE_MAP_FILMIC, TONE_MAP_REINHARD)
 from lenslab.limits import SceneTooLarge, available_memory_bytes, format_bytes
 from lenslab.render.sobol import glsl_array_literal
@@ -51,6 +52,14 @@ SAMPLE_INDEX_LIMIT = 1 << 32  # the kernel's sample index is a 32-bit unsigned i
 # memory too; 39 for an EXR), rounded up.
 ACCUMULATION_BYTES_PER_PIXEL = 16
 HOST_BYTES_PER_PIXEL = 96
+# With the denoiser's feature buffers, their sums take FEATURE_BYTES_PER_PIXEL in a storage buffer of their own
+# (the largest one then), and reading them back, denoising and writing an EXR with its extra layers takes
+# HOST_FEATURE_BYTES_PER_PIXEL more of the machine's memory at the peak (an estimate: the read-back, albedo,
+# normal, the denoised copy and twelve float channels to write; rounded up).
+FEATURE_BYTES_PER_PIXEL = 16 * FEATURE_ROWS
+HOST_FEATURE_BYTES_PER_PIXEL = 192
+# The storage buffers the trace kernel binds: the scene's six, image data, the accumulation, and the features.
+TRACE_STORAGE_BLOCKS_WITH_FEATURES = 9
 #: A triangle's bytes in the largest of the scene's storage buffers (buffers.py's shading rows).
 GPU_BYTES_PER_TRIANGLE = SHADING_ROWS * 16
 #: And in this machine's memory while the scene is flattened, packed and its kd-tree built: the float64 and
@@ -107,9 +116,16 @@ class Renderer:
             elif name not in declared:
                 raise KeyError(f"{shader} declares no uniform {name!r}")
 
-    def trace_program(self, sampler: str, features: KernelFeatures = GENERAL):
+    def trace_program(self, sampler: str, features: KernelFeatures = GENERAL, feature_buffers: bool = False):
+        """The trace kernel for this sampler and these scene features; ``feature_buffers`` compiles in the
+        denoiser's albedo and normal buffers (glsl/feature_buffers.glsl), a variant of its own."""
         defines = {"LOCAL_SIZE_X": LOCAL_SIZE_X, "SOBOL_DIRECTIONS": glsl_array_literal(),
                    **features.defines()}
+        if feature_buffers:
+            if self.limits.max_compute_storage_blocks < TRACE_STORAGE_BLOCKS_WITH_FEATURES:
+                raise RuntimeError(f"this GL device lets a kernel bind {self.limits.max_compute_storage_blocks} storage "
+                                   f"buffers; the denoiser's feature buffers need {TRACE_STORAGE_BLOCKS_WITH_FEATURES}")
+            defines["HAS_FEATURE_BUFFERS"] = 1
         if sampler == "independent":
             defines["SAMPLER_INDEPENDENT"] = 1
         return self.program("trace.comp", **defines)
@@ -140,17 +156,21 @@ def largest_storage_buffer(renderer_name: str, limits: gl.DeviceLimits) -> int:
     return limits.max_storage_block_bytes
 
 
-def check_image_size(width: int, height: int, largest_buffer_bytes: int, memory_bytes: int | None) -> None:
-    """Refuse, in one line, an image whose accumulation buffer the device cannot bind or whose read-back the
-    machine's memory (``memory_bytes`` available, None: unknown) cannot hold, saying the largest image of
-    the same shape that fits."""
+def check_image_size(width: int, height: int, largest_buffer_bytes: int, memory_bytes: int | None,
+                     feature_buffers: bool = False) -> None:
+    """Refuse, in one line, an image whose accumulation buffer (or feature buffer) the device cannot bind or whose
+    read-back the machine's memory (``memory_bytes`` available, None: unknown) cannot hold, saying the largest
+    image of the same shape that fits."""
     pixels = width * height
-    most_pixels = largest_buffer_bytes // ACCUMULATION_BYTES_PER_PIXEL
-    needs = f"needs {ACCUMULATION_BYTES_PER_PIXEL * pixels:,} bytes of accumulation buffer"
+    buffer_bytes, what = ((FEATURE_BYTES_PER_PIXEL, "feature buffer") if feature_buffers
+                          else (ACCUMULATION_BYTES_PER_PIXEL, "accumulation buffer"))
+    host_bytes = HOST_BYTES_PER_PIXEL + (HOST_FEATURE_BYTES_PER_PIXEL if feature_buffers else 0)
+    most_pixels = largest_buffer_bytes // buffer_bytes
+    needs = f"needs {buffer_bytes * pixels:,} bytes of {what}"
     holder, holds = "this device", f"the largest storage buffer it binds is {largest_buffer_bytes:,} bytes"
-    if memory_bytes is not None and memory_bytes // HOST_BYTES_PER_PIXEL < most_pixels:
-        most_pixels = memory_bytes // HOST_BYTES_PER_PIXEL
-        needs = f"needs {format_bytes(HOST_BYTES_PER_PIXEL * pixels)} of memory ({HOST_BYTES_PER_PIXEL} bytes a pixel)"
+    if memory_bytes is not None and memory_bytes // host_bytes < most_pixels:
+        most_pixels = memory_bytes // host_bytes
+        needs = f"needs {format_bytes(host_bytes * pixels)} of memory ({host_bytes} bytes a pixel)"
         holder, holds = "this machine", f"{format_bytes(memory_bytes)} of memory is available"
     if pixels <= most_pixels:
         return
@@ -260,7 +280,8 @@ class RenderSession:
 
     def __init__(self, renderer: Renderer, scene: Scene, *, width: int | None = None, height: int | None = None,
                  settings: RenderSettings | None = None, dispatch_seconds: float = DEFAULT_DISPATCH_SECONDS,
-                 environment_importance: bool = True, specialise: bool = True, first_sample: int = 0):
+                 environment_importance: bool = True, specialise: bool = True, first_sample: int = 0,
+                 feature_buffers: bool = False):
         if not 0 <= first_sample < SAMPLE_INDEX_LIMIT:
             raise ValueError(f"first sample index {first_sample} is out of range [0, {SAMPLE_INDEX_LIMIT})")
         self.renderer = renderer
@@ -275,7 +296,15 @@ class RenderSession:
         self._accumulation = None
         self._splat_samples = None  # one pass of radiance samples, while a gaussian filter is splatted
         self._display_pixels = None  # display.comp's 8-bit picture
+        self._display_source = None  # display_image's linear image, on its way to display.comp
+        # The denoiser's guides: first-hit albedo and normal sums beside the image (set_feature_buffers).
+        self.feature_buffers = bool(feature_buffers)
+        self._features = None
         self._aperture_table = ApertureTable(self.ctx)
+        # How the camera frames the image: None, as the export does (camera.frame); a margin, as the studio's
+        # viewport does, showing the export's frame and some of the scene around it (camera.view_frame).
+        self.view_margin: float | None = None
+        self.region: tuple[int, int, int, int] | None = None  # (x, y, width, height): render only these pixels
         self.set_scene(scene, width=width, height=height, settings=settings)
 
     # -- scene and camera ---------------------------------------------------------------------------------
@@ -295,6 +324,8 @@ class RenderSession:
         self.scene = scene
         self.settings = settings or scene.render
         self.flat_scene = flat_scene
+        if (width, height) != (getattr(self, "width", None), getattr(self, "height", None)):
+            self.region = None  # its pixels were another image's
         packed = pack_scene(self.flat_scene, scene.environment, base_dir=scene.base_dir(), lights=scene.lights,
                             environment_importance=self.environment_importance)
         # What the render survives but the user should hear about: unmapped mesh materials, missing textures.
@@ -312,9 +343,44 @@ class RenderSession:
     def set_camera(self, camera: ThinLensCamera) -> None:
         """A camera-only edit: no re-upload of geometry, just restart accumulation."""
         camera.validate()
-        self.frame = camera.frame(self.width, self.height, base_dir=self.scene.base_dir())
         self.camera = camera
+        self._frame_camera()
         self.reset()
+
+    def _frame_camera(self) -> None:
+        if self.view_margin is None:
+            self.frame = self.camera.frame(self.width, self.height, base_dir=self.scene.base_dir())
+        else:
+            self.frame = self.camera.view_frame(self.width, self.height, self.view_margin,
+                                                base_dir=self.scene.base_dir())
+
+    @in_context
+    def set_view(self, width: int, height: int, margin: float | None = None) -> None:
+        """A new image size, and how the camera frames it (see view_margin); restarts accumulation and drops
+        any render region."""
+        self._check_image_size(int(width), int(height))
+        self.width, self.height = int(width), int(height)
+        self.view_margin = margin
+        self.region = None
+        self._frame_camera()
+        self.reset()
+
+    @in_context
+    def set_region(self, region: tuple[int, int, int, int] | None) -> None:
+        """Render only the pixels of ``region`` (x, y, width, height; clipped to the image) from now on, or the
+        whole image (None). Restarts accumulation: pixels outside the region stay without samples."""
+        if region is not None:
+            x, y, w, h = (int(round(v)) for v in region)
+            x0, y0 = min(max(x, 0), self.width), min(max(y, 0), self.height)
+            x1, y1 = min(max(x + w, 0), self.width), min(max(y + h, 0), self.height)
+            region = (x0, y0, x1 - x0, y1 - y0) if x1 > x0 and y1 > y0 else None
+        self.region = region
+        self.reset()
+
+    @property
+    def region_pixels(self) -> tuple[int, int, int, int]:
+        """The pixels each pass renders: the render region, or the whole image."""
+        return self.region if self.region is not None else (0, 0, self.width, self.height)
 
     @in_context
     def set_settings(self, settings: RenderSettings) -> None:
@@ -328,13 +394,33 @@ class RenderSession:
 
     def _check_image_size(self, width: int, height: int) -> None:
         """Refuse an image this device or machine cannot hold (check_image_size), before allocating for it."""
-        check_image_size(width, height, self.renderer.largest_buffer_bytes, available_memory_bytes())
+        check_image_size(width, height, self.renderer.largest_buffer_bytes, available_memory_bytes(),
+                         self.feature_buffers)
+
+    @in_context
+    def set_feature_buffers(self, on: bool) -> None:
+        """Accumulate the denoiser's guides (first-hit albedo and normal, :meth:`features_image`) beside the image,
+        or stop. The kernel with them is a variant of its own (compiled once, then cached); restarts accumulation.
+        Without them the kernel is exactly the one before (HAS_FEATURE_BUFFERS 0), and the image is the same."""
+        on = bool(on)
+        if on == self.feature_buffers:
+            return
+        previous = self.feature_buffers
+        self.feature_buffers = on
+        try:
+            self._check_image_size(self.width, self.height)
+            self.program = self._trace_program(self.settings.sampler)
+        except Exception:
+            self.feature_buffers = previous
+            raise
+        self.reset()
 
     @property
     def splat_layers(self) -> int:
         """Samples per pixel one pass may take while splatting a gaussian filter; 0: samples are not splatted
-        (a box filter, or a gaussian by filter importance sampling where a pass would not fit in memory)."""
-        if self.settings.pixel_filter != "gaussian":
+        (a box filter, or a gaussian by filter importance sampling where a pass would not fit in memory or only
+        a render region is rendered: splat.comp spreads whole images)."""
+        if self.settings.pixel_filter != "gaussian" or self.region is not None:
             return 0
         layer_bytes = 16 * self.width * self.height
         if layer_bytes > min(SPLAT_MEMORY_BYTES, self.renderer.limits.max_storage_block_bytes):
@@ -352,7 +438,7 @@ class RenderSession:
         return self._gpu_scene.packed.kdtree
 
     def _trace_program(self, sampler: str):
-        return self.renderer.trace_program(sampler, self.features)
+        return self.renderer.trace_program(sampler, self.features, self.feature_buffers)
 
     @in_context
     def reset(self) -> None:
@@ -370,7 +456,14 @@ class RenderSession:
             self._splat_samples = self.ctx.buffer(reserve=16 * pixels * layers)
         elif not layers:
             self._release_splat_samples()
-        if self.settings.pixel_filter == "gaussian" and not layers:
+        if not self.feature_buffers:
+            self._release_features()
+        elif self._features is None or self._features.size != pixels * FEATURE_BYTES_PER_PIXEL:
+            self._release_features()
+            self._features = self.ctx.buffer(reserve=pixels * FEATURE_BYTES_PER_PIXEL)
+        if self._features is not None:
+            self._features.clear()
+        if self.settings.pixel_filter == "gaussian" and not layers and self.region is None:
             warning = (f"a {self.width}x{self.height} image is too large to splat its gaussian pixel filter on this "
                        "device: it is sampled by importance instead (the same image, more noise)")
             if warning not in self.warnings:
@@ -399,7 +492,7 @@ class RenderSession:
 
     def _plan_dispatch(self, target_spp: int | None) -> tuple[int, int]:
         """(pixels, samples) for the next dispatch, aiming at dispatch_seconds of GPU time."""
-        pixels_total = self.width * self.height
+        pixels_total = self.region_pixels[2] * self.region_pixels[3]
         remaining_pixels = pixels_total - self._pixels_done
         if self._seconds_per_pixel_sample is None:
             return min(remaining_pixels, 16384), 1  # a small first dispatch to measure the cost
@@ -423,6 +516,7 @@ class RenderSession:
 
     def _dispatch(self, pixels: int, samples: int) -> None:
         program = self.program
+        program["region"].value = self.region_pixels
         program["tile_start"].value = self._pixels_done
         program["tile_pixels"].value = pixels
         program["sample_start"].value = self.first_sample + self.samples_per_pixel
@@ -438,7 +532,7 @@ class RenderSession:
         previous = self._seconds_per_pixel_sample
         self._seconds_per_pixel_sample = measured if previous is None else 0.5 * (previous + measured)
         self._pixels_done += pixels
-        if self._pixels_done >= self.width * self.height:
+        if self._pixels_done >= self.region_pixels[2] * self.region_pixels[3]:
             if self._splat_samples is not None:
                 self._splat_pass(samples)
             self._pixels_done = 0
@@ -494,6 +588,8 @@ class RenderSession:
         self._aperture_table.bind(self.frame.aperture)
         target = self._splat_samples if self._splat_samples is not None else self._accumulation
         target.bind_to_storage_buffer(ACCUMULATION_BINDING)
+        if self._features is not None:
+            self._features.bind_to_storage_buffer(FEATURES_BINDING)
 
     def done(self, target_spp: int) -> bool:
         return self.samples_per_pixel >= target_spp
@@ -522,18 +618,56 @@ class RenderSession:
     @in_context
     def accumulation(self) -> np.ndarray:
         """(H, W, 4) float32: radiance sums and sample counts; rows top to bottom."""
+        return self._read_accumulation().copy()
+
+    @in_context
+    def _read_accumulation(self) -> np.ndarray:
+        """The accumulation as read back: a read-only view of the bytes, for callers that only read it."""
         data = np.frombuffer(self._accumulation.read(), dtype=np.float32)
-        return data.reshape(self.height, self.width, 4).copy()
+        return data.reshape(self.height, self.width, 4)
 
     def image(self) -> np.ndarray:
         """(H, W, 3) float32 linear radiance: the mean of the samples so far."""
-        return film.resolve(self.accumulation())
+        return film.resolve(self._read_accumulation())
+
+    @in_context
+    def feature_accumulation(self) -> np.ndarray:
+        """(H, W, FEATURE_ROWS, 4) float32: the denoiser's guide sums (albedo and sample count, normal and 0)."""
+        if self._features is None:
+            raise RuntimeError("this render session has no feature buffers (set_feature_buffers(True) first)")
+        data = np.frombuffer(self._features.read(), dtype=np.float32)
+        return data.reshape(self.height, self.width, FEATURE_ROWS, 4)  # read-only: resolve_features copies
+
+    def features_image(self) -> tuple[np.ndarray, np.ndarray]:
+        """(albedo, normal), each (H, W, 3) float32: the mean first-hit albedo in [0, 1] and world-space shading
+        normal in [-1, 1] (not unit length) over each pixel's samples so far (glsl/feature_buffers.glsl);
+        zero where a pixel has none. The guides OIDN takes beside the image (render/denoise.py)."""
+        return film.resolve_features(self.feature_accumulation())
 
     @in_context
     def display(self, exposure_stops: float = 0.0, tone_map: str = "clamp") -> np.ndarray:
         """(H, W, 4) uint8 RGBA: the image as a screen shows it, made on the GPU (display.comp: the steps of
         film.resolve, film.tone_map and film.to_8bit); alpha 0 where a pixel has no sample yet. A quarter of
         the bytes of :meth:`accumulation` cross to the CPU, and no per-pixel work is left for it."""
+        return self._display_from(self._accumulation, exposure_stops, tone_map)
+
+    @in_context
+    def display_image(self, image: np.ndarray, exposure_stops: float = 0.0, tone_map: str = "clamp") -> np.ndarray:
+        """:meth:`display` of another linear image (H, W, 3) of this session's size, such as the denoiser's: it
+        goes up to the GPU once and comes back as RGBA8, instead of being tone-mapped in numpy (at 1920 x 1080,
+        a few milliseconds against a tenth of a second)."""
+        if image.shape[:2] != (self.height, self.width):
+            raise ValueError(f"an image of {image.shape[1]} x {image.shape[0]} pixels is not this session's "
+                             f"{self.width} x {self.height}")
+        rgba = np.ones((self.height, self.width, 4), np.float32)  # weight 1: display.comp's resolve is a no-op
+        rgba[..., :3] = image
+        if self._display_source is None or self._display_source.size != rgba.nbytes:
+            self._release_display_source()
+            self._display_source = self.ctx.buffer(reserve=rgba.nbytes)
+        self._display_source.write(rgba)
+        return self._display_from(self._display_source, exposure_stops, tone_map)
+
+    def _display_from(self, source, exposure_stops: float, tone_map: str) -> np.ndarray:
         film.check_tone_map(tone_map)
         pixels = self.width * self.height
         if self._display_pixels is None or self._display_pixels.size != 4 * pixels:
@@ -543,7 +677,7 @@ class RenderSession:
         program["image_size"].value = (self.width, self.height)
         program["exposure_scale"].value = float(2.0 ** exposure_stops)
         program["tone_map"].value = TONE_MAP_CODES[tone_map]
-        self._accumulation.bind_to_storage_buffer(ACCUMULATION_BINDING)
+        source.bind_to_storage_buffer(ACCUMULATION_BINDING)
         self._display_pixels.bind_to_storage_buffer(DISPLAY_BINDING)
         program.run((self.width + DISPLAY_GROUP_X - 1) // DISPLAY_GROUP_X, self.height, 1)
         self.ctx.memory_barrier()  # the shader's writes must be visible to the read that follows
@@ -555,16 +689,28 @@ class RenderSession:
             self._display_pixels.release()
             self._display_pixels = None
 
+    def _release_display_source(self) -> None:
+        if self._display_source is not None:
+            self._display_source.release()
+            self._display_source = None
+
     def _release_splat_samples(self) -> None:
         if self._splat_samples is not None:
             self._splat_samples.release()
             self._splat_samples = None
 
+    def _release_features(self) -> None:
+        if self._features is not None:
+            self._features.release()
+            self._features = None
+
     @in_context
     def release(self) -> None:
         self._aperture_table.release()
         self._release_splat_samples()
+        self._release_features()
         self._release_display_pixels()
+        self._release_display_source()
         if self._gpu_scene is not None:
             self._gpu_scene.release()
             self._gpu_scene = None

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lenslab.color import srgb_to_linear
+from lenslab.color import luminance, srgb_to_linear
 from lenslab.image_files import read_pixels
 
 
@@ -44,7 +44,7 @@ def _read(path: str, stamp: int) -> np.ndarray:
     if channels in (2, 4):  # alpha is the transmission
         transmission = pixels[..., -1]
     elif channels >= 3:  # luminance (Rec. 709)
-        transmission = pixels[..., :3] @ np.array([0.2126, 0.7152, 0.0722])
+        transmission = luminance(pixels[..., :3])
     else:
         transmission = pixels[..., 0]
     transmission = np.clip(np.nan_to_num(transmission, nan=0.0), 0.0, 1.0)

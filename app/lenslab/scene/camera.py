@@ -15,6 +15,7 @@ selection buffers, the placement of new objects. glsl/camera.glsl mirrors :meth:
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -221,6 +222,22 @@ class ThinLensCamera:
                            barrel_clipping=float(self.barrel_clipping), film_mm=(film_w, film_h),
                            image_distance_mm=v, width=width, height=height)
 
+    def view_frame(self, width: int, height: int, margin: float = 0.0, *,
+                   base_dir: Path | None = None) -> "CameraFrame":
+        """The camera as a viewport of ``width`` x ``height`` pixels shows it: the whole of the export's frame (the
+        camera's resolution, framed as its sensor fit gives) centred, with at least ``margin`` of the frame's size
+        to spare on each side, and more of the scene beyond it wherever the viewport's shape differs from the
+        frame's (as a camera's viewfinder shows past the frame lines). Inside the frame the rays are the export's;
+        the barrel's clipping keeps the export frame's corner as its reference, so cat's-eye bokeh matches."""
+        frame = self.frame(width, height, base_dir=base_dir)
+        export_w, export_h = self.imaged_area_mm(*self.resolution)
+        aspect = width / height
+        film_w = max(export_w, export_h * aspect) * (1.0 + 2.0 * margin)
+        film_h = film_w / aspect
+        v = frame.image_distance_mm
+        return dataclasses.replace(frame, tan_half_fov=(film_w / (2.0 * v), film_h / (2.0 * v)),
+                                   film_mm=(film_w, film_h), gate_mm=(export_w, export_h))
+
 
 @dataclass(frozen=True, eq=False)
 class CameraFrame:
@@ -249,6 +266,18 @@ class CameraFrame:
     image_distance_mm: float  # lens to sensor
     width: int
     height: int
+    # The export's frame (mm of film) where this image shows more than it (a viewport's view_frame); None: the
+    # image is the export's frame.
+    gate_mm: tuple[float, float] | None = None
+
+    @property
+    def gate_pixels(self) -> tuple[float, float, float, float]:
+        """The export's frame in this image: (left, top, width, height) in pixels, centred."""
+        if self.gate_mm is None:
+            return 0.0, 0.0, float(self.width), float(self.height)
+        w = self.width * self.gate_mm[0] / self.film_mm[0]
+        h = self.height * self.gate_mm[1] / self.film_mm[1]
+        return (self.width - w) / 2.0, (self.height - h) / 2.0, w, h
 
     @property
     def forward(self) -> np.ndarray:
@@ -279,7 +308,8 @@ class CameraFrame:
         stop would be)."""
         radius = max(self.aperture.axes)
         half_w, half_h = self.film_mm[0] / 2.0, self.film_mm[1] / 2.0
-        gain = self.barrel_clipping * radius / math.hypot(half_w, half_h)
+        corner_w, corner_h = (self.gate_mm or self.film_mm)[0] / 2.0, (self.gate_mm or self.film_mm)[1] / 2.0
+        gain = self.barrel_clipping * radius / math.hypot(corner_w, corner_h)
         return (gain * half_w, gain * half_h), radius
 
     def view_size_at(self, distance: float) -> tuple[float, float]:

@@ -185,6 +185,30 @@ def focus_distance_for(model: EditableScene, paths: Iterable[tuple], gbuffer=Non
     return round(setting, 4) if setting >= camera.closest_focus_m else None
 
 
+# -- scrubbing ----------------------------------------------------------------------------------------------------
+def screen_drag_rate(model: EditableScene, target: tuple, picture_height_px: float) -> float | None:
+    """How far one pixel of a drag moves the place of ``target`` (a node's translate, in its parent's units; a
+    point or spot light's position) so that it moves on screen about as far as the mouse: the height the picture
+    shows at the thing's depth over the height, in screen pixels, of the picture on screen. A cup on a table and a
+    house across the street both follow the hand, at any focal length and zoom. At or behind the lens, the plane
+    of focus's depth stands in. None for what has no place to move (a sun, a group's fields of another kind)."""
+    frame = model.scene.camera.frame()
+    if target[0] == "node":
+        path = tuple(target[1])
+        parent = world_matrix(model, path[:-1])
+        point = (parent @ np.append(np.asarray(model.node(path).transform.translate, float), 1.0))[:3]
+        parent_scale = abs(float(np.linalg.det(parent[:3, :3]))) ** (1.0 / 3.0)  # a scaled group's units
+    elif target[0] == "light" and hasattr(model.resolve(target), "position"):
+        point, parent_scale = np.asarray(model.resolve(target).position, float), 1.0
+    else:
+        return None
+    depth = frame.depth_of(point)
+    if not depth > 1e-3:
+        depth = frame.focus_distance
+    height = max(float(picture_height_px), 1.0)
+    return frame.view_size_at(depth)[1] / height / max(parent_scale, 1e-9)
+
+
 # -- transforms ---------------------------------------------------------------------------------------------------
 def world_matrix(model: EditableScene, path: tuple) -> np.ndarray:
     """The 4x4 matrix from the node's own space to the world's; the identity for the root (the empty path)."""

@@ -19,6 +19,31 @@ def shipped_scene_names() -> list[str]:
     return sorted(p.name for p in scenes_dir().iterdir() if (p / SCENE_FILE_NAME).is_file())
 
 
+#: Words a scene's name spells in lower case that a title writes otherwise (acronyms).
+TITLE_WORDS = {"dof": "DOF", "hdr": "HDR", "hdri": "HDRI", "ibl": "IBL", "pbr": "PBR", "3d": "3D", "uv": "UV"}
+#: Words a title leaves in lower case unless they begin it.
+SMALL_WORDS = {"a", "an", "and", "at", "by", "for", "in", "of", "on", "or", "the", "to", "with"}
+
+
+def scene_title(name: str) -> str:
+    """A scene's name (its folder's or its file's: ``dof_chart``) as a title: "DOF Chart", "Marbles on Sand".
+    The native format holds no title of its own, so the name is all there is; a word its author capitalised
+    stays as written."""
+    words = name.replace("_", " ").replace("-", " ").split()
+    out = []
+    for i, word in enumerate(words):
+        low = word.lower()
+        if low in TITLE_WORDS:
+            out.append(TITLE_WORDS[low])
+        elif word != low:
+            out.append(word)
+        elif i and low in SMALL_WORDS:
+            out.append(low)
+        else:
+            out.append(word[:1].upper() + word[1:])
+    return " ".join(out)
+
+
 def resolve_scene_path(text: str | os.PathLike) -> Path:
     path = Path(text)
     if os.path.isfile(path / SCENE_FILE_NAME):

@@ -1,0 +1,185 @@
+"""Denoising with Intel Open Image Denoise (OIDN), through PyPI ``pyoidn``, whose wheels carry the library.
+
+:func:`denoise` takes linear HDR radiance (H, W, 3) and, when given, the first-hit albedo and shading normal the
+tracer accumulates beside it (``RenderSession(feature_buffers=True)``, glsl/feature_buffers.glsl), and runs
+OIDN's "RT" filter on them. Two ways, as OIDN's documentation advises:
+
+* **preview** (``prefilter=False``): the guides as they are. They come from the same few samples as the image and
+  are noisy too, so ``cleanAux`` stays off: OIDN then tolerates their noise. For the studio's viewport.
+* **final frame** (``prefilter=True``): the albedo and normal are denoised first, each by a filter of its own,
+  and the image then with ``cleanAux`` on: sharper textures and edges, about three times the work. For exports.
+
+Making an OIDN device loads its library and kernels, so one device serves every call, and the filters and
+buffers of the last image size and options are kept: the viewport, which denoises the same size again and
+again, only copies pixels in and out and runs the network. Calls are serialised (one lock).
+
+The device is OIDN's default: a GPU that OIDN supports and whose driver it finds (CUDA, HIP, SYCL), else the
+CPU. ``LENSLAB_DENOISE_DEVICE`` (cpu, cuda, hip, sycl, metal) forces one.
+"""
+
+from __future__ import annotations
+
+import atexit
+import os
+import threading
+
+import numpy as np
+
+from lenslab.messages import one_line
+
+QUALITIES = ("high", "balanced", "fast")  # OIDN's filter qualities: balanced and fast trade quality for speed
+DEVICE_ENV = "LENSLAB_DENOISE_DEVICE"
+_DEVICE_TYPES = {"default": 0, "cpu": 1, "sycl": 2, "cuda": 3, "hip": 4, "metal": 5}  # OIDNDeviceType
+_DEVICE_NAMES = {value: name.upper() for name, value in _DEVICE_TYPES.items()}
+_FLOAT3 = 3  # OIDN_FORMAT_FLOAT3
+
+
+class DenoiseError(RuntimeError):
+    """Denoising cannot run here (no pyoidn, no device) or OIDN reported a failure: a one-line reason."""
+
+
+def denoise(color: np.ndarray, albedo: np.ndarray | None = None, normal: np.ndarray | None = None, *,
+            prefilter: bool = False, quality: str = "high") -> np.ndarray:
+    """The denoised image, (H, W, 3) float32 linear radiance, from ``color`` (H, W, 3) linear radiance and the
+    optional guides: ``albedo`` in [0, 1] and ``normal`` in [-1, 1] (world or view space, any length), each
+    (H, W, 3). A normal needs an albedo (OIDN has no filter for a normal alone). ``prefilter``: denoise the
+    guides first and trust them (OIDN's cleanAux), for final frames. Raises ValueError for input it cannot take
+    and DenoiseError where denoising cannot run."""
+    if quality not in QUALITIES:
+        raise ValueError(f"unknown denoise quality '{quality}' (choose from {', '.join(QUALITIES)})")
+    images = _checked_images(color, albedo, normal)
+    with _LOCK:
+        return _shared_denoiser().run(images, prefilter, quality)
+
+
+def describe() -> str:
+    """The library and the device that denoises, e.g. "Intel Open Image Denoise 2.5.1 on CPU (2 threads)"."""
+    with _LOCK:
+        return _shared_denoiser().description
+
+
+def _checked_images(color, albedo, normal) -> dict[str, np.ndarray]:
+    if normal is not None and albedo is None:
+        raise ValueError("a normal guide needs an albedo guide beside it (OIDN denoises with color, color + albedo "
+                         "or color + albedo + normal)")
+    images = {}
+    for name, image in (("color", color), ("albedo", albedo), ("normal", normal)):
+        if image is None:
+            continue
+        image = np.asarray(image)
+        if image.ndim != 3 or image.shape[2] != 3 or 0 in image.shape:
+            raise ValueError(f"the {name} image to denoise must be (height, width, 3), not {image.shape}")
+        if image.shape != np.shape(color):
+            raise ValueError(f"the {name} image is {image.shape[1]}x{image.shape[0]}, the color image "
+                             f"{np.shape(color)[1]}x{np.shape(color)[0]}: they must be the same size")
+        images[name] = np.ascontiguousarray(image, dtype=np.float32)
+    if not np.isfinite(images["color"]).all():  # OIDN would spread a NaN over its neighbourhood
+        raise ValueError("the color image to denoise has NaN or infinite pixels")
+    return images
+
+
+class _Denoiser:
+    """One OIDN device, and the filters and buffers for the last image size and options."""
+
+    def __init__(self, device_kind: str):
+        try:
+            import pyoidn
+        except ImportError as exc:  # pyoidn is a dependency; a broken install says so in one line
+            raise DenoiseError(f"denoising needs Intel Open Image Denoise: pip install pyoidn ({exc})") from None
+        if device_kind not in _DEVICE_TYPES:
+            raise DenoiseError(f"{DEVICE_ENV}={device_kind}: choose one of {', '.join(_DEVICE_TYPES)}")
+        self.pyoidn = pyoidn
+        self.device = pyoidn.Device(_DEVICE_TYPES[device_kind])
+        self._check(f"making a {device_kind} device")
+        self.device.commit()
+        self._check(f"starting the {device_kind} device")
+        kind = _DEVICE_NAMES.get(self.device.get_int("type"), "unknown device")
+        version = self.device.get_int("version")  # e.g. 20501
+        threads = f" ({self.device.get_int('numThreads')} threads)" if kind == "CPU" else ""
+        self.description = (f"Intel Open Image Denoise {version // 10000}.{version // 100 % 100}.{version % 100} "
+                            f"on {kind}{threads}")
+        self._key = None
+        self._buffers: dict[str, object] = {}
+        self._filters: list = []  # run in this order: the guides' prefilters, then the image's
+
+    def _check(self, doing: str) -> None:
+        message = self.device.get_error()
+        if message:
+            raise DenoiseError(one_line(f"Open Image Denoise failed {doing}: {message}"))
+
+    def run(self, images: dict[str, np.ndarray], prefilter: bool, quality: str) -> np.ndarray:
+        height, width = images["color"].shape[:2]
+        key = (tuple(images), width, height, prefilter, quality)
+        if key != self._key:
+            self._configure(tuple(images), width, height, prefilter, quality)
+            self._key = key
+        size = width * height * 12
+        for name, pixels in images.items():
+            self._buffers[name].write(0, size, pixels)
+        for flt in self._filters:
+            flt.execute()
+            self._check("denoising")
+        output = np.empty((height, width, 3), np.float32)
+        self._buffers["output"].read(0, size, output)
+        return output
+
+    def _configure(self, names: tuple[str, ...], width: int, height: int, prefilter: bool, quality: str) -> None:
+        self._release_filters()
+        self._key = None
+        oidn = self.pyoidn
+        for name in (*names, "output"):
+            self._buffers[name] = oidn.Buffer(self.device, width * height * 12)
+            self._check(f"allocating a {width}x{height} {name} image")
+        level = {"high": oidn.OIDN_QUALITY_HIGH, "balanced": oidn.OIDN_QUALITY_BALANCED,
+                 "fast": oidn.OIDN_QUALITY_FAST}[quality]
+
+        def new_filter(images: dict[str, str], **flags: bool):
+            flt = oidn.Filter(self.device, oidn.OIDN_FILTER_TYPE_RT)
+            self._filters.append(flt)  # released with the others, also if a step below fails
+            for slot, buffer in images.items():
+                flt.set_image(slot, self._buffers[buffer], _FLOAT3, width, height)
+            for flag, value in flags.items():
+                flt.set_bool(flag, value)
+            flt.set_quality(level)
+            flt.commit()
+            self._check("setting up a filter")
+
+        guides = [name for name in ("albedo", "normal") if name in names]
+        if prefilter:
+            for guide in guides:  # a guide alone, denoised in place (OIDN's "denoising with prefiltering")
+                new_filter({guide: guide, "output": guide})
+        new_filter({name: name for name in names} | {"output": "output"}, hdr=True,
+                   cleanAux=bool(prefilter and guides))
+
+    def _release_filters(self) -> None:
+        for flt in self._filters:
+            flt.release()
+        self._filters = []
+        for buffer in self._buffers.values():
+            buffer.release()
+        self._buffers = {}
+
+    def release(self) -> None:
+        self._release_filters()
+        self.device.release()
+
+
+_LOCK = threading.Lock()
+_DENOISER: _Denoiser | None = None
+
+
+def _shared_denoiser() -> _Denoiser:
+    global _DENOISER
+    if _DENOISER is None:
+        _DENOISER = _Denoiser(os.environ.get(DEVICE_ENV, "default").strip().lower() or "default")
+    return _DENOISER
+
+
+@atexit.register
+def _release_at_exit() -> None:
+    """Release the device before the interpreter unloads the library under it."""
+    global _DENOISER
+    with _LOCK:
+        if _DENOISER is not None:
+            _DENOISER.release()
+            _DENOISER = None
