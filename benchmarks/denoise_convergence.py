@@ -4,7 +4,7 @@ For each shipped scene, at a small size (``--size``: the long edge in pixels): a
 samples in two halves of other seeds than the renders compared; cached under ``--cache``, keyed by the scene file, the
 size and the kernels' source), then two progressive renders as the studio's viewport makes them (``RenderSession.step``): one plain,
 one with the denoiser's feature buffers, whose image is denoised as the viewport's preview is (render/denoise.py,
-prefilter off). At checkpoints spaced by sqrt(2) in time, up to ``--seconds`` of sampling, both are compared with the
+prefilter off, ``--quality`` fast as the viewport's). At checkpoints spaced by sqrt(2) in time, up to ``--seconds`` of sampling, both are compared with the
 reference, by two errors:
 
 * relMSE: the mean over pixels and channels of (x - ref)^2 / (ref^2 + 0.01), the denoising literature's relative
@@ -99,7 +99,8 @@ def reference(renderer, name: str, scene, spp: int, cache: Path) -> np.ndarray:
     return np.load(file)
 
 
-def progression(renderer, scene, ref: np.ndarray, seconds: float, denoised: bool) -> list[tuple[float, float, int, dict]]:
+def progression(renderer, scene, ref: np.ndarray, seconds: float, denoised: bool,
+                quality: str = "fast") -> list[tuple[float, float, int, dict]]:
     """(seconds until shown, seconds sampled, spp, {metric: error}) at checkpoints sqrt(2) apart in sampling time,
     from the first full pass. A denoised image is shown once it is denoised: its time adds one denoise (what the
     viewport pays for the frame it shows; how often it denoises while sampling is the viewport's choice)."""
@@ -112,7 +113,7 @@ def progression(renderer, scene, ref: np.ndarray, seconds: float, denoised: bool
         if denoised:
             albedo, normal = session.features_image()
             start = time.perf_counter()
-            image = oidn.denoise(image, albedo, normal)
+            image = oidn.denoise(image, albedo, normal, quality=quality)
             extra = time.perf_counter() - start
         points.append((session.elapsed_seconds + extra, session.elapsed_seconds, session.samples_per_pixel,
                        {metric: error(image, ref) for metric, error in METRICS.items()}))
@@ -147,13 +148,14 @@ def seconds_to(points, metric: str, threshold: float, extrapolate: bool) -> str:
 def time_denoiser(sizes: list[tuple[int, int]]) -> None:
     rng = np.random.default_rng(1)
     print(f"\n{oidn.describe()}: seconds to denoise once (best of 3, after a first call that sets the filter up)")
-    print(f"{'size':>11} {'colour only':>12} {'+ guides':>9} {'+ guides, prefiltered':>22}")
+    print(f"{'size':>11} {'colour only':>12} {'+ guides':>9} {'+ guides, fast':>15} {'+ guides, prefiltered':>22}")
     for width, height in sizes:
         color = rng.random((height, width, 3), dtype=np.float32)
         albedo = rng.random((height, width, 3), dtype=np.float32)
         normal = rng.random((height, width, 3), dtype=np.float32) * 2 - 1
         row = []
-        for kwargs in ({}, {"albedo": albedo, "normal": normal}, {"albedo": albedo, "normal": normal, "prefilter": True}):
+        guides = {"albedo": albedo, "normal": normal}
+        for kwargs in ({}, guides, {**guides, "quality": "fast"}, {**guides, "prefilter": True}):
             oidn.denoise(color, **kwargs)
             times = []
             for _ in range(3):
@@ -161,7 +163,7 @@ def time_denoiser(sizes: list[tuple[int, int]]) -> None:
                 oidn.denoise(color, **kwargs)
                 times.append(time.perf_counter() - start)
             row.append(min(times))
-        print(f"{f'{width}x{height}':>11} {row[0]:>12.3f} {row[1]:>9.3f} {row[2]:>22.3f}", flush=True)
+        print(f"{f'{width}x{height}':>11} {row[0]:>12.3f} {row[1]:>9.3f} {row[2]:>15.3f} {row[3]:>22.3f}", flush=True)
 
 
 def main() -> None:
@@ -171,6 +173,7 @@ def main() -> None:
     parser.add_argument("--reference-spp", type=int, default=1024)
     parser.add_argument("--relmse", default="0.01,0.002", help="relMSE thresholds, comma-separated")
     parser.add_argument("--mae", default="0.01,0.005", help="display MAE thresholds, comma-separated")
+    parser.add_argument("--quality", choices=oidn.QUALITIES, default="fast", help="the preview's (the viewport's: fast)")
     parser.add_argument("--scenes", default=",".join(shipped_scene_names()))
     parser.add_argument("--cache", type=Path, default=Path.home() / ".cache" / "lenslab" / "benchmarks")
     parser.add_argument("--denoise-sizes", default="320x320,800x533,1920x1080",
@@ -182,15 +185,16 @@ def main() -> None:
     print(f"device: {device['renderer']}, {device['version']}; denoiser: {oidn.describe()}")
     thresholds = [(metric, float(value)) for metric, values in (("relMSE", args.relmse), ("display MAE", args.mae))
                   for value in values.split(",")]
-    print(f"long edge {args.size} px, reference {args.reference_spp} spp, up to {args.seconds:g} s of sampling")
+    print(f"long edge {args.size} px, reference {args.reference_spp} spp, up to {args.seconds:g} s of sampling, "
+          f"denoised at quality {args.quality}")
     print(f"{'scene':<16} {'size':>8} {'metric':<12} {'below':>7} {'plain s':>8} {'denoised s':>11} "
           f"{'plain spp/s':>12} {'guided spp/s':>13} {'error at end: plain':>20} {'denoised':>9} {'ref. floor':>10}")
-    for name in args.scenes.split(","):
+    for name in [name for name in args.scenes.split(",") if name]:
         scene = sized(open_scene(name), args.size)
         ref = reference(renderer, name, scene, args.reference_spp, args.cache)
         floor = reference_floor(ref)
         plain = progression(renderer, scene, ref, args.seconds, denoised=False)
-        guided = progression(renderer, scene, ref, args.seconds, denoised=True)
+        guided = progression(renderer, scene, ref, args.seconds, denoised=True, quality=args.quality)
         size = "x".join(map(str, scene.camera.resolution))
         for metric, threshold in thresholds:
             print(f"{name:<16} {size:>8} {metric:<12} {threshold:>7g} {seconds_to(plain, metric, threshold, True):>8} "

@@ -240,3 +240,15 @@ def test_cli_denoise_without_the_library_says_so_in_one_line_before_rendering(tm
     err = capsys.readouterr().err
     assert status == 1 and not out.exists()
     assert err.count("\n") == 1 and "--denoise: denoising needs Intel Open Image Denoise: pip install pyoidn" in err
+
+
+def test_an_image_too_large_for_its_feature_buffers_is_refused_in_one_line():
+    from lenslab.limits import SceneTooLarge
+    from lenslab.render.tracer import LLVMPIPE_BUFFER_BYTES, check_image_size
+
+    check_image_size(12000, 11500, LLVMPIPE_BUFFER_BYTES, memory_bytes=None)  # its image alone fits
+    with pytest.raises(SceneTooLarge, match="feature buffer"):  # 32 bytes a pixel: more than 4 GiB
+        check_image_size(12000, 11500, LLVMPIPE_BUFFER_BYTES, memory_bytes=None, feature_buffers=True)
+    with pytest.raises(SceneTooLarge, match=r"and 1\.0 GiB for the denoiser\); this machine holds at most"):
+        check_image_size(4000, 4000, LLVMPIPE_BUFFER_BYTES, memory_bytes=4 << 30, feature_buffers=True)
+    check_image_size(4000, 4000, LLVMPIPE_BUFFER_BYTES, memory_bytes=4 << 30)

@@ -114,8 +114,10 @@ class RenderController(QObject):
         return viewport_size(self.doc.scene.camera.resolution, self.quality, self._widget_size, cpu)
 
     def send_scene(self) -> None:
-        self._size = self._view_size()
-        self.region = None
+        size = self._view_size()
+        if size != self._size:
+            self.region = None  # the worker drops a region whose picture changed size, as here
+        self._size = size
         self.worker.set_scene(copy_scene(self.doc.scene), *self._size, self._next_generation(), self.margin)
 
     def set_widget_size(self, width: int, height: int) -> None:

@@ -24,6 +24,7 @@ import numpy as np
 from lenslab.optics.aperture import APERTURE_KINDS, Aperture
 from lenslab.render import film, gl
 from lenslab.render.buffers import GpuScene, pack_scene
+from lenslab.render.denoise import MAX_MEMORY_MB
 from lenslab.render.features import GENERAL, KernelFeatures, scene_features
 from lenslab.render.gpu_layout import (ACCUMULATION_BINDING, APERTURE_TABLE_UNIT, DISPLAY_BINDING, FEATURE_ROWS,
                                       FEATURES_BINDING, SHADING_ROWS,
@@ -54,10 +55,12 @@ ACCUMULATION_BYTES_PER_PIXEL = 16
 HOST_BYTES_PER_PIXEL = 96
 # With the denoiser's feature buffers, their sums take FEATURE_BYTES_PER_PIXEL in a storage buffer of their own
 # (the largest one then), and reading them back, denoising and writing an EXR with its extra layers takes
-# HOST_FEATURE_BYTES_PER_PIXEL more of the machine's memory at the peak (an estimate: the read-back, albedo,
-# normal, the denoised copy and twelve float channels to write; rounded up).
+# HOST_FEATURE_BYTES_PER_PIXEL more of the machine's memory at the peak, and OIDN's scratch memory up to
+# DENOISER_SCRATCH_BYTES besides (measured, a denoised EXR of the Cornell box: 0.87 GB more at 1024 x 1024,
+# 1.21 GB at 2048 x 2048, about 0.76 GB and 108 bytes a pixel; rounded up).
 FEATURE_BYTES_PER_PIXEL = 16 * FEATURE_ROWS
 HOST_FEATURE_BYTES_PER_PIXEL = 192
+DENOISER_SCRATCH_BYTES = MAX_MEMORY_MB << 20
 # The storage buffers the trace kernel binds: the scene's six, image data, the accumulation, and the features.
 TRACE_STORAGE_BLOCKS_WITH_FEATURES = 9
 #: A triangle's bytes in the largest of the scene's storage buffers (buffers.py's shading rows).
@@ -165,12 +168,14 @@ def check_image_size(width: int, height: int, largest_buffer_bytes: int, memory_
     buffer_bytes, what = ((FEATURE_BYTES_PER_PIXEL, "feature buffer") if feature_buffers
                           else (ACCUMULATION_BYTES_PER_PIXEL, "accumulation buffer"))
     host_bytes = HOST_BYTES_PER_PIXEL + (HOST_FEATURE_BYTES_PER_PIXEL if feature_buffers else 0)
+    scratch = DENOISER_SCRATCH_BYTES if feature_buffers else 0
     most_pixels = largest_buffer_bytes // buffer_bytes
     needs = f"needs {buffer_bytes * pixels:,} bytes of {what}"
     holder, holds = "this device", f"the largest storage buffer it binds is {largest_buffer_bytes:,} bytes"
-    if memory_bytes is not None and memory_bytes // host_bytes < most_pixels:
-        most_pixels = memory_bytes // host_bytes
-        needs = f"needs {format_bytes(host_bytes * pixels)} of memory ({host_bytes} bytes a pixel)"
+    if memory_bytes is not None and max(0, memory_bytes - scratch) // host_bytes < most_pixels:
+        most_pixels = max(0, memory_bytes - scratch) // host_bytes
+        needs = f"needs {format_bytes(host_bytes * pixels + scratch)} of memory ({host_bytes} bytes a pixel" + (
+            f" and {format_bytes(scratch)} for the denoiser)" if scratch else ")")
         holder, holds = "this machine", f"{format_bytes(memory_bytes)} of memory is available"
     if pixels <= most_pixels:
         return
