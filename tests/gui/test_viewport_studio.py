@@ -148,6 +148,13 @@ def test_the_denoised_preview_is_on_by_default_and_one_toggle(make_window, small
     qtbot.waitUntil(lambda: window.controller.last_frame is not None and window.controller.last_frame.denoised
                     and window.controller.last_frame.image is not None, timeout=30000)
     assert "denoised" in window.viewport.status_text
+    # Another display exposure shows the same denoised image anew (no second denoise needed): brighter.
+    before = window.controller.last_frame
+    window.set_display_exposure(1.0)
+    qtbot.waitUntil(lambda: window.controller.last_frame.display_settings[0] == 1.0, timeout=20000)
+    after = window.controller.last_frame
+    assert after.denoised
+    assert after.display[..., :3].astype(float).mean() > before.display[..., :3].astype(float).mean() + 5
     window.actions["denoise"].trigger()
     assert settings.value("viewport/denoise") in (False, "false")
     qtbot.waitUntil(lambda: not window.controller.last_frame.denoised, timeout=20000)

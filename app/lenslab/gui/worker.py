@@ -636,9 +636,12 @@ class RenderWorker(QThread):
         spp = session.samples_per_pixel
         cached = self._denoised
         now = time.perf_counter()
-        if cached is not None and cached[0] == self._generation and cached[3] == self._display_look() \
+        look = self._display_look()
+        if cached is not None and cached[0] == self._generation \
                 and (cached[1] == spp or (not converged and now < self._denoise_ready_at)):
-            return cached[2], cached[4]
+            if cached[3] != look:  # another exposure or tone map: the same denoised image, shown anew
+                self._denoised = (*cached[:2], session.display_image(cached[4], *look), look, cached[4])
+            return self._denoised[2], self._denoised[4]
         start = time.perf_counter()
         image = session.image()
         albedo, normal = session.features_image()
@@ -648,7 +651,6 @@ class RenderWorker(QThread):
         if session.region is not None and fill_linear is not None:
             image = fill_linear.copy()
         image[y:y + h, x:x + w] = crop
-        look = self._display_look()
         picture = session.display_image(image, *look)  # tone-mapped on the GPU, as the raw pictures are
         cost = time.perf_counter() - start
         self._denoise_ready_at = time.perf_counter() + max(DENOISE_MIN_INTERVAL, 2.0 * cost)
