@@ -248,6 +248,7 @@ class RenderWorker(QThread):
         self._scene_ok = False
         self._camera_ok = True
         self._preview_image = None
+        self._preview_linear = None  # the preview pass's linear image at the viewport's size
         self._preview_display: tuple[tuple[float, str], np.ndarray] | None = None  # (settings, RGBA8 at full size)
         self._display_settings: tuple[float, str] = (0.0, "filmic")
         self._last_linear = 0.0
@@ -543,7 +544,9 @@ class RenderWorker(QThread):
                     image = self._denoise_image(image, *session.features_image())
                 self._preview_image = image
                 w, h = self._size
-                self._offer(self._preview_picture(), upscale_smooth(image, w, h), preview=True)
+                # Enlarged once: the frames of the first full pass fill their unreached pixels from it.
+                self._preview_linear = upscale_smooth(image, w, h)
+                self._offer(self._preview_picture(), self._preview_linear, preview=True)
                 self._resize(w, h)
                 self._phase = "full"
                 self._gbuffer_if_due()  # during a drag every edit restarts here: the outline must keep up
@@ -614,7 +617,7 @@ class RenderWorker(QThread):
         """What shows where the render has no sample yet: this edit's preview, else the last picture shown."""
         w, h = self._size
         if self._preview_image is not None:
-            return self._preview_picture(), upscale_smooth(self._preview_image, w, h)
+            return self._preview_picture(), self._preview_linear
         if self._backdrop is not None and self._backdrop.shape[:2] == (h, w):
             linear = self._backdrop_linear
             return self._backdrop, linear if linear is not None and linear.shape[:2] == (h, w) else None
@@ -647,9 +650,10 @@ class RenderWorker(QThread):
         albedo, normal = session.features_image()
         x, y, w, h = session.region_pixels
         crop = self._denoise_image(image[y:y + h, x:x + w], albedo[y:y + h, x:x + w], normal[y:y + h, x:x + w])
-        _fill, fill_linear = self._fill_pictures()
-        if session.region is not None and fill_linear is not None:
-            image = fill_linear.copy()
+        if session.region is not None:  # outside the region: the last picture shown
+            _fill, fill_linear = self._fill_pictures()
+            if fill_linear is not None:
+                image = fill_linear.copy()
         image[y:y + h, x:x + w] = crop
         picture = session.display_image(image, *look)  # tone-mapped on the GPU, as the raw pictures are
         cost = time.perf_counter() - start
