@@ -11,9 +11,14 @@ render: wall seconds (loading, tree build and kernel compile included, as a user
 of the rendering alone, relative MSE against the reference, and efficiency 1 / (seconds x relMSE) as a
 multiple of Mitsuba's. Ratios are what to compare across machines: these are shared and noisy.
 
+With ``--seeds N`` every render is made N times with seeds 0 ... N-1 and the mean seconds and mean relMSE are
+printed: a scene with small bright lights far out of focus (dof_lights) has most of its squared error in a
+handful of pixels at the rims of the bokeh disks, where one lens sample in hundreds sees the lamp, so one
+seed's relMSE there varies by 2x from seed to seed.
+
 Mitsuba renders in a child process of its own (lenslab.validate.runner.render_mitsuba_file says why).
 
-Usage: python benchmarks/vs_mitsuba.py [--res 256] [--spp 64] [--reference-spp 1024] [--scenes a,b]
+Usage: python benchmarks/vs_mitsuba.py [--res 256] [--spp 64] [--reference-spp 1024] [--seeds 1] [--scenes a,b]
        python benchmarks/vs_mitsuba.py --lenslab-only --res 16 --spp 2 --triangles 2000   (no Mitsuba needed;
        relMSE against references already in the cache, made on another machine, say)
 The million-triangle scene's mesh (a bumpy torus) is written into the cache as a PLY the first time.
@@ -104,6 +109,7 @@ def main() -> None:
     parser.add_argument("--res", type=int, default=256)
     parser.add_argument("--spp", type=int, default=64)
     parser.add_argument("--reference-spp", type=int, default=1024)
+    parser.add_argument("--seeds", type=int, default=1, help="renders per renderer, seeds 0 ... N-1: means printed")
     parser.add_argument("--scenes", default=",".join(SCENES))
     parser.add_argument("--triangles", type=int, default=1_000_000, help="of the million-triangle scene's torus")
     parser.add_argument("--cache", type=Path, default=Path.home() / ".cache" / "lenslab" / "benchmarks")
@@ -127,25 +133,28 @@ def main() -> None:
         defines = {"res": str(args.res), "spp": str(args.spp)}
         if name == "million_triangles":
             defines["mesh"] = str(torus_mesh(args.cache, args.triangles))
-        runs: list[tuple[str, Result]] = []
+        runs: list[tuple[str, list[Result]]] = []
         ref = reference(path, defines, args.reference_spp, args.cache, render=not args.lenslab_only)
+        seeds = range(args.seeds)
         if not args.lenslab_only:
-            runs.append(("mitsuba independent", render_mitsuba(path, defines, args.spp, 0)))
+            runs.append(("mitsuba independent", [render_mitsuba(path, defines, args.spp, seed) for seed in seeds]))
         for sampler in ("independent", "sobol"):
-            runs.append((f"lenslab {sampler}", render_lenslab(renderer, path, defines, args.spp, sampler, 0)))
+            runs.append((f"lenslab {sampler}",
+                         [render_lenslab(renderer, path, defines, args.spp, sampler, seed) for seed in seeds]))
         baseline = None
-        for label, result in runs:
-            rate = result.samples / result.render_seconds / 1e6
+        for label, results in runs:
+            seconds = float(np.mean([result.seconds for result in results]))
+            rate = sum(result.samples for result in results) / sum(result.render_seconds for result in results) / 1e6
             if ref is None:
-                print(f"{name:<20} {label:<22} {result.seconds:>8.2f} {rate:>11.3g} {'-':>9} {'-':>11}")
+                print(f"{name:<20} {label:<22} {seconds:>8.2f} {rate:>11.3g} {'-':>9} {'-':>11}")
                 continue
-            error = relative_mse(result.image, ref)
+            error = float(np.mean([relative_mse(result.image, ref) for result in results]))
             if args.lenslab_only:  # no Mitsuba time here to compare with
-                print(f"{name:<20} {label:<22} {result.seconds:>8.2f} {rate:>11.3g} {error:>9.5f} {'-':>11}")
+                print(f"{name:<20} {label:<22} {seconds:>8.2f} {rate:>11.3g} {error:>9.5f} {'-':>11}")
                 continue
-            efficiency = 1.0 / (result.seconds * error)
+            efficiency = 1.0 / (seconds * error)
             baseline = baseline or efficiency
-            print(f"{name:<20} {label:<22} {result.seconds:>8.2f} {rate:>11.3g} {error:>9.5f} {efficiency / baseline:>10.2f}x")
+            print(f"{name:<20} {label:<22} {seconds:>8.2f} {rate:>11.3g} {error:>9.5f} {efficiency / baseline:>10.2f}x")
         sys.stdout.flush()
     renderer.release()
 

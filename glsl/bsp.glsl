@@ -110,7 +110,40 @@ bool trace_bsp(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
     return hit.prim != NO_HIT;
 }
 
+// Every primitive, in one loop (the scene's primitives are few: render/features.py, "Small scenes"). The
+// loop counter is the same in every lane, so each primitive is read once for all lanes and no lane waits
+// on another's path through a tree: on llvmpipe that is faster than the kd-tree up to a few dozen
+// primitives (docs/performance.md). No early exit for shadow rays: a break taken by some lanes only would
+// make the loop divergent, and the few tests it would save cost less than that.
+bool trace_all_primitives(Ray ray, float t_min, float t_max, out Hit hit) {
+    hit.t = t_max;
+    hit.prim = NO_HIT;
+    hit.uv = vec2(0.0);
+    for (int prim = 0; prim < FLAT_PRIMITIVES; prim++) {
+        vec2 bary;
+        float t = intersect_prim(ray, prim, t_min, hit.t, bary);
+#if defined(MASKED_TRAVERSAL) && HAS_MATERIAL(MATERIAL_MASK)
+        if (t < hit.t && passes_through(ray, prim, t, bary)) continue;  // a cut-out (mask.glsl)
+#endif
+        if (t < hit.t) {
+            hit.t = t;
+            hit.prim = prim;
+            hit.uv = bary;
+        }
+    }
+    return hit.prim != NO_HIT;
+}
+
+// Nearest hit with t in (t_min, t_max), through the kd-tree or, in a small scene, by testing everything.
+bool trace_scene(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
+#if FLAT_PRIMITIVES > 0
+    return trace_all_primitives(ray, t_min, t_max, hit);
+#else
+    return trace_bsp(ray, t_min, t_max, any_hit, hit);
+#endif
+}
+
 bool occluded(Ray ray, float t_max) {
     Hit hit;
-    return trace_bsp(ray, 0.0, t_max, true, hit);
+    return trace_scene(ray, 0.0, t_max, true, hit);
 }

@@ -4,6 +4,10 @@
 // lane takes (Mesa 22's llvmpipe pays for both sides of every branch, taken or not), and every loop runs
 // its body at least once on llvmpipe. A kernel compiled without these defines is the general kernel, with
 // everything in; the tests compare the two.
+// 0: rays walk the kd-tree. N > 0: the scene has N primitives, few enough that testing them all is faster.
+#ifndef FLAT_PRIMITIVES
+#define FLAT_PRIMITIVES 0
+#endif
 #ifndef HAS_SPHERES
 #define HAS_SPHERES 1
 #endif

@@ -19,7 +19,7 @@ vec3 path_radiance(Ray ray, inout Sampler sampler) {
 
     for (int segments = 1; ; segments++) {
         Hit hit;
-        if (!trace_bsp(ray, 0.0, INFINITY, false, hit)) {
+        if (!trace_scene(ray, 0.0, INFINITY, false, hit)) {
             // The ray leaves the scene: the sky, and the sun's disk if it looks straight at it.
             vec3 le = environment_radiance(ray.d);
 #if HAS_FEATURE_BUFFERS

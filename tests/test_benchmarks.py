@@ -20,7 +20,7 @@ def run(script, *args, tmp_path):
 
 @pytest.mark.gl
 def test_vs_mitsuba_renders_every_scene_with_both_samplers(renderer, tmp_path):
-    out = run("vs_mitsuba.py", "--lenslab-only", "--res", 12, "--spp", 2, "--triangles", 2000,
+    out = run("vs_mitsuba.py", "--lenslab-only", "--res", 12, "--spp", 2, "--seeds", 2, "--triangles", 2000,
               "--cache", tmp_path / "cache", tmp_path=tmp_path)
     rows = [line.split() for line in out.splitlines() if line.split()[:1] and line.split()[0] in
             ("cornell_dof", "dof_lights", "glass_metal_envmap", "million_triangles")]

@@ -16,12 +16,23 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from lenslab.render.bsp import INTERSECTION_COST, KdTree
 from lenslab.render.buffers import HOLDING_CODES, MATERIAL_CODES, WRAPPER_CODES, PackedScene, held_materials
 from lenslab.render.gpu_layout import (ENV_MAP, GEOMETRY_ROWS, LIGHT_AREA, LIGHT_ENVIRONMENT, LIGHT_POINT, LIGHT_ROWS,
                                        LIGHT_SPOT, LIGHT_SUN, MATERIAL_ROWS,
                                        MICROFACET_BECKMANN)
 
 ALL_MATERIAL_TYPES = frozenset(MATERIAL_CODES.values())
+
+# Small scenes. Lanes of a SIMD group that walk a kd-tree each read their own nodes and wait for the lane
+# with the longest walk; a loop over every primitive reads each one once for all lanes and never diverges.
+# On llvmpipe a divergent tree step costs about three uniform primitive tests, so a scene whose tree saves
+# less than that over testing everything renders faster flat (docs/performance.md, "Small scenes":
+# dof_lights +40%, cornell_caustic +50%, the Cornell box +7%; dof_chart, whose tree saves eleven-fold,
+# 34% slower flat). A scene renders flat when it has at most FLAT_MAX_PRIMITIVES primitives and its tree's
+# SAH cost is at least FLAT_SAH_FRACTION of the cost of testing them all.
+FLAT_MAX_PRIMITIVES = 64
+FLAT_SAH_FRACTION = 0.35
 
 
 @dataclass(frozen=True)
@@ -45,9 +56,12 @@ class KernelFeatures:
     # resolve loop of glsl/bsdf.glsl.
     nested_materials: bool = True
     beckmann: bool = True  # a rough material with the Beckmann distribution (else GGX alone)
+    # 0: rays walk the kd-tree. N > 0: the scene's N primitives are tested in one loop (a small scene).
+    flat_primitives: int = 0
 
     def defines(self) -> dict[str, int]:
         return {
+            "FLAT_PRIMITIVES": int(self.flat_primitives),
             "HAS_SPHERES": int(self.spheres),
             "HAS_TEXTURES": int(self.textures),
             "HAS_ENVIRONMENT_MAP": int(self.environment_map),
@@ -94,4 +108,13 @@ def scene_features(packed: PackedScene) -> KernelFeatures:
         material_types=frozenset(int(code) for code in records[:, 0, 3]),
         nested_materials=bool(((records[:, 2, 0] >= 0) & np.isin(records[:, 0, 3], HOLDING_CODES)).any()),
         beckmann=bool(((records[:, 5, 3] == MICROFACET_BECKMANN) & ~np.isin(records[:, 0, 3], HOLDING_CODES)).any()),
+        flat_primitives=prim_count if renders_flat(packed.kdtree, prim_count) else 0,
     )
+
+
+def renders_flat(kdtree: KdTree, prim_count: int) -> bool:
+    """Whether testing every primitive beats walking this tree (see FLAT_MAX_PRIMITIVES)."""
+    if not 0 < prim_count <= FLAT_MAX_PRIMITIVES:
+        return False
+    test_all = prim_count * kdtree.params.get("intersection_cost", INTERSECTION_COST)
+    return kdtree.sah_cost >= FLAT_SAH_FRACTION * test_all
