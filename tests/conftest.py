@@ -2,11 +2,22 @@
 
 from __future__ import annotations
 
+import atexit
 import os
+import shutil
+import tempfile
 
 import pytest
 
-os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+if not os.environ.get("QT_QPA_PLATFORM"):  # unset or empty (an empty value makes Qt abort)
+    os.environ["QT_QPA_PLATFORM"] = "offscreen"
+
+# Large scenes' kd-trees are kept on disk between runs (render/kdtree_cache.py): the tests keep theirs apart from
+# the user's, for this session only.
+if "LENSLAB_KDTREE_CACHE" not in os.environ:
+    _trees = tempfile.mkdtemp(prefix="lenslab-test-kdtrees-")
+    os.environ["LENSLAB_KDTREE_CACHE"] = _trees
+    atexit.register(shutil.rmtree, _trees, True)
 
 
 @pytest.fixture(scope="session")

@@ -364,8 +364,9 @@ def render_headless(args) -> int:
     session = job.session
     ready_after = time.perf_counter() - loading_start
     flat, tree = session.flat_scene, session.kdtree
+    made = "read from the cache" if tree.from_cache else "built"
     loaded = (f"{flat.triangle_count:,} triangles, {flat.sphere_count:,} spheres; kd-tree of {len(tree.nodes):,} "
-              f"nodes built in {tree.build_seconds:.1f} s; ready to sample after {ready_after:.1f} s")
+              f"nodes {made} in {tree.build_seconds:.1f} s; ready to sample after {ready_after:.1f} s")
     if console is not None:
         console.print(loaded, highlight=False)
     elif ready_after >= PROGRESS_LINE_SECONDS:  # a log that was silent this long says what took the time

@@ -144,6 +144,7 @@ class KdTree:
     reference_limit: int  # the budget the build honoured (see "Bounded work")
     budget_leaves: int  # nodes the SAH would have split that became leaves to stay within it (0: none)
     params: dict = field(default_factory=dict, compare=False)
+    from_cache: bool = field(default=False, compare=False)  # read back by render/kdtree_cache.py, not built
 
 
 def default_depth_limit(prim_count: int) -> int:

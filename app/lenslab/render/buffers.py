@@ -16,7 +16,8 @@ from typing import Sequence
 import numpy as np
 
 from lenslab.color import luminance
-from lenslab.render.bsp import KdTree, build_kdtree
+from lenslab.render import kdtree_cache
+from lenslab.render.bsp import KdTree
 from lenslab.render.fresnel import (internal_diffuse_reflectance, rough_internal_reflectance, rough_reflectance_table,
                                     rough_transmittance_table)
 from lenslab.render.environment import EnvironmentDistribution, environment_power, infinite_light_power
@@ -332,7 +333,7 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
     ``environment_importance=False`` samples an environment map uniformly (to measure what importance
     sampling gains)."""
     if kdtree is None:
-        kdtree = build_kdtree(flat.prim_bounds(), triangles=flat.triangles)
+        kdtree = kdtree_cache.kdtree(flat.prim_bounds(), triangles=flat.triangles)
     n_tri, n_prim = flat.triangle_count, flat.prim_count
     material_ids = np.concatenate([flat.triangle_material, flat.sphere_material]).astype(np.int32)
 

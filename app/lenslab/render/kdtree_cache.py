@@ -1,0 +1,151 @@
+"""Built kd-trees kept on disk, so that opening a large scene again skips the build.
+
+A million triangles take four seconds to build into a kd-tree on two cores (docs/performance.md), every time the
+scene is opened: each shot of a batch on a render box, each reopening in the studio, each undo back to a
+geometry seen before. The tree depends only on the primitives' boxes and triangles, the build's constants and
+the builder's own code, so it is kept under a hash of exactly those (as Mesa keeps compiled shaders, and as
+production renderers keep acceleration structures in their mesh proxies) and read back in a fraction of the
+time. Nothing else about the scene enters the key: a new material or camera finds the same tree.
+
+* Only scenes of at least ``MIN_PRIMITIVES`` primitives use the cache; smaller trees build faster than they hash.
+* Where: ``$LENSLAB_KDTREE_CACHE`` (a folder; ``off`` turns the cache off), else ``$XDG_CACHE_HOME/lenslab/kdtrees``
+  or ``~/.cache/lenslab/kdtrees``.
+* At most ``MAX_CACHE_BYTES`` are kept; the trees used least recently go first.
+* A tree the build's reference budget cut short (docs/performance.md, "Bounded work") is used again only where
+  today's budget is no smaller than the references it holds, so that it is the tree a build would make now.
+* A file that cannot be read (cut short, another version's) is built again and replaced; a folder that cannot
+  be written costs only the keeping: the render goes on.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import time
+import zipfile
+from pathlib import Path
+
+import numpy as np
+
+from lenslab.render import bsp
+from lenslab.render.bsp import KdTree, build_kdtree, reference_budget
+
+MIN_PRIMITIVES = 50_000
+MAX_CACHE_BYTES = 2 * 1024**3
+_FORMAT = b"lenslab-kdtree-1"
+# KdTree's fields stored as numbers beside its arrays (params and build_seconds are handled apart).
+_SCALARS = ("max_depth", "max_depth_limit", "node_count", "leaf_count", "empty_leaf_count", "refs_per_prim",
+            "sah_cost", "reference_limit", "budget_leaves")
+
+
+def cache_dir() -> Path | None:
+    """The folder trees are kept in, or None where ``LENSLAB_KDTREE_CACHE=off``."""
+    chosen = os.environ.get("LENSLAB_KDTREE_CACHE", "")
+    if chosen.lower() in ("off", "0", "no", "false"):
+        return None
+    if chosen:
+        return Path(chosen)
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "lenslab" / "kdtrees"
+
+
+def _builder_fingerprint() -> bytes:
+    """The builder's source: any change to how trees are built makes new keys."""
+    return hashlib.sha256(Path(bsp.__file__).read_bytes()).digest()
+
+
+def tree_key(prim_bounds: np.ndarray, triangles: np.ndarray | None, options: dict) -> str:
+    digest = hashlib.blake2b(_FORMAT + _builder_fingerprint(), digest_size=20)
+    digest.update(repr(sorted(options.items())).encode())
+    digest.update(np.ascontiguousarray(prim_bounds, dtype=np.float32).tobytes())
+    if triangles is not None:
+        digest.update(b"triangles")
+        digest.update(np.ascontiguousarray(triangles, dtype=np.float32).tobytes())
+    return digest.hexdigest()
+
+
+def kdtree(prim_bounds: np.ndarray, *, triangles: np.ndarray | None = None, folder: Path | None = None,
+           **options) -> KdTree:
+    """``build_kdtree(prim_bounds, triangles=triangles, **options)``, from the cache where it holds that tree.
+
+    ``folder``: the cache's folder (default :func:`cache_dir`). The returned tree's ``from_cache`` says which
+    it was, and its ``build_seconds`` how long reading it took.
+    """
+    folder = cache_dir() if folder is None else folder
+    prim_count = len(prim_bounds)
+    if folder is None or prim_count < MIN_PRIMITIVES or options.get("max_refs") is not None:
+        return build_kdtree(prim_bounds, triangles=triangles, **options)
+    start = time.perf_counter()
+    build_options = {name: value for name, value in options.items() if name not in ("threads", "memory_bytes")}
+    path = folder / f"{tree_key(prim_bounds, triangles, build_options)}.npz"
+    tree = _read(path, start)
+    if tree is not None:
+        budget = _budget(prim_count, options)
+        if len(tree.prim_refs) <= budget and (tree.budget_leaves == 0 or tree.reference_limit == budget):
+            return tree
+    tree = build_kdtree(prim_bounds, triangles=triangles, **options)
+    _write(path, tree)
+    _evict(folder, keep=path)
+    return tree
+
+
+def _budget(prim_count: int, options: dict) -> int:
+    memory = options.get("memory_bytes")
+    return reference_budget(prim_count, memory if memory is not None else bsp.available_memory_bytes())
+
+
+def _read(path: Path, start: float) -> KdTree | None:
+    try:
+        with np.load(path, allow_pickle=False) as stored:
+            if bytes(stored["format"]) != _FORMAT:
+                return None
+            scalars = dict(zip(_SCALARS, stored["scalars"].tolist()))
+            params = {**dict(zip(stored["int_param_names"].tolist(), stored["int_param_values"].tolist())),
+                      **dict(zip(stored["float_param_names"].tolist(), stored["float_param_values"].tolist()))}
+            tree = KdTree(nodes=stored["nodes"], prim_refs=stored["prim_refs"], bounds=stored["bounds"],
+                          build_seconds=time.perf_counter() - start, params=params, from_cache=True,
+                          **{name: (float(value) if name in ("refs_per_prim", "sah_cost") else int(value))
+                             for name, value in scalars.items()})
+    except (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile):  # missing, cut short, another layout
+        return None
+    try:
+        os.utime(path)  # used now: evicted last
+    except OSError:
+        pass
+    return tree
+
+
+def _write(path: Path, tree: KdTree) -> None:
+    """Write atomically (a reader never sees half a file); a folder that cannot be written is skipped."""
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        partial = path.with_name(f".{path.stem}.{os.getpid()}.partial.npz")
+        ints = {name: value for name, value in tree.params.items() if isinstance(value, (int, np.integer))}
+        floats = {name: float(value) for name, value in tree.params.items() if name not in ints}
+        np.savez(partial, format=np.frombuffer(_FORMAT, np.uint8), nodes=tree.nodes, prim_refs=tree.prim_refs,
+                 bounds=tree.bounds, scalars=np.array([float(getattr(tree, name)) for name in _SCALARS]),
+                 int_param_names=np.array(list(ints), dtype=str), int_param_values=np.array(list(ints.values()), np.int64),
+                 float_param_names=np.array(list(floats), dtype=str),
+                 float_param_values=np.array(list(floats.values()), np.float64))
+        os.replace(partial, path)
+    except OSError:
+        return
+
+
+def _evict(folder: Path, keep: Path) -> None:
+    """Delete the least recently used trees until the folder holds at most MAX_CACHE_BYTES."""
+    try:
+        files = [(entry.stat().st_mtime, entry.stat().st_size, entry) for entry in folder.glob("*.npz")]
+    except OSError:
+        return
+    total = sum(size for _, size, _ in files)
+    for _, size, entry in sorted(files, key=lambda item: item[0]):
+        if total <= MAX_CACHE_BYTES:
+            break
+        if entry == keep:
+            continue
+        try:
+            entry.unlink()
+            total -= size
+        except OSError:
+            pass
