@@ -112,8 +112,8 @@ bool trace_bsp(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
     return hit.prim != NO_HIT;
 }
 
-// Every primitive, in one loop (the scene's primitives are few: render/features.py, "Small scenes"). The
-// loop counter is the same in every lane, so each primitive is read once for all lanes and no lane waits
+// Every primitive, in one loop (the scene's primitives are few: render/features.py's FLAT_MAX_PRIMITIVES).
+// The loop counter is the same in every lane, so each primitive is read once for all lanes and no lane waits
 // on another's path through a tree: on llvmpipe that is faster than the kd-tree up to a few dozen
 // primitives (docs/performance.md). No early exit for shadow rays: a break taken by some lanes only would
 // make the loop divergent, and the few tests it would save cost less than that.

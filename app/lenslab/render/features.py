@@ -27,10 +27,10 @@ ALL_MATERIAL_TYPES = frozenset(MATERIAL_CODES.values())
 # Small scenes. Lanes of a SIMD group that walk a kd-tree each read their own nodes and wait for the lane
 # with the longest walk; a loop over every primitive reads each one once for all lanes and never diverges.
 # On llvmpipe a divergent tree step costs about three uniform primitive tests, so a scene whose tree saves
-# less than that over testing everything renders faster flat (docs/performance.md, "Small scenes":
-# dof_lights +40%, cornell_caustic +50%, the Cornell box +7%; dof_chart, whose tree saves eleven-fold,
-# 34% slower flat). A scene renders flat when it has at most FLAT_MAX_PRIMITIVES primitives and its tree's
-# SAH cost is at least FLAT_SAH_FRACTION of the cost of testing them all.
+# less than that over testing everything renders faster flat (docs/performance.md, "Where the time goes,
+# and small scenes": dof_lights +40%, cornell_caustic +50%, the Cornell box +7%; dof_chart, whose tree
+# saves eleven-fold, 34% slower flat). A scene renders flat when it has at most FLAT_MAX_PRIMITIVES
+# primitives and its tree's SAH cost is at least FLAT_SAH_FRACTION of the cost of testing them all.
 FLAT_MAX_PRIMITIVES = 64
 FLAT_SAH_FRACTION = 0.35
 

@@ -106,8 +106,8 @@ def _read(path: Path, start: float) -> KdTree | None:
                           build_seconds=time.perf_counter() - start, params=params, from_cache=True,
                           **{name: (float(value) if name in ("refs_per_prim", "sah_cost") else int(value))
                              for name, value in scalars.items()})
-    except (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile):  # missing, cut short, another layout
-        return None
+    except (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile):
+        return None  # missing, cut short, or another layout
     try:
         os.utime(path)  # used now: evicted last
     except OSError:
@@ -124,7 +124,8 @@ def _write(path: Path, tree: KdTree) -> None:
         floats = {name: float(value) for name, value in tree.params.items() if name not in ints}
         np.savez(partial, format=np.frombuffer(_FORMAT, np.uint8), nodes=tree.nodes, prim_refs=tree.prim_refs,
                  bounds=tree.bounds, scalars=np.array([float(getattr(tree, name)) for name in _SCALARS]),
-                 int_param_names=np.array(list(ints), dtype=str), int_param_values=np.array(list(ints.values()), np.int64),
+                 int_param_names=np.array(list(ints), dtype=str),
+                 int_param_values=np.array(list(ints.values()), np.int64),
                  float_param_names=np.array(list(floats), dtype=str),
                  float_param_values=np.array(list(floats.values()), np.float64))
         os.replace(partial, path)
