@@ -19,6 +19,23 @@
 #define SHORT_STACK 4
 #endif
 
+// Test one primitive against the ray and keep it in hit if it lies nearer than hit.t (and is not cut out
+// there by a mask): the one step both ways of tracing below take per primitive. Returns whether it was kept.
+bool keep_if_nearer(Ray ray, int prim, float t_min, inout Hit hit) {
+    vec2 bary;
+    float t = intersect_prim(ray, prim, t_min, hit.t, bary);
+    bool nearer = t < hit.t;
+#if defined(MASKED_TRAVERSAL) && HAS_MATERIAL(MATERIAL_MASK)
+    nearer = nearer && !passes_through(ray, prim, t, bary);  // a cut-out (mask.glsl)
+#endif
+    if (nearer) {
+        hit.t = t;
+        hit.prim = prim;
+        hit.uv = bary;
+    }
+    return nearer;
+}
+
 // Nearest hit with t in (t_min, t_max); with any_hit, stop at the first hit found (shadow rays).
 bool trace_bsp(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
     hit.t = t_max;
@@ -77,18 +94,7 @@ bool trace_bsp(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
         int count = int(n.y >> 2);
         int first_ref = int(n.x);
         for (int i = 0; i < count; i++) {
-            int prim = prim_refs[first_ref + i];
-            vec2 bary;
-            float t = intersect_prim(ray, prim, t_min, hit.t, bary);
-#if defined(MASKED_TRAVERSAL) && HAS_MATERIAL(MATERIAL_MASK)
-            if (t < hit.t && passes_through(ray, prim, t, bary)) continue;  // a cut-out (mask.glsl)
-#endif
-            if (t < hit.t) {
-                hit.t = t;
-                hit.prim = prim;
-                hit.uv = bary;
-                if (any_hit) return true;
-            }
+            if (keep_if_nearer(ray, prim_refs[first_ref + i], t_min, hit) && any_hit) return true;
         }
         // Done when the nearest hit lies within this leaf's interval, or the ray's whole interval is covered.
         if (hit.t <= t1 || t1 >= t_end) break;
@@ -121,18 +127,7 @@ bool trace_all_primitives(Ray ray, float t_min, float t_max, out Hit hit) {
     hit.t = t_max;
     hit.prim = NO_HIT;
     hit.uv = vec2(0.0);
-    for (int prim = 0; prim < FLAT_PRIMITIVES; prim++) {
-        vec2 bary;
-        float t = intersect_prim(ray, prim, t_min, hit.t, bary);
-#if defined(MASKED_TRAVERSAL) && HAS_MATERIAL(MATERIAL_MASK)
-        if (t < hit.t && passes_through(ray, prim, t, bary)) continue;  // a cut-out (mask.glsl)
-#endif
-        if (t < hit.t) {
-            hit.t = t;
-            hit.prim = prim;
-            hit.uv = bary;
-        }
-    }
+    for (int prim = 0; prim < FLAT_PRIMITIVES; prim++) keep_if_nearer(ray, prim, t_min, hit);
     return hit.prim != NO_HIT;
 }
 
