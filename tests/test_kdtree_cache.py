@@ -155,3 +155,12 @@ def test_the_cli_says_when_the_tree_came_from_the_cache(renderer, tmp_path, caps
         assert status == 0, err
         loaded.append(next(line for line in err.splitlines() if line.startswith("lenslab: loaded:")))
     assert "nodes built in" in loaded[0] and "nodes read from the cache in" in loaded[1]
+
+
+def test_trees_and_mitsubas_references_share_the_users_cache_folder(tmp_path, monkeypatch):
+    from lenslab.validate.files import default_cache_dir
+
+    monkeypatch.delenv("LENSLAB_KDTREE_CACHE", raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    assert kdtree_cache.cache_dir() == tmp_path / "lenslab" / "kdtrees"
+    assert default_cache_dir() == tmp_path / "lenslab" / "validate"

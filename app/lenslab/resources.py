@@ -1,4 +1,5 @@
-"""Where the data that ships with LensLab lives: shaders, ready scenes and presets.
+"""Where the data that ships with LensLab lives (shaders, ready scenes and presets), and where it keeps what it
+saves between runs (user_cache_dir).
 
 In an installed wheel these folders sit inside the package (``lenslab/glsl`` ...); in a source checkout
 they sit at the top of the repository. We look in the package first so that an installed copy never
@@ -7,6 +8,7 @@ picks up a stray checkout.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 _PACKAGE_DIR = Path(__file__).resolve().parent
@@ -19,6 +21,13 @@ def resource_dir(name: str) -> Path:
         if candidate.is_dir():
             return candidate
     raise FileNotFoundError(f"LensLab's '{name}' folder is missing from {_PACKAGE_DIR} (broken install?)")
+
+
+def user_cache_dir(name: str) -> Path:
+    """``$XDG_CACHE_HOME/lenslab/<name>``, by default ``~/.cache/lenslab/<name>``: work kept between runs to be
+    done once (Mitsuba's references, built kd-trees), safe to delete."""
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "lenslab" / name
 
 
 def checkout_dir() -> Path | None:

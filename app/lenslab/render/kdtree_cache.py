@@ -19,6 +19,7 @@ time. Nothing else about the scene enters the key: a new material or camera find
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import os
 import time
@@ -29,6 +30,7 @@ import numpy as np
 
 from lenslab.render import bsp
 from lenslab.render.bsp import KdTree, build_kdtree, reference_budget
+from lenslab.resources import user_cache_dir
 
 MIN_PRIMITIVES = 50_000
 MAX_CACHE_BYTES = 2 * 1024**3
@@ -43,12 +45,10 @@ def cache_dir() -> Path | None:
     chosen = os.environ.get("LENSLAB_KDTREE_CACHE", "")
     if chosen.lower() in ("off", "0", "no", "false"):
         return None
-    if chosen:
-        return Path(chosen)
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return Path(base) / "lenslab" / "kdtrees"
+    return Path(chosen) if chosen else user_cache_dir("kdtrees")
 
 
+@functools.cache
 def _builder_fingerprint() -> bytes:
     """The builder's source: any change to how trees are built makes new keys."""
     return hashlib.sha256(Path(bsp.__file__).read_bytes()).digest()
@@ -136,17 +136,17 @@ def _write(path: Path, tree: KdTree) -> None:
 def _evict(folder: Path, keep: Path) -> None:
     """Delete the least recently used trees until the folder holds at most MAX_CACHE_BYTES."""
     try:
-        files = [(entry.stat().st_mtime, entry.stat().st_size, entry) for entry in folder.glob("*.npz")]
+        files = [(entry, entry.stat()) for entry in folder.glob("*.npz")]
     except OSError:
         return
-    total = sum(size for _, size, _ in files)
-    for _, size, entry in sorted(files, key=lambda item: item[0]):
+    total = sum(stat.st_size for _, stat in files)
+    for entry, stat in sorted(files, key=lambda item: item[1].st_mtime):
         if total <= MAX_CACHE_BYTES:
             break
         if entry == keep:
             continue
         try:
             entry.unlink()
-            total -= size
+            total -= stat.st_size
         except OSError:
             pass

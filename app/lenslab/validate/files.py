@@ -27,6 +27,7 @@ from typing import Callable
 import numpy as np
 
 from lenslab.messages import one_line
+from lenslab.resources import user_cache_dir
 from lenslab.validate import findings, metrics
 from lenslab.validate.runner import Render, in_child_process, mitsuba_image, render_scene
 
@@ -39,8 +40,7 @@ AUTO_DEFINES = ("spp",)
 
 
 def default_cache_dir() -> Path:
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return Path(base) / "lenslab" / "validate"
+    return user_cache_dir("validate")
 
 
 @dataclass
