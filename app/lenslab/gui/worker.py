@@ -38,7 +38,7 @@ import numpy as np
 from PySide6.QtCore import QThread, Signal
 
 from lenslab.messages import one_line
-from lenslab.render.film import resolve, to_8bit, tone_map
+from lenslab.render.film import to_8bit, tone_map
 
 PREVIEW_DIVISOR = 4  # the preview pass renders at 1/4 of the width and height
 PREVIEW_MIN_PIXELS = 256 * 256  # images smaller than this skip the preview pass
@@ -607,7 +607,7 @@ class RenderWorker(QThread):
             picture[empty, 3] = 255  # black
         image = None
         if with_linear or converged or self._paused or not self._busy() or now - self._last_linear >= LINEAR_INTERVAL:
-            image = resolve(session.accumulation())
+            image = session.image()  # resolved from the read-back itself, without a copy of the sums
             if has_empty and fill_linear is not None:
                 image[empty] = fill_linear[empty]
             self._last_linear = now
