@@ -1,7 +1,9 @@
-"""CPU tests of the SAH kd-tree builder (lenslab.render.bsp).
+"""CPU tests of the SAH kd-tree builders (lenslab.render.bsp: the levels build in numpy, and the compiled one
+in render/bsp_compiled.py).
 
 The tests walk the flat arrays in Python, exactly as the GLSL traversal does, and check them against
-brute force: which primitives must be in which leaf, and which triangle a ray hits first.
+brute force: which primitives must be in which leaf, and which triangle a ray hits first. Every test runs
+against both builders (the ``builder`` fixture makes ``build_kdtree``'s automatic choice pick each in turn).
 """
 
 from __future__ import annotations
@@ -9,9 +11,22 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import lenslab.render.bsp as bsp
 from lenslab.render.bsp import KdTree, build_kdtree, default_depth_limit
 
 LEAF = 3
+
+
+@pytest.fixture(autouse=True, params=["levels", "compiled"])
+def builder(request, monkeypatch):
+    """Every test twice: with the levels build, and with the compiled build for scenes of any size (its threads
+    too, from a few hundred primitives on, so that the subtrees built apart and joined are tested)."""
+    from lenslab.render import bsp_compiled
+
+    compiled = request.param == "compiled"
+    monkeypatch.setattr(bsp, "COMPILED_MIN_PRIMITIVES", 0 if compiled else 1 << 62)
+    monkeypatch.setattr(bsp_compiled, "PARALLEL_MIN_PRIMITIVES", 300)
+    return request.param
 
 
 # --------------------------------------------------------------------------------------------------
@@ -461,9 +476,7 @@ def test_statistics_are_consistent():
 
 
 def test_threads_build_the_same_tree(monkeypatch):
-    """Levels cut into parts for worker threads give exactly the single-threaded tree."""
-    import lenslab.render.bsp as bsp
-
+    """Levels cut into parts for worker threads, or subtrees built apart, give exactly the single-threaded tree."""
     rng = np.random.default_rng(8)
     tris, spheres = mixed_scene(rng)
     bounds = np.concatenate([triangle_bounds(tris), sphere_bounds(spheres)])
@@ -542,3 +555,41 @@ def test_bad_input_is_refused():
         build_kdtree(good, triangles=np.zeros((2, 3, 3), np.float32))
     with pytest.raises(ValueError):
         build_kdtree(good, max_depth_limit=65)
+
+
+def test_the_builders_make_trees_of_the_same_quality_with_the_same_hits(builder):
+    """The compiled build against the reference levels build: the same SAH cost and references within a hair
+    (their bins and rules are the same), and rays find the same first hits in both."""
+    if builder != "compiled":
+        pytest.skip("one comparison of the two builders")
+    rng = np.random.default_rng(21)
+    tris, spheres = mixed_scene(rng)
+    tris = np.concatenate([tris, noisy_sphere(rng, 4, center=(0.5, 0.2, -0.3), radius=0.6)])
+    bounds = np.concatenate([triangle_bounds(tris), sphere_bounds(spheres)])
+    reference = build_kdtree(bounds, triangles=tris, builder="levels")
+    compiled = build_kdtree(bounds, triangles=tris, builder="compiled", threads=2)
+    assert reference.params["builder"] == "levels" and compiled.params["builder"] == "compiled"
+    assert compiled.sah_cost <= 1.02 * reference.sah_cost
+    assert compiled.refs_per_prim <= 1.02 * reference.refs_per_prim
+    assert compiled.max_depth <= compiled.max_depth_limit == reference.max_depth_limit
+    o_all, d_all = aimed_rays(rng, 300)
+    for o, d in zip(o_all, d_all):
+        assert trace_tree(compiled, o, d, tris, spheres) == trace_tree(reference, o, d, tris, spheres)
+
+
+def test_the_compiled_build_stays_within_a_small_budget_and_is_exact(builder):
+    if builder != "compiled":
+        pytest.skip("the levels build's budget is tested in test_bounded_work.py")
+    rng = np.random.default_rng(22)
+    tris = np.concatenate([noisy_sphere(rng, 3)] * 4)  # four copies in one place: every split copies them
+    bounds = triangle_bounds(tris)
+    for threads in (1, 2):
+        tree = build_kdtree(bounds, triangles=tris, builder="compiled", max_refs=2 * len(tris), threads=threads)
+        assert len(tree.prim_refs) <= 2 * len(tris) and tree.budget_leaves > 0
+        assert check_leaf_contents(tree, bounds, tris) == len(tree.prim_refs)
+        check_rays(tree, tris, np.zeros((0, 4)), rng, n=100, rays=aimed_rays)
+
+
+def test_an_unknown_builder_is_refused():
+    with pytest.raises(ValueError, match="builder"):
+        build_kdtree(np.zeros((1, 2, 3), np.float32), builder="fast")

@@ -34,7 +34,7 @@ from lenslab.resources import user_cache_dir
 
 MIN_PRIMITIVES = 50_000
 MAX_CACHE_BYTES = 2 * 1024**3
-_FORMAT = b"lenslab-kdtree-1"
+_FORMAT = b"lenslab-kdtree-2"
 # KdTree's fields stored as numbers beside its arrays (params and build_seconds are handled apart).
 _SCALARS = ("max_depth", "max_depth_limit", "node_count", "leaf_count", "empty_leaf_count", "refs_per_prim",
             "sah_cost", "reference_limit", "budget_leaves")
@@ -50,8 +50,10 @@ def cache_dir() -> Path | None:
 
 @functools.cache
 def _builder_fingerprint() -> bytes:
-    """The builder's source: any change to how trees are built makes new keys."""
-    return hashlib.sha256(Path(bsp.__file__).read_bytes()).digest()
+    """The builders' source: any change to how trees are built makes new keys."""
+    digest = hashlib.sha256(Path(bsp.__file__).read_bytes())
+    digest.update(Path(bsp.__file__).with_name("bsp_compiled.py").read_bytes())
+    return digest.digest()
 
 
 def tree_key(prim_bounds: np.ndarray, triangles: np.ndarray | None, options: dict) -> str:
@@ -101,7 +103,8 @@ def _read(path: Path, start: float) -> KdTree | None:
                 return None
             scalars = dict(zip(_SCALARS, stored["scalars"].tolist()))
             params = {**dict(zip(stored["int_param_names"].tolist(), stored["int_param_values"].tolist())),
-                      **dict(zip(stored["float_param_names"].tolist(), stored["float_param_values"].tolist()))}
+                      **dict(zip(stored["float_param_names"].tolist(), stored["float_param_values"].tolist())),
+                      **dict(zip(stored["str_param_names"].tolist(), stored["str_param_values"].tolist()))}
             tree = KdTree(nodes=stored["nodes"], prim_refs=stored["prim_refs"], bounds=stored["bounds"],
                           build_seconds=time.perf_counter() - start, params=params, from_cache=True,
                           **{name: (float(value) if name in ("refs_per_prim", "sah_cost") else int(value))
@@ -121,13 +124,15 @@ def _write(path: Path, tree: KdTree) -> None:
         path.parent.mkdir(parents=True, exist_ok=True)
         partial = path.with_name(f".{path.stem}.{os.getpid()}.partial.npz")
         ints = {name: value for name, value in tree.params.items() if isinstance(value, (int, np.integer))}
-        floats = {name: float(value) for name, value in tree.params.items() if name not in ints}
+        texts = {name: value for name, value in tree.params.items() if isinstance(value, str)}
+        floats = {name: float(value) for name, value in tree.params.items() if name not in ints and name not in texts}
         np.savez(partial, format=np.frombuffer(_FORMAT, np.uint8), nodes=tree.nodes, prim_refs=tree.prim_refs,
                  bounds=tree.bounds, scalars=np.array([float(getattr(tree, name)) for name in _SCALARS]),
                  int_param_names=np.array(list(ints), dtype=str),
                  int_param_values=np.array(list(ints.values()), np.int64),
                  float_param_names=np.array(list(floats), dtype=str),
-                 float_param_values=np.array(list(floats.values()), np.float64))
+                 float_param_values=np.array(list(floats.values()), np.float64),
+                 str_param_names=np.array(list(texts), dtype=str), str_param_values=np.array(list(texts.values()), dtype=str))
         os.replace(partial, path)
     except OSError:
         return
