@@ -32,6 +32,7 @@ void main() {
     s.uv = vec2(0.5);
     s.material = probe_material;
     s.prim = 0;
+    s.instance = NO_INSTANCE;
     if (b.w < 0.5) {
         vec3 wi, weight;
         float pdf;

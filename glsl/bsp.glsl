@@ -36,23 +36,23 @@ bool keep_if_nearer(Ray ray, int prim, float t_min, inout Hit hit) {
     return nearer;
 }
 
-// Nearest hit with t in (t_min, t_max); with any_hit, stop at the first hit found (shadow rays).
-bool trace_bsp(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
-    hit.t = t_max;
-    hit.prim = NO_HIT;
-    hit.uv = vec2(0.0);
+// Walk the tree whose root is node `root` and whose box is [box_min, box_max] for a hit nearer than hit.t (and
+// beyond t_min), keeping it in hit; with any_hit, stop at the first hit found (shadow rays). Returns whether a
+// hit was kept. The world's tree and each mesh group's (in its own space) are walked alike.
+bool walk_tree(Ray ray, int root, vec3 box_min, vec3 box_max, float t_min, bool any_hit, inout Hit hit) {
     // A zero direction component gives +-huge rather than inf, so no 0 * inf = NaN appears below.
     vec3 inv_dir = 1.0 / mix(ray.d, vec3(1e-30), equal(ray.d, vec3(0.0)));
-    vec2 span = intersect_box(ray, inv_dir, scene_min, scene_max);
+    vec2 span = intersect_box(ray, inv_dir, box_min, box_max);
     float t0 = max(span.x, t_min);
-    float t_end = min(span.y, t_max);
+    float t_end = min(span.y, hit.t);
     if (t0 > t_end) return false;
+    bool kept = false;
     float t1 = t_end;
 
     int stack_node[SHORT_STACK];
     vec2 stack_span[SHORT_STACK];
     int depth = 0;  // entries on the stack
-    int node = 0;
+    int node = root;
     float restarted_at = -1.0;
     // After a restart that made no progress (the zero-length intervals of ties at t0 filled the stack and
     // pushed out what lies beyond), ties at t0 go to the far side only: the near sides were just visited.
@@ -94,7 +94,10 @@ bool trace_bsp(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
         int count = int(n.y >> 2);
         int first_ref = int(n.x);
         for (int i = 0; i < count; i++) {
-            if (keep_if_nearer(ray, prim_refs[first_ref + i], t_min, hit) && any_hit) return true;
+            if (keep_if_nearer(ray, prim_refs[first_ref + i], t_min, hit)) {
+                kept = true;
+                if (any_hit) return true;
+            }
         }
         // Done when the nearest hit lies within this leaf's interval, or the ray's whole interval is covered.
         if (hit.t <= t1 || t1 >= t_end) break;
@@ -108,15 +111,52 @@ bool trace_bsp(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
             }
             depth--;
         } else {
-            node = 0;  // the stack dropped what lies beyond: restart from the root there
+            node = root;  // the stack dropped what lies beyond: restart from the root there
             past_ties = t1 == restarted_at;
             restarted_at = t1;
             t0 = t1;
             t1 = t_end;
         }
     }
+    return kept;
+}
+
+void no_hit_yet(float t_max, out Hit hit) {
+    hit.t = t_max;
+    hit.prim = NO_HIT;
+    hit.uv = vec2(0.0);
+    hit.instance = NO_INSTANCE;
+}
+
+// Nearest hit with t in (t_min, t_max) among the world's own primitives; with any_hit, stop at the first.
+bool trace_bsp(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
+    no_hit_yet(t_max, hit);
+    return walk_tree(ray, world_root, scene_min, scene_max, t_min, any_hit, hit);
+}
+
+#if HAS_INSTANCES
+// Two levels (docs/architecture.md, "Two levels"): the world's own primitives, then every instance of a mesh
+// group. A ray enters an instance by taking itself into the group's space (the direction is not renormalised,
+// so that t measures the same distance in both spaces and hits compare across instances) and walks the group's
+// tree there. The instances are few (the large meshes of a scene) and every lane loops over the same ones, so
+// the loop does not diverge; a ray that misses an instance's box pays for one box test.
+bool trace_instances(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
+    no_hit_yet(t_max, hit);
+    if (walk_tree(ray, world_root, scene_min, scene_max, t_min, any_hit, hit) && any_hit) return true;
+    for (int k = 0; k < instance_count; k++) {
+        int row = INSTANCE_ROWS * k;
+        vec4 r0 = instances[row], r1 = instances[row + 1], r2 = instances[row + 2];
+        Ray local = Ray(vec3(dot(r0.xyz, ray.o) + r0.w, dot(r1.xyz, ray.o) + r1.w, dot(r2.xyz, ray.o) + r2.w),
+                        vec3(dot(r0.xyz, ray.d), dot(r1.xyz, ray.d), dot(r2.xyz, ray.d)));
+        vec4 box_min = instances[row + 3], box_max = instances[row + 4];
+        if (walk_tree(local, floatBitsToInt(box_min.w), box_min.xyz, box_max.xyz, t_min, any_hit, hit)) {
+            hit.instance = k;
+            if (any_hit) return true;
+        }
+    }
     return hit.prim != NO_HIT;
 }
+#endif
 
 // Every primitive, in one loop (the scene's primitives are few: render/features.py's FLAT_MAX_PRIMITIVES).
 // The loop counter is the same in every lane, so each primitive is read once for all lanes and no lane waits
@@ -124,17 +164,18 @@ bool trace_bsp(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
 // primitives (docs/performance.md). No early exit for shadow rays: a break taken by some lanes only would
 // make the loop divergent, and the few tests it would save cost less than that.
 bool trace_all_primitives(Ray ray, float t_min, float t_max, out Hit hit) {
-    hit.t = t_max;
-    hit.prim = NO_HIT;
-    hit.uv = vec2(0.0);
+    no_hit_yet(t_max, hit);
     for (int prim = 0; prim < FLAT_PRIMITIVES; prim++) keep_if_nearer(ray, prim, t_min, hit);
     return hit.prim != NO_HIT;
 }
 
-// Nearest hit with t in (t_min, t_max), through the kd-tree or, in a small scene, by testing everything.
+// Nearest hit with t in (t_min, t_max), through the kd-tree (and the instances' trees) or, in a small scene,
+// by testing everything.
 bool trace_scene(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
 #if FLAT_PRIMITIVES > 0
     return trace_all_primitives(ray, t_min, t_max, hit);
+#elif HAS_INSTANCES
+    return trace_instances(ray, t_min, t_max, any_hit, hit);
 #else
     return trace_bsp(ray, t_min, t_max, any_hit, hit);
 #endif

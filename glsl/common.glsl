@@ -27,9 +27,17 @@ layout(std430, binding = MATERIALS_BINDING) readonly buffer Materials { vec4 mat
 // LIGHT_ROWS vec4 per light (see lights.glsl).
 layout(std430, binding = LIGHTS_BINDING) readonly buffer Lights { vec4 lights[]; };
 
-uniform int triangle_count;
-uniform vec3 scene_min;
+// Mesh groups placed by instances (render/instancing.py): INSTANCE_ROWS vec4 per instance. Rows 0-2: world to
+// group space (a 3x4 matrix, one row each); 3: the group's box min, its tree's root node (int bits); 4: box max,
+// the instance's material (int bits); 5-7: group space to world. The transpose of rows 0-2's 3x3 part takes
+// normals back to the world (the inverse-transpose of 5-7's).
+layout(std430, binding = INSTANCES_BINDING) readonly buffer Instances { vec4 instances[]; };
+
+uniform int triangle_count;   // every triangle in the geometry buffer: the groups' (first), then the world's
+uniform vec3 scene_min;       // the box of the world's own primitives' tree
 uniform vec3 scene_max;
+uniform int world_root;       // the row of that tree's root in kd_nodes (after the groups' trees)
+uniform int instance_count;
 
 uniform int light_count;      // entries in the light table
 uniform vec3 env_radiance;    // constant environment
@@ -39,10 +47,13 @@ struct Ray {
     vec3 d;
 };
 
+const int NO_INSTANCE = -1;
+
 struct Hit {
     float t;
     int prim;
     vec2 uv;  // barycentrics (b1, b2) on triangles
+    int instance;  // the instance whose group holds prim, or NO_INSTANCE for the world's own primitives
 };
 
 int material_of(int prim) { return floatBitsToInt(geometry[GEOMETRY_ROWS * prim + 1].w); }

@@ -8,6 +8,9 @@
 #ifndef FLAT_PRIMITIVES
 #define FLAT_PRIMITIVES 0
 #endif
+#ifndef HAS_INSTANCES
+#define HAS_INSTANCES 1
+#endif
 #ifndef HAS_SPHERES
 #define HAS_SPHERES 1
 #endif

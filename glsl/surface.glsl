@@ -10,13 +10,40 @@ struct SurfaceHit {
     vec2 uv;         // texture coordinates
     int material;
     int prim;
+    int instance;    // Hit.instance: the instance whose group holds prim, or NO_INSTANCE
     bool front_face; // the ray arrived on the side the primitive's normal points to
 };
+
+#if HAS_INSTANCES
+// A point and a direction of instance k's group space in the world, and a normal (by the inverse-transpose).
+vec3 instance_point_to_world(int k, vec3 p) {
+    int row = INSTANCE_ROWS * k + 5;
+    vec4 r0 = instances[row], r1 = instances[row + 1], r2 = instances[row + 2];
+    return vec3(dot(r0.xyz, p) + r0.w, dot(r1.xyz, p) + r1.w, dot(r2.xyz, p) + r2.w);
+}
+
+vec3 instance_vector_to_world(int k, vec3 v) {
+    int row = INSTANCE_ROWS * k + 5;
+    return vec3(dot(instances[row].xyz, v), dot(instances[row + 1].xyz, v), dot(instances[row + 2].xyz, v));
+}
+
+vec3 instance_normal_to_world(int k, vec3 n) {
+    int row = INSTANCE_ROWS * k;
+    return n.x * instances[row].xyz + n.y * instances[row + 1].xyz + n.z * instances[row + 2].xyz;
+}
+
+int instance_material(int k) { return floatBitsToInt(instances[INSTANCE_ROWS * k + 4].w); }
+#endif
 
 SurfaceHit surface_at(Ray ray, Hit hit) {
     SurfaceHit s;
     s.prim = hit.prim;
+    s.instance = hit.instance;
+#if HAS_INSTANCES
+    s.material = hit.instance == NO_INSTANCE ? material_of(hit.prim) : instance_material(hit.instance);
+#else
     s.material = material_of(hit.prim);
+#endif
     s.wo = -ray.d;
     s.uv = vec2(0.0);
     if (is_sphere(hit.prim)) {
@@ -35,6 +62,13 @@ SurfaceHit surface_at(Ray ray, Hit hit) {
         s.ng = normalize(cross(e1, e2));
         int j = SHADING_ROWS * hit.prim;
         vec3 n = b0 * shading[j].xyz + b1 * shading[j + 1].xyz + b2 * shading[j + 2].xyz;
+#if HAS_INSTANCES
+        if (hit.instance != NO_INSTANCE) {  // the group's corners and normals are in its own space
+            s.p = instance_point_to_world(hit.instance, s.p);
+            s.ng = normalize(instance_normal_to_world(hit.instance, s.ng));
+            n = instance_normal_to_world(hit.instance, n);
+        }
+#endif
         s.ns = dot(n, n) > 0.0 ? normalize(n) : s.ng;
         s.uv = triangle_uv(hit.prim, hit.uv);
     }
@@ -73,6 +107,12 @@ void surface_tangents(SurfaceHit s, vec3 n, out vec3 dpdu, out vec3 dpdv) {
     }
     dpdu = (d2.y * e1 - d1.y * e2) / det;
     dpdv = (d1.x * e2 - d2.x * e1) / det;
+#if HAS_INSTANCES
+    if (s.instance != NO_INSTANCE) {
+        dpdu = instance_vector_to_world(s.instance, dpdu);
+        dpdv = instance_vector_to_world(s.instance, dpdv);
+    }
+#endif
 }
 
 // Start a new ray at p, nudged off the surface to the side it leaves on, so that it does not hit the

@@ -331,6 +331,21 @@ def _progress_lines(every_seconds: float):
     return report
 
 
+def _load_line(session, ready_after: float) -> str:
+    """What opening the scene made and where the time went: triangles and spheres (and meshes placed more than
+    once), the kd-trees (built or read from the cache), each step's seconds (render/tracer.SceneLoad)."""
+    flat, packed, load = session.flat_scene, session.gpu_scene.packed, session.load
+    placed, stored = flat.placed_triangle_count, flat.stored_triangle_count
+    triangles = f"{placed:,} triangles" + (f" ({stored:,} stored)" if stored != placed else "")
+    trees = packed.trees
+    made = ("read from the cache" if load.trees_from_cache == load.trees_built else
+            "built" if not load.trees_from_cache else f"built or read from the cache ({load.trees_from_cache})")
+    what = f"kd-tree of {len(trees[0].nodes):,} nodes" if len(trees) == 1 else \
+        f"{len(trees)} kd-trees of {sum(len(t.nodes) for t in trees):,} nodes"
+    return (f"{triangles}, {flat.sphere_count:,} spheres; {what} {made} in {load.trees:.1f} s; "
+            f"{load.describe_steps()}; ready to sample after {ready_after:.1f} s")
+
+
 def render_headless(args) -> int:
     from lenslab.render.job import RenderJob
     from lenslab.limits import SceneTooLarge
@@ -363,10 +378,7 @@ def render_headless(args) -> int:
         raise SceneError.in_file(scene.source_path or args.scene, exc) from None
     session = job.session
     ready_after = time.perf_counter() - loading_start
-    flat, tree = session.flat_scene, session.kdtree
-    made = "read from the cache" if tree.from_cache else "built"
-    loaded = (f"{flat.triangle_count:,} triangles, {flat.sphere_count:,} spheres; kd-tree of {len(tree.nodes):,} "
-              f"nodes {made} in {tree.build_seconds:.1f} s; ready to sample after {ready_after:.1f} s")
+    loaded = _load_line(session, ready_after)
     if console is not None:
         console.print(loaded, highlight=False)
     elif ready_after >= PROGRESS_LINE_SECONDS:  # a log that was silent this long says what took the time

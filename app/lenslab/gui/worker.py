@@ -718,8 +718,7 @@ class RenderWorker(QThread):
         self._gbuffer_time = time.perf_counter()
         origins, directions = frame.rays(frame.pixel_centres())
         hits = cast_rays(self._renderer, session.gpu_scene, origins, directions)
-        prim_node = session.flat_scene.prim_node
-        node_index = np.where(hits.prim >= 0, prim_node[np.maximum(hits.prim, 0)], -1).astype(np.int32)
+        node_index = session.hit_nodes(hits)
         depth = np.where(hits.prim >= 0, hits.t * (directions @ frame.forward), np.inf).astype(np.float32)
         self._gbuffer_size = (w, h)
         self.gbuffer_ready.emit(GBuffer(node_index.reshape(h, w), depth.reshape(h, w), self._generation))
@@ -733,9 +732,8 @@ class RenderWorker(QThread):
         if pick is None:
             self.pick_ready.emit(PickResult(request.request_id, self._generation, False))
             return
-        node_index = int(session.flat_scene.prim_node[pick.prim])
         self.pick_ready.emit(PickResult(request.request_id, self._generation, True, float(pick.depth),
-                                        tuple(float(c) for c in pick.point), node_index))
+                                        tuple(float(c) for c in pick.point), pick.node_index))
 
     # -- export ----------------------------------------------------------------------------------------------
     def _start_export(self, start: ExportStart) -> bool:

@@ -30,7 +30,9 @@ from lenslab.render.gpu_layout import (ENV_CONSTANT, ENV_MAP, GEOMETRY_BINDING, 
                                        MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_EMISSIVE, MATERIAL_MASK,
                                        MATERIAL_NESTING, MATERIAL_NORMAL_MAP, MATERIAL_PLASTIC, MATERIAL_ROWS,
                                        MATERIAL_THIN_DIELECTRIC, MATERIALS_BINDING, MICROFACET_BECKMANN,
-                                       MICROFACET_GGX, PRIM_REFS_BINDING, SHADING_BINDING, SHADING_ROWS)
+                                       MICROFACET_GGX, PRIM_REFS_BINDING, SHADING_BINDING, SHADING_ROWS,
+                                       INSTANCES_BINDING)
+from lenslab.render.instancing import GroupCache, PackedGroup, join_layers, triangle_rows
 from lenslab.render.textures import TextureTable, read_texture_image
 from lenslab.scene.flatten import FlatScene
 from lenslab.scene.materials import (Blend, BumpMap, Conductor, Diffuse, Dielectric, Emissive, Mask, Material,
@@ -50,7 +52,7 @@ MICROFACET_CODES = {"ggx": MICROFACET_GGX, "beckmann": MICROFACET_BECKMANN}
 # Where each of the packed scene's arrays is bound.
 BINDINGS = {"kd_nodes": KD_NODES_BINDING, "prim_refs": PRIM_REFS_BINDING, "geometry": GEOMETRY_BINDING,
             "shading": SHADING_BINDING, "materials": MATERIALS_BINDING, "lights": LIGHTS_BINDING,
-            "image_data": IMAGE_DATA_BINDING}
+            "image_data": IMAGE_DATA_BINDING, "instances": INSTANCES_BINDING}
 UNIFORM_BINDINGS = {"light_choice": LIGHT_CHOICE_BINDING}  # uniform blocks (glsl/lights.glsl's LightPlaces)
 MISSING_SKY = (0.2, 0.0, 0.2)  # what a scene whose environment map cannot be read is lit by
 
@@ -317,9 +319,17 @@ class PackedScene:
 
     arrays: dict[str, np.ndarray]
     uniforms: dict[str, object]
-    kdtree: KdTree
-    prim_count: int  # triangles, then spheres (the kernels need only the uniform triangle_count)
+    kdtree: KdTree  # the world's own primitives' tree
+    prim_count: int  # rows of the geometry buffer: the groups' triangles, the world's, its spheres
     warnings: tuple[str, ...] = ()  # problems the render survives (a missing texture): show them to the user
+    group_trees: tuple[KdTree, ...] = ()  # the mesh groups' trees (render/instancing.py)
+    first_world_prim: int = 0  # the world's own primitive i is row first_world_prim + i of the geometry buffer
+    instance_materials: tuple[int, ...] = ()  # the material of each instance
+
+    @property
+    def trees(self) -> tuple[KdTree, ...]:
+        """Every kd-tree the scene holds: the groups', then the world's."""
+        return (*self.group_trees, self.kdtree)
 
     @property
     def nbytes(self) -> int:
@@ -328,12 +338,17 @@ class PackedScene:
 
 def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None = None,
                base_dir: Path | None = None, lights: Sequence[Light] = (),
-               environment_importance: bool = True) -> PackedScene:
+               environment_importance: bool = True, packed_groups: Sequence[PackedGroup] | None = None) -> PackedScene:
     """Arrays and uniforms for the trace kernel; ``base_dir`` resolves relative texture paths.
     ``environment_importance=False`` samples an environment map uniformly (to measure what importance
-    sampling gains)."""
+    sampling gains). ``kdtree`` is the world's own primitives' tree (built here when None); ``packed_groups`` are
+    the mesh groups' trees and rows (render/instancing.py; a GroupCache keeps them from one edit to the next), packed
+    here when None."""
     if kdtree is None:
         kdtree = kdtree_cache.kdtree(flat.prim_bounds(), triangles=flat.triangles)
+    if packed_groups is None:
+        packed_groups = GroupCache().packed_groups(flat)
+    first_world_prim = sum(len(g.geometry) for g in packed_groups)
     n_tri, n_prim = flat.triangle_count, flat.prim_count
     material_ids = np.concatenate([flat.triangle_material, flat.sphere_material]).astype(np.int32)
 
@@ -374,7 +389,9 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
     light_of_prim = np.full(n_prim, -1, np.int32)  # each primitive's row in the light table, or -1
     lights_table = np.zeros((len(entries), LIGHT_ROWS, 4), np.float32)
     for row, (entry, pmf, cdf) in enumerate(zip(entries, pmfs, np.cumsum(pmfs))):
-        lights_table[row, 0] = (entry.kind, np.int32(entry.prim).view(np.float32), cdf, pmf)
+        # An area light's primitive as the geometry buffer numbers it: after the mesh groups' triangles.
+        prim_row = entry.prim + first_world_prim if entry.kind == LIGHT_AREA else entry.prim
+        lights_table[row, 0] = (entry.kind, np.int32(prim_row).view(np.float32), cdf, pmf)
         lights_table[row, 1, :3], lights_table[row, 2, :3] = entry.vector, entry.rgb
         lights_table[row, 1, 3], lights_table[row, 2, 3] = entry.w
         if entry.kind == LIGHT_AREA:
@@ -392,20 +409,14 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
     env_row = next((row for row, e in enumerate(entries) if e.kind == LIGHT_ENVIRONMENT), -1)
     sun_row = next((row for row, e in enumerate(entries) if e.kind == LIGHT_SUN), -1)
 
+    triangle_geometry, shading = triangle_rows(flat.triangles, flat.triangle_normals, flat.triangle_uvs,
+                                               material_ids[:n_tri], light_of_prim[:n_tri])
     geometry = np.zeros((n_prim, GEOMETRY_ROWS, 4), np.float32)
-    tris = flat.triangles
-    geometry[:n_tri, 0, :3] = tris[:, 0]
-    geometry[:n_tri, 1, :3] = tris[:, 1] - tris[:, 0]
-    geometry[:n_tri, 2, :3] = tris[:, 2] - tris[:, 0]
+    geometry[:n_tri] = triangle_geometry
     geometry[n_tri:, 0] = flat.spheres
-    geometry[:, 1, 3] = material_ids.view(np.float32)
-    geometry[:, 2, 3] = light_of_prim.view(np.float32)
-
-    shading = np.zeros((n_tri, SHADING_ROWS, 4), np.float32)
-    shading[:, :3, :3] = flat.triangle_normals
-    uv = flat.triangle_uvs.reshape(n_tri, 6)  # u0 v0 u1 v1 u2 v2
-    shading[:, 0, 3], shading[:, 1, 3], shading[:, 2, 3] = uv[:, 0], uv[:, 1], uv[:, 2]
-    shading[:, 3, :3] = uv[:, 3:6]
+    geometry[n_tri:, 1, 3] = material_ids[n_tri:].view(np.float32)
+    geometry[n_tri:, 2, 3] = light_of_prim[n_tri:].view(np.float32)
+    layers = join_layers(packed_groups, flat, kdtree, geometry, shading)
 
     material_rows = MaterialTable(flat.materials, textures, flat.material_names).rows()
 
@@ -413,10 +424,11 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
         return a if a.size else np.zeros(4, a.dtype)
 
     arrays = {
-        "kd_nodes": kdtree.nodes.astype(np.uint32),
-        "prim_refs": kdtree.prim_refs.astype(np.int32),
-        "geometry": geometry,
-        "shading": shading,
+        "kd_nodes": layers.kd_nodes,
+        "prim_refs": layers.prim_refs,
+        "geometry": layers.geometry,
+        "shading": layers.shading,
+        "instances": layers.instances,
         "materials": np.concatenate([material_rows, textures.records()]).astype(np.float32),
         "lights": lights_table.reshape(-1, 4),
         "light_choice": light_choice,
@@ -424,9 +436,11 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
     }
     arrays = {name: at_least_one(np.ascontiguousarray(a)) for name, a in arrays.items()}
     uniforms = {
-        "triangle_count": n_tri,
+        "triangle_count": layers.triangle_count,
         "scene_min": tuple(float(v) for v in kdtree.bounds[0]),
         "scene_max": tuple(float(v) for v in kdtree.bounds[1]),
+        "world_root": layers.world_root,
+        "instance_count": len(flat.instances),
         "light_count": len(entries),
         "env_light": env_row,
         "sun_light": sun_row,
@@ -435,8 +449,11 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
         **env_uniforms,
         **sun_uniforms,
     }
-    tree_warnings = [_reference_budget_warning(kdtree)] if kdtree.budget_leaves else []
-    return PackedScene(arrays, uniforms, kdtree, n_prim, (*tree_warnings, *textures.warnings))
+    tree_warnings = [_reference_budget_warning(tree) for tree in (*(g.tree for g in packed_groups), kdtree)
+                     if tree.budget_leaves]
+    return PackedScene(arrays, uniforms, kdtree, len(layers.geometry), (*tree_warnings, *textures.warnings),
+                       group_trees=tuple(g.tree for g in packed_groups), first_world_prim=layers.first_world_prim,
+                       instance_materials=tuple(i.material for i in flat.instances))
 
 
 class GpuScene:

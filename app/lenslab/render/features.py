@@ -58,10 +58,12 @@ class KernelFeatures:
     beckmann: bool = True  # a rough material with the Beckmann distribution (else GGX alone)
     # 0: rays walk the kd-tree. N > 0: the scene's N primitives are tested in one loop (a small scene).
     flat_primitives: int = 0
+    instances: bool = True  # mesh groups placed by instances (render/instancing.py): two levels to walk
 
     def defines(self) -> dict[str, int]:
         return {
             "FLAT_PRIMITIVES": int(self.flat_primitives),
+            "HAS_INSTANCES": int(self.instances),
             "HAS_SPHERES": int(self.spheres),
             "HAS_TEXTURES": int(self.textures),
             "HAS_ENVIRONMENT_MAP": int(self.environment_map),
@@ -86,8 +88,10 @@ def scene_features(packed: PackedScene) -> KernelFeatures:
     uniforms, arrays = packed.uniforms, packed.arrays
     prim_count, triangle_count = packed.prim_count, int(uniforms["triangle_count"])
     materials = arrays["materials"][: int(uniforms["texture_base"])].reshape(-1, MATERIAL_ROWS, 4)
-    used = (np.unique(arrays["geometry"].reshape(-1, GEOMETRY_ROWS, 4)[:prim_count, 1, 3].view(np.int32))
-            if prim_count else [])
+    # The world's primitives name their materials; a mesh group's triangles take their instance's.
+    rows = arrays["geometry"].reshape(-1, 4)  # (an empty scene's buffer is one placeholder row)
+    world_rows = rows[GEOMETRY_ROWS * packed.first_world_prim + 1:GEOMETRY_ROWS * prim_count:GEOMETRY_ROWS, 3]
+    used = np.union1d(np.unique(world_rows.view(np.int32)), np.asarray(packed.instance_materials, np.int32))
     # The records primitives name, and every record those hold (a blend's two, a light's surface ...).
     records = materials[np.asarray(sorted(held_materials(materials, used)), dtype=np.int64)]
     # A scene without lights still has a row (GL refuses empty buffers).
@@ -108,7 +112,8 @@ def scene_features(packed: PackedScene) -> KernelFeatures:
         material_types=frozenset(int(code) for code in records[:, 0, 3]),
         nested_materials=bool(((records[:, 2, 0] >= 0) & np.isin(records[:, 0, 3], HOLDING_CODES)).any()),
         beckmann=bool(((records[:, 5, 3] == MICROFACET_BECKMANN) & ~np.isin(records[:, 0, 3], HOLDING_CODES)).any()),
-        flat_primitives=prim_count if renders_flat(packed.kdtree, prim_count) else 0,
+        flat_primitives=prim_count if not packed.instance_materials and renders_flat(packed.kdtree, prim_count) else 0,
+        instances=bool(packed.instance_materials),
     )
 
 

@@ -54,6 +54,8 @@ SHADING_ROWS = 4
 
 # kd-tree nodes (render/bsp.py): the low two bits of a node's second word are its split axis, or this.
 KD_LEAF = 3
+# -- Instances of mesh groups (render/instancing.py, glsl/common.glsl): vec4 rows per instance.
+INSTANCE_ROWS = 8
 
 # -- Lights: LIGHT_ROWS vec4 rows per light in the light table (buffers.pack_scene, glsl/lights.glsl), its
 # kind in row 0, x.
@@ -93,6 +95,7 @@ DISPLAY_BINDING = 8
 # vec4 per pixel, (albedo sum, sample count) and (normal sum, 0).
 FEATURES_BINDING = 9
 FEATURE_ROWS = 2
+INSTANCES_BINDING = 10  # the instance table (render/instancing.py)
 # display.comp's tone maps, in the order of lenslab.render.film.TONE_MAPS.
 TONE_MAP_CLAMP = 0
 TONE_MAP_REINHARD = 1

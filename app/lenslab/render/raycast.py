@@ -22,6 +22,17 @@ class RayHits:
     t: np.ndarray  # (N,) float32, inf where nothing was hit
     prim: np.ndarray  # (N,) int32, -1 where nothing was hit
     barycentrics: np.ndarray  # (N, 2) float32 (triangles)
+    instance: np.ndarray  # (N,) int32: the instance whose mesh group holds prim, or -1 (a world primitive)
+
+    def nodes(self, flat, first_world_prim: int = 0) -> np.ndarray:
+        """The index (into flat.nodes) of the node each ray hit, -1 where it hit nothing. A world primitive's row
+        is ``first_world_prim`` past its index in ``flat`` (render/instancing.py's layout)."""
+        instance_node = np.array([i.node for i in flat.instances] + [-1], np.int32)
+        world = self.prim - first_world_prim
+        world_node = (flat.prim_node[np.clip(world, 0, len(flat.prim_node) - 1)] if len(flat.prim_node)
+                      else np.full(len(self.prim), -1, np.int32))
+        node = np.where(self.instance >= 0, instance_node[self.instance], world_node)
+        return np.where(self.prim >= 0, node, -1).astype(np.int32)
 
 
 def cast_rays(renderer, gpu_scene: GpuScene, origins: np.ndarray, directions: np.ndarray,
@@ -31,7 +42,8 @@ def cast_rays(renderer, gpu_scene: GpuScene, origins: np.ndarray, directions: np
     directions = np.asarray(directions, np.float32).reshape(-1, 3)
     n = len(origins)
     if n == 0:
-        return RayHits(np.zeros(0, np.float32), np.zeros(0, np.int32), np.zeros((0, 2), np.float32))
+        return RayHits(np.zeros(0, np.float32), np.zeros(0, np.int32), np.zeros((0, 2), np.float32),
+                       np.zeros(0, np.int32))
     ctx = renderer.ctx
     make_current(ctx)  # whatever context was made in this thread since (see gl.make_current)
     program = renderer.program("raycast.comp", LOCAL_SIZE_X=LOCAL_SIZE_X)
@@ -42,9 +54,9 @@ def cast_rays(renderer, gpu_scene: GpuScene, origins: np.ndarray, directions: np
     # storage block may hold: cast it in chunks that fit both.
     limits = renderer.limits
     chunk = min(n, limits.max_work_group_count[0] * LOCAL_SIZE_X, limits.max_storage_block_bytes // packed[0].nbytes)
-    out = np.empty((n, 4), np.float32)
+    out = np.empty((n, 2, 4), np.float32)
     rays = ctx.buffer(reserve=chunk * packed[0].nbytes)
-    hits = ctx.buffer(reserve=chunk * 16)
+    hits = ctx.buffer(reserve=chunk * out[0].nbytes)
     try:
         gpu_scene.bind()
         rays.bind_to_storage_buffer(RAYS_BINDING)
@@ -60,10 +72,10 @@ def cast_rays(renderer, gpu_scene: GpuScene, origins: np.ndarray, directions: np
             program["ray_count"].value = count
             program.run((count + LOCAL_SIZE_X - 1) // LOCAL_SIZE_X, 1, 1)
             ctx.memory_barrier()
-            out[first:first + count] = np.frombuffer(hits.read(count * 16), np.float32).reshape(count, 4)
+            out[first:first + count] = np.frombuffer(hits.read(count * out[0].nbytes), np.float32).reshape(count, 2, 4)
     finally:
         rays.release()
         hits.release()
-    prim = out[:, 1].view(np.int32).copy()
-    t = np.where(prim >= 0, out[:, 0], np.inf).astype(np.float32)
-    return RayHits(t, prim, out[:, 2:4].copy())
+    prim = out[:, 0, 1].view(np.int32).copy()
+    t = np.where(prim >= 0, out[:, 0, 0], np.inf).astype(np.float32)
+    return RayHits(t, prim, out[:, 0, 2:4].copy(), out[:, 1, 0].view(np.int32).copy())

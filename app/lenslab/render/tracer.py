@@ -22,8 +22,9 @@ import moderngl
 import numpy as np
 
 from lenslab.optics.aperture import APERTURE_KINDS, Aperture
-from lenslab.render import film, gl
+from lenslab.render import film, gl, kdtree_cache
 from lenslab.render.buffers import GpuScene, pack_scene
+from lenslab.render.instancing import INSTANCE_MIN_TRIANGLES, GroupCache
 from lenslab.render.denoise import MAX_MEMORY_MB
 from lenslab.render.features import GENERAL, KernelFeatures, scene_features
 from lenslab.render.gpu_layout import (ACCUMULATION_BINDING, APERTURE_TABLE_UNIT, DISPLAY_BINDING, FEATURE_ROWS,
@@ -32,7 +33,7 @@ from lenslab.render.gpu_layout import (ACCUMULATION_BINDING, APERTURE_TABLE_UNIT
 from lenslab.limits import SceneTooLarge, available_memory_bytes, format_bytes
 from lenslab.render.sobol import glsl_array_literal
 from lenslab.scene.camera import CameraFrame, ThinLensCamera
-from lenslab.scene.flatten import made_triangles
+from lenslab.scene.flatten import flatten_scene, made_triangles
 from lenslab.scene.scene import RenderSettings, Scene
 
 LOCAL_SIZE_X = 32  # GPU-NOTES: 32x1 work groups traversed the kd-tree fastest on llvmpipe
@@ -270,6 +271,32 @@ class Pick:
     depth: float  # distance along the view axis: what focus_distance_m must be for this point to be sharp
     prim: int
     node: object  # the scene Node that owns the primitive
+    node_index: int  # that node's index in the flattened scene's nodes (depth first)
+
+
+@dataclass(frozen=True)
+class SceneLoad:
+    """Where the time of the last set_scene went, in seconds, and what it made (the CLI's load line, the
+    benchmarks). ``place``: reading mesh files and placing every primitive (scene/flatten.py); ``trees``: building
+    or reading back the kd-trees; ``pack``: the rest of the packing (materials, lights, textures, joining the
+    layers); ``upload``: the buffers to the device; ``kernel``: choosing (and, the first time, compiling) it."""
+
+    place: float
+    trees: float
+    pack: float
+    upload: float
+    kernel: float
+    trees_built: int  # kd-trees built (the rest were kept from an earlier version of the scene, or read back)
+    trees_from_cache: int  # kd-trees read back from the on-disk cache
+
+    @property
+    def total(self) -> float:
+        return self.place + self.trees + self.pack + self.upload + self.kernel
+
+    def describe_steps(self) -> str:
+        """Every step but the trees' (which the CLI's load line names with the trees)."""
+        return (f"read and placed in {self.place:.2f} s, packed in {self.pack:.2f} s, uploaded in {self.upload:.2f} s, "
+                f"kernel ready in {self.kernel:.2f} s")
 
 
 @dataclass(frozen=True)
@@ -306,6 +333,7 @@ class RenderSession:
         self.feature_buffers = bool(feature_buffers)
         self._features = None
         self._aperture_table = ApertureTable(self.ctx)
+        self._groups = GroupCache()  # the mesh groups' trees and rows, kept across edits
         # How the camera frames the image: None, as the export does (camera.frame); a margin, as the studio's
         # viewport does, showing the export's frame and some of the scene around it (camera.view_frame).
         self.view_margin: float | None = None
@@ -324,25 +352,40 @@ class RenderSession:
         # and those of mesh files once read, before the kd-tree build: a scene too large is refused at once.
         made, largest = made_triangles(scene)
         self._check_triangle_count(made, f"the shapes made in code (node '{largest}' the most) make")
-        flat_scene = scene.flatten()
-        self._check_triangle_count(flat_scene.triangle_count, "the scene has")
+        start = time.perf_counter()
+        # Large meshes stay in their own space with trees of their own, kept from one edit to the next
+        # (render/instancing.py): an edit that leaves a mesh as it was never rebuilds its tree.
+        flat_scene = flatten_scene(scene, instance_min_triangles=INSTANCE_MIN_TRIANGLES,
+                                   known_groups=self._groups.known_groups())
+        self._check_triangle_count(flat_scene.stored_triangle_count, "the scene has")
+        placed = time.perf_counter()
         self.scene = scene
         self.settings = settings or scene.render
         self.flat_scene = flat_scene
         if (width, height) != (getattr(self, "width", None), getattr(self, "height", None)):
             self.region = None  # its pixels were another image's
-        packed = pack_scene(self.flat_scene, scene.environment, base_dir=scene.base_dir(), lights=scene.lights,
-                            environment_importance=self.environment_importance)
+        world_tree = kdtree_cache.kdtree(flat_scene.prim_bounds(), triangles=flat_scene.triangles)
+        packed_groups = self._groups.packed_groups(flat_scene)
+        trees = time.perf_counter()
+        packed = pack_scene(self.flat_scene, scene.environment, kdtree=world_tree, base_dir=scene.base_dir(),
+                            lights=scene.lights, environment_importance=self.environment_importance,
+                            packed_groups=packed_groups)
+        packing = time.perf_counter()
         # What the render survives but the user should hear about: unmapped mesh materials, missing textures.
         self.warnings = [*self.flat_scene.warnings, *packed.warnings]
         gpu_scene = GpuScene(self.ctx, packed, self.renderer.limits.max_storage_block_bytes)
         if self._gpu_scene is not None:
             self._gpu_scene.release()
         self._gpu_scene = gpu_scene
+        uploaded = time.perf_counter()
         self.width, self.height = width, height
         self.features = scene_features(packed) if self.specialise else GENERAL
         self.program = self._trace_program(self.settings.sampler)
         self.set_camera(scene.camera)
+        built = [world_tree, *self._groups.new_trees]
+        self.load = SceneLoad(place=placed - start, trees=trees - placed, pack=packing - trees, upload=uploaded - packing,
+                              kernel=time.perf_counter() - uploaded, trees_built=len(built),
+                              trees_from_cache=sum(tree.from_cache for tree in built))
 
     @in_context
     def set_camera(self, camera: ThinLensCamera) -> None:
@@ -616,8 +659,13 @@ class RenderSession:
         if prim < 0:
             return None
         point = origins[0] + float(hits.t[0]) * directions[0]
-        node = self.flat_scene.nodes[int(self.flat_scene.prim_node[prim])]
-        return Pick(point=point, depth=frame.depth_of(point), prim=prim, node=node)
+        node_index = int(self.hit_nodes(hits)[0])
+        return Pick(point=point, depth=frame.depth_of(point), prim=prim, node=self.flat_scene.nodes[node_index],
+                    node_index=node_index)
+
+    def hit_nodes(self, hits) -> np.ndarray:
+        """The index (into flat_scene.nodes) of the node each of cast_rays' hits landed on, -1 for none."""
+        return hits.nodes(self.flat_scene, self._gpu_scene.packed.first_world_prim)
 
     # -- reading the image --------------------------------------------------------------------------------
     @in_context

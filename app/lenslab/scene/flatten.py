@@ -2,23 +2,61 @@
 
 Primitives are numbered triangles first, then spheres; ``prim_node`` maps each back to the node that made it
 (so a click in the viewport can select a node).
+
+Large meshes may instead stay in their own space (``instance_min_triangles``): each becomes a ``MeshGroup``
+(its triangles once, however often it is placed) and a ``MeshInstance`` per placement (a transform), so that the
+renderer keeps a kd-tree per group and moving an object, or any edit elsewhere, never rebuilds it
+(docs/architecture.md, "Two levels"). The world-space arrays then hold everything else.
 """
 
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
 from lenslab.limits import LARGEST_NUMBER
-from lenslab.scene.materials import Material, walk_materials
+from lenslab.scene.materials import Mask, Material, walk_materials
 from lenslab.scene.scene import DEFAULT_MATERIAL, Node, Scene, SceneError
 from lenslab.scene.shapes import Box, Cylinder, Disk, MeshFile, Rectangle, Relief, Sphere, TriangleMesh
 from lenslab.scene.io.meshes import LoadedMesh, MeshLoadError, MeshPart
 from lenslab.scene.transform import transform_normals, transform_points
+
+
+@dataclass(frozen=True)
+class MeshGroup:
+    """Triangles in their own object space, placed in the world by one or more MeshInstances."""
+
+    key: tuple  # the same key, the same triangles: (id of the source mesh, smooth); see ``source``
+    triangles: np.ndarray  # (T, 3, 3) float32 object-space corners
+    triangle_normals: np.ndarray  # (T, 3, 3) float32 object-space shading normals at the corners
+    triangle_uvs: np.ndarray  # (T, 3, 2) float32
+    source: object = field(repr=False, compare=False)  # the mesh it was made from, kept alive: its id is in key
+
+    @property
+    def triangle_count(self) -> int:
+        return len(self.triangles)
+
+    def object_bounds(self) -> np.ndarray:
+        """(2, 3) box around the triangles in object space."""
+        if not len(self.triangles):
+            return np.zeros((2, 3), np.float32)
+        corners = self.triangles.reshape(-1, 3)
+        return np.stack([corners.min(axis=0), corners.max(axis=0)])
+
+
+@dataclass(frozen=True)
+class MeshInstance:
+    """One placement of a MeshGroup: object to world, the material of all its triangles, the node it belongs to."""
+
+    group: int  # index into FlatScene.groups
+    matrix: np.ndarray  # (4, 4) float64, object space to world
+    material: int  # index into FlatScene.materials
+    node: int  # index into FlatScene.nodes
+    bounds: np.ndarray  # (2, 3) float32 world box (the object box's corners, transformed)
 
 
 @dataclass(frozen=True)
@@ -34,10 +72,30 @@ class FlatScene:
     prim_node: np.ndarray  # (T + S,) int32 index into nodes
     nodes: list[Node]  # every node, depth first
     warnings: tuple[str, ...] = ()  # what could not be mapped from mesh files, once per material
+    # Large meshes kept in their own space (flatten_scene's instance_min_triangles); the arrays above are the rest.
+    groups: tuple[MeshGroup, ...] = ()
+    instances: tuple[MeshInstance, ...] = ()
 
     @property
     def triangle_count(self) -> int:
+        """Triangles in the world-space arrays (not those of the groups: see ``placed_triangle_count``)."""
         return len(self.triangles)
+
+    @property
+    def stored_triangle_count(self) -> int:
+        """Triangles the renderer stores: the world-space ones and each group's once."""
+        return self.triangle_count + sum(group.triangle_count for group in self.groups)
+
+    @property
+    def placed_triangle_count(self) -> int:
+        """Every triangle as the camera sees it: the world-space ones and each instance's."""
+        return self.triangle_count + sum(self.groups[i.group].triangle_count for i in self.instances)
+
+    def node_boxes(self) -> tuple[np.ndarray, np.ndarray]:
+        """World boxes of every primitive and instance, (N, 2, 3), and the node of each, (N,)."""
+        boxes = [self.prim_bounds()] + [i.bounds[None] for i in self.instances]
+        owners = [self.prim_node] + [np.array([i.node], np.int32) for i in self.instances]
+        return np.concatenate(boxes).astype(np.float32), np.concatenate(owners).astype(np.int32)
 
     @property
     def sphere_count(self) -> int:
@@ -57,12 +115,13 @@ class FlatScene:
     def bounds(self) -> np.ndarray:
         """(2, 3) box around every primitive: the union of prim_bounds, without making them (a million
         triangles' boxes take a fifth of a second)."""
-        if self.prim_count == 0:
+        if self.prim_count == 0 and not self.instances:
             return np.zeros((2, 3), np.float32)
         corners = self.triangles.reshape(-1, 3)
         c, r = self.spheres[:, :3], self.spheres[:, 3:4]
-        low = np.concatenate([corners, c - r]).astype(np.float32)
-        high = np.concatenate([corners, c + r]).astype(np.float32)
+        placed = np.array([i.bounds for i in self.instances], np.float32).reshape(-1, 2, 3)
+        low = np.concatenate([corners, c - r, placed[:, 0]]).astype(np.float32)
+        high = np.concatenate([corners, c + r, placed[:, 1]]).astype(np.float32)
         return np.stack([low.min(axis=0), high.max(axis=0)])
 
 
@@ -105,7 +164,12 @@ def made_triangles(scene: Scene) -> tuple[int, str]:
     return sum(count for count, _ in counts), max(counts)[1] if counts else ""
 
 
-def flatten_scene(scene: Scene, mesh_loader=None) -> FlatScene:
+def flatten_scene(scene: Scene, mesh_loader=None, instance_min_triangles: int | None = None,
+                  known_groups: dict | None = None) -> FlatScene:
+    """The scene's primitives in world space; with ``instance_min_triangles``, meshes of at least that many
+    triangles whose material neither emits nor cuts out stay in their own space as groups and instances
+    (emitters are sampled from world-space triangles, and cut-outs are tested while the tree is walked).
+    ``known_groups`` (key -> MeshGroup, from an earlier call) lends groups whose arrays need not be made again."""
     if mesh_loader is None:
         from lenslab.scene.io.meshes import load_mesh_parts as mesh_loader
 
@@ -136,8 +200,34 @@ def flatten_scene(scene: Scene, mesh_loader=None) -> FlatScene:
         return default_index
 
     tris, tri_normals, tri_uvs, tri_mat, tri_node = [], [], [], [], []
+    groups: list[MeshGroup] = []
+    group_index: dict[tuple, int] = {}
+    instances: list[MeshInstance] = []
+
+    def instanced(mesh: TriangleMesh, matrix: np.ndarray, mat: int, node_index: int) -> bool:
+        """Place a large mesh as an instance of its group, when it may be one."""
+        if instance_min_triangles is None or mesh.triangle_count < instance_min_triangles:
+            return False
+        if any(isinstance(m, Mask) or m.emits for m in walk_materials(materials[mat])):
+            return False
+        key = (id(mesh), mesh.normals is not None)
+        if key not in group_index:
+            group = (known_groups or {}).get(key) or _mesh_group(key, mesh, nodes[node_index])
+            group_index[key] = len(groups)
+            groups.append(group)
+        group = group_index[key]
+        box = groups[group].object_bounds().astype(np.float64)
+        corners = np.array([[box[i, 0], box[j, 1], box[k, 2]] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
+        with np.errstate(over="ignore", invalid="ignore"):
+            placed = transform_points(matrix, corners)
+        _check_in_world(placed, nodes[node_index])
+        bounds = np.stack([placed.min(axis=0), placed.max(axis=0)]).astype(np.float32)
+        instances.append(MeshInstance(group, np.asarray(matrix, np.float64), mat, node_index, bounds))
+        return True
 
     def add_mesh(mesh: TriangleMesh, matrix: np.ndarray, mat: int, node_index: int) -> None:
+        if instanced(mesh, matrix, mat, node_index):
+            return
         with np.errstate(over="ignore", invalid="ignore"):  # overflow is found and named just below
             corners = transform_points(matrix, mesh.vertices)[mesh.faces]
         _check_in_world(corners, nodes[node_index])
@@ -204,7 +294,21 @@ def flatten_scene(scene: Scene, mesh_loader=None) -> FlatScene:
         prim_node=np.concatenate([triangle_node, np.asarray(sph_node, np.int32)]),
         nodes=nodes,
         warnings=tuple(warnings),
+        groups=tuple(groups),
+        instances=tuple(instances),
     )
+
+
+def _mesh_group(key: tuple, mesh: TriangleMesh, node: Node) -> MeshGroup:
+    """A mesh's triangles in its own space, as flatten_scene's add_mesh makes them in the world's."""
+    corners = np.asarray(mesh.vertices, np.float64)[mesh.faces]
+    normals = mesh.normals[mesh.faces] if mesh.normals is not None else _flat_normals(corners)
+    uvs = mesh.uvs[mesh.faces] if mesh.uvs is not None else np.zeros((len(mesh.faces), 3, 2))
+    _check_in_world(corners, node)
+    for what, values in (("normals", normals), ("texture coordinates", uvs)):
+        _check_finite_attribute(what, [values], np.zeros(len(values), np.int32), [node])
+    return MeshGroup(key, corners.astype(np.float32), np.asarray(normals, np.float32), np.asarray(uvs, np.float32),
+                     source=mesh)
 
 
 def _check_in_world(values: np.ndarray, node: Node) -> None:

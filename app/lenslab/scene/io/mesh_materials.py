@@ -62,7 +62,7 @@ import numpy as np
 
 from lenslab.color import srgb_to_linear
 from lenslab.image_files import read_pixels
-from lenslab.scene.io.meshes import LoadedMesh, MeshLoadError, MeshPart, check_geometry
+from lenslab.scene.io.meshes import LoadedMesh, MeshLoadError, MeshPart, check_geometry, smooth_normals
 from lenslab.scene.io.mitsuba_serialized import read_serialized
 from lenslab.scene.materials import Conductor, Dielectric, Diffuse, Emissive, Material, Plastic
 from lenslab.scene.shapes import TriangleMesh
@@ -154,16 +154,33 @@ def _load(path: Path, smooth: bool, shape_index: int = 0) -> LoadedMesh:
 
 def _baked(geometry, matrix: np.ndarray, smooth: bool, path: Path) -> TriangleMesh:
     faces = np.asarray(geometry.faces, dtype=np.int64)
-    check_geometry(np.asarray(geometry.vertices, dtype=np.float64), faces, path)
-    with np.errstate(over="ignore", invalid="ignore"):  # a glTF node's matrix could still overflow: checked next
-        vertices = transform_points(matrix, np.asarray(geometry.vertices, dtype=np.float64))
+    vertices = np.asarray(geometry.vertices, dtype=np.float64)
     check_geometry(vertices, faces, path)
-    normals = transform_normals(matrix, np.asarray(geometry.vertex_normals, dtype=np.float64)) if smooth else None
+    if not np.array_equal(matrix, np.eye(4)):  # a glTF node's transform (most files have none)
+        with np.errstate(over="ignore", invalid="ignore"):  # it could still overflow: checked next
+            vertices = transform_points(matrix, vertices)
+        check_geometry(vertices, faces, path)
+    normals = None
+    if smooth:
+        normals = _file_normals(geometry)
+        normals = smooth_normals(vertices, faces) if normals is None else transform_normals(matrix, normals)
     if np.linalg.det(matrix[:3, :3]) < 0:  # a mirroring transform: keep the front faces in front
         faces = faces[:, ::-1]
     uvs = getattr(geometry.visual, "uv", None)
     uvs = np.asarray(uvs, dtype=np.float64) if uvs is not None and len(uvs) == len(vertices) else None
     return TriangleMesh(vertices, faces, normals, uvs)
+
+
+def _file_normals(geometry) -> np.ndarray | None:
+    """The vertex normals the file gave (a PLY's nx ny nz, an OBJ's vn, a glTF's NORMAL), or None.
+
+    trimesh keeps given normals in its cache under the property's name and makes them on demand otherwise; its
+    own way is slow on large meshes (a sparse matrix, and hashes of the arrays at every cache look-up), so the
+    look-up goes to the cache's dictionary and missing normals are made by meshes.smooth_normals."""
+    normals = getattr(getattr(geometry, "_cache", None), "cache", {}).get("vertex_normals")
+    if normals is None or np.shape(normals) != np.shape(geometry.vertices):
+        return None
+    return np.asarray(normals, dtype=np.float64)
 
 
 def _concatenate(meshes: list[TriangleMesh]) -> TriangleMesh:
