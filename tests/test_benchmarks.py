@@ -27,7 +27,7 @@ def test_vs_mitsuba_renders_every_scene_with_both_samplers(renderer, tmp_path):
     assert {(row[0], row[2]) for row in rows} == {(scene, sampler) for scene in
                                                    ("cornell_dof", "dof_lights", "glass_metal_envmap", "million_triangles")
                                                    for sampler in ("independent", "sobol")}
-    assert all(float(row[3]) > 0 and float(row[4]) > 0 for row in rows)  # seconds and samples per second
+    assert all(float(row[3]) > 0 and float(row[4]) > 0 and float(row[5]) > 0 for row in rows)  # cold, warm, rate
     assert list((tmp_path / "cache").glob("torus_outward_2000.ply"))
 
 
@@ -55,3 +55,27 @@ def test_denoise_convergence_prints_seconds_per_scene_and_metric(renderer, tmp_p
     assert len(rows) == 8 and {row[2] for row in rows} == {"relMSE", "display"}  # two thresholds each
     assert len(list((tmp_path / "cache").glob("denoise_reference_*.npy"))) == 2
     assert "16x16" in out and "Open Image Denoise" in out
+
+
+@pytest.mark.gl
+def test_studio_edits_times_each_edit_with_two_levels_and_one(renderer, tmp_path):
+    out = run("studio_edits.py", "--scenes", "cornell_ball", "--triangles", 20000, "--width", 16, "--repeat", 1,
+              "--cache", tmp_path / "cache", tmp_path=tmp_path)
+    rows = {line.split("  ")[0].strip(): line.split() for line in out.splitlines()
+            if line.startswith(("open", "material", "move", "hide"))}
+    assert set(rows) == {"open", "material", "move small", "move large", "hide small"}
+    for edit, row in rows.items():
+        numbers = [word for word in row if word.endswith("s") and word[:-1].replace(".", "").isdigit()]
+        assert len(numbers) == 2 and all(float(n[:-1]) > 0 for n in numbers), (edit, row)
+    # With two levels the opening builds the ball's tree, and no edit after it does (the last column).
+    assert rows["open"][-1] == "1" and all(row[-1] == "0" for edit, row in rows.items() if edit != "open"), out
+
+
+@pytest.mark.gl
+def test_mesh_open_prints_a_rate_for_every_format_and_step(tmp_path):
+    out = run("mesh_open.py", "--triangles", 2000, "--repeat", 1, tmp_path=tmp_path)
+    steps = ("read ply", "read ply-ascii", "read obj", "read glb", "read serialized", "place (a mesh group)",
+             "kd-tree, compiled build", "kd-tree, levels build", "pack rows")
+    for step in steps:
+        line = next(line for line in out.splitlines() if line.startswith(step))
+        assert float(line.split()[-1]) > 0 and float(line.split()[-2]) > 0, line

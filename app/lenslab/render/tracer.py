@@ -286,8 +286,9 @@ class SceneLoad:
     pack: float
     upload: float
     kernel: float
-    trees_built: int  # kd-trees built (the rest were kept from an earlier version of the scene, or read back)
-    trees_from_cache: int  # kd-trees read back from the on-disk cache
+    trees_built: int  # kd-trees built or read back (the world's, and the mesh groups' not kept from before)
+    trees_from_cache: int  # of those, read back from the on-disk cache
+    mesh_trees_built: int  # of those, mesh groups' (render/instancing.py): 0 after an edit that kept every mesh
 
     @property
     def total(self) -> float:
@@ -385,7 +386,8 @@ class RenderSession:
         built = [world_tree, *self._groups.new_trees]
         self.load = SceneLoad(place=placed - start, trees=trees - placed, pack=packing - trees, upload=uploaded - packing,
                               kernel=time.perf_counter() - uploaded, trees_built=len(built),
-                              trees_from_cache=sum(tree.from_cache for tree in built))
+                              trees_from_cache=sum(tree.from_cache for tree in built),
+                              mesh_trees_built=self._groups.built)
 
     @in_context
     def set_camera(self, camera: ThinLensCamera) -> None:
