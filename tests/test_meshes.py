@@ -74,3 +74,22 @@ def test_a_whole_mesh_file_reads_as_one_mesh_with_its_texture_coordinates(tmp_pa
     assert len(joined.faces) == 2 and joined.faces.max() < len(joined.vertices)
     assert sorted(map(tuple, joined.vertices[joined.faces].reshape(-1, 3).round(6).tolist())) == sorted(
         [(0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)])
+
+
+@pytest.mark.parametrize("compiled", [False, True])
+def test_smooth_normals_are_trimeshs_angle_weighted_normals(compiled, monkeypatch):
+    """A file without normals gets the normals trimesh (and Mitsuba) would make, made faster here; faces of zero
+    area add nothing, and a vertex only they use gets none."""
+    from lenslab.scene.io import meshes
+
+    monkeypatch.setattr(meshes, "COMPILED_NORMALS_MIN_FACES", 0 if compiled else 1 << 40)
+    ball = trimesh.creation.icosphere(subdivisions=3)
+    rng = np.random.default_rng(4)
+    vertices = ball.vertices * (1 + 0.2 * rng.uniform(-1, 1, (len(ball.vertices), 1)))
+    faces = np.concatenate([ball.faces, [[0, 0, 1]], [[len(vertices), len(vertices) + 1, len(vertices)]]])
+    vertices = np.concatenate([vertices, [[5.0, 5.0, 5.0], [6.0, 6.0, 6.0]]])  # two vertices of a degenerate face
+    expected = trimesh.Trimesh(vertices[: len(ball.vertices)], ball.faces, process=False).vertex_normals
+    normals = meshes.smooth_normals(vertices, faces)
+    assert normals.shape == vertices.shape
+    assert np.abs(normals[: len(ball.vertices)] - expected).max() < 1e-5
+    assert (normals[len(ball.vertices):] == 0).all()

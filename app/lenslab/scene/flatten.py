@@ -34,18 +34,12 @@ class MeshGroup:
     triangles: np.ndarray  # (T, 3, 3) float32 object-space corners
     triangle_normals: np.ndarray  # (T, 3, 3) float32 object-space shading normals at the corners
     triangle_uvs: np.ndarray  # (T, 3, 2) float32
+    object_bounds: np.ndarray  # (2, 3) float32 box around the triangles in object space
     source: object = field(repr=False, compare=False)  # the mesh it was made from, kept alive: its id is in key
 
     @property
     def triangle_count(self) -> int:
         return len(self.triangles)
-
-    def object_bounds(self) -> np.ndarray:
-        """(2, 3) box around the triangles in object space."""
-        if not len(self.triangles):
-            return np.zeros((2, 3), np.float32)
-        corners = self.triangles.reshape(-1, 3)
-        return np.stack([corners.min(axis=0), corners.max(axis=0)])
 
 
 @dataclass(frozen=True)
@@ -216,7 +210,7 @@ def flatten_scene(scene: Scene, mesh_loader=None, instance_min_triangles: int | 
             group_index[key] = len(groups)
             groups.append(group)
         group = group_index[key]
-        box = groups[group].object_bounds().astype(np.float64)
+        box = groups[group].object_bounds.astype(np.float64)
         corners = np.array([[box[i, 0], box[j, 1], box[k, 2]] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
         with np.errstate(over="ignore", invalid="ignore"):
             placed = transform_points(matrix, corners)
@@ -300,15 +294,24 @@ def flatten_scene(scene: Scene, mesh_loader=None, instance_min_triangles: int | 
 
 
 def _mesh_group(key: tuple, mesh: TriangleMesh, node: Node) -> MeshGroup:
-    """A mesh's triangles in its own space, as flatten_scene's add_mesh makes them in the world's."""
-    corners = np.asarray(mesh.vertices, np.float64)[mesh.faces]
-    normals = mesh.normals[mesh.faces] if mesh.normals is not None else _flat_normals(corners)
-    uvs = mesh.uvs[mesh.faces] if mesh.uvs is not None else np.zeros((len(mesh.faces), 3, 2))
-    _check_in_world(corners, node)
-    for what, values in (("normals", normals), ("texture coordinates", uvs)):
-        _check_finite_attribute(what, [values], np.zeros(len(values), np.int32), [node])
-    return MeshGroup(key, corners.astype(np.float32), np.asarray(normals, np.float32), np.asarray(uvs, np.float32),
-                     source=mesh)
+    """A mesh's triangles in its own space, as flatten_scene's add_mesh makes them in the world's. The checks run
+    on the vertices (each once) and the arrays are gathered straight into float32: a million triangles take a
+    few tenths of a second less than through float64 corners."""
+    vertices = np.asarray(mesh.vertices)
+    _check_in_world(vertices, node)
+    for what, values in (("normals", mesh.normals), ("texture coordinates", mesh.uvs)):
+        if values is not None:
+            _check_finite_attribute(what, [values[mesh.faces]], np.zeros(len(mesh.faces), np.int32), [node])
+    corners = vertices.astype(np.float32)[mesh.faces]
+    normals = (np.asarray(mesh.normals, np.float32)[mesh.faces] if mesh.normals is not None else
+               _flat_normals(corners).astype(np.float32))
+    uvs = (np.asarray(mesh.uvs, np.float32)[mesh.faces] if mesh.uvs is not None else
+           np.zeros((len(mesh.faces), 3, 2), np.float32))
+    referenced = np.zeros(len(vertices), bool)
+    referenced[mesh.faces.ravel()] = True  # vertices no face uses stay out of the box
+    used = vertices[referenced] if len(mesh.faces) else np.zeros((1, 3))
+    bounds = np.stack([used.min(axis=0), used.max(axis=0)]).astype(np.float32)
+    return MeshGroup(key, corners, normals, uvs, bounds, source=mesh)
 
 
 def _check_in_world(values: np.ndarray, node: Node) -> None:
@@ -334,7 +337,9 @@ def _check_finite_attribute(what: str, parts: list[np.ndarray], triangle_node: n
     node of the first triangle whose value is not a finite number, before it reaches the GPU as a NaN."""
     if not parts:
         return
-    values = np.concatenate(parts)
+    values = np.concatenate(parts) if len(parts) > 1 else parts[0]
+    if np.isfinite(values).all():  # one pass over the whole array; the rows are looked at only to name one
+        return
     bad = ~np.isfinite(values.reshape(len(values), -1)).all(axis=1)
     if bad.any():
         node = nodes[int(triangle_node[int(np.argmax(bad))])]

@@ -18,6 +18,7 @@ from lenslab.scene.materials import Material
 from lenslab.scene.shapes import TriangleMesh
 
 MESH_SUFFIXES = (".obj", ".ply", ".gltf", ".glb", ".stl", ".off")
+COMPILED_NORMALS_MIN_FACES = 200_000
 
 
 class MeshLoadError(ValueError):
@@ -60,25 +61,35 @@ def smooth_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     (Thuermer and Wuethrich 1998, as trimesh and Mitsuba make them). Faces of zero area add nothing; a vertex
     that only such faces use gets a zero normal (glsl/surface.glsl then shades with the face's own).
 
-    Whole-array numpy (one gather, one bincount per coordinate): about ten times faster than trimesh's
-    vertex_normals, which builds a sparse matrix and hashes its arrays on the way."""
-    corners = vertices[faces]  # (F, 3, 3)
-    edges = np.roll(corners, -1, axis=1) - corners  # edge k runs from corner k to corner k + 1
-    normal = np.cross(edges[:, 0], edges[:, 1])
-    length = np.linalg.norm(normal, axis=1)
+    Whole-array numpy in float32 (the precision the GPU shades with): one gather, one bincount per coordinate;
+    several times faster than trimesh's vertex_normals, which builds a sparse matrix and hashes its arrays. Meshes
+    of ``COMPILED_NORMALS_MIN_FACES`` or more go to the same sum in compiled code (normals_compiled.py), which
+    is faster again once numba's machine code is loaded (a fraction of a second, once a process).
+    """
+    if len(faces) >= COMPILED_NORMALS_MIN_FACES:
+        from lenslab.scene.io.normals_compiled import smooth_normals as compiled
+
+        return compiled(np.ascontiguousarray(vertices), np.ascontiguousarray(faces))
+    corners = np.asarray(vertices, np.float32)[faces]  # (F, 3, 3)
+    a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
+    ab, bc, ca = b - a, c - b, a - c  # edge k runs from corner k to corner k + 1
+    normal = np.cross(ab, -ca)
+    length = np.sqrt(np.einsum("fc,fc->f", normal, normal))
     with np.errstate(invalid="ignore", divide="ignore"):
-        unit = np.where(length[:, None] > 0, normal / length[:, None], 0.0)
-    # The angle at corner k, between the edges leaving it (k) and arriving at it (k - 1, reversed).
-    outgoing, incoming = edges, -np.roll(edges, 1, axis=1)
-    dot = np.einsum("fkc,fkc->fk", outgoing, incoming)
-    angle = np.arctan2(length[:, None], dot)  # |a x b| is twice the area at every corner
-    summed = np.empty((len(vertices), 3))
+        normal /= np.where(length > 0, length, np.inf)[:, None]
+    # The angle at each corner, between the edges leaving and arriving there: atan2(|a x b|, a . b), where
+    # |a x b| is twice the face's area at every corner.
+    angles = np.arctan2(length[:, None], -np.stack([np.einsum("fc,fc->f", ab, ca), np.einsum("fc,fc->f", bc, ab),
+                                                    np.einsum("fc,fc->f", ca, bc)], axis=1))
+    summed = np.empty((len(vertices), 3), np.float32)
     index = faces.ravel()
-    for c in range(3):
-        summed[:, c] = np.bincount(index, weights=(angle * unit[:, None, c]).ravel(), minlength=len(vertices))
-    norm = np.linalg.norm(summed, axis=1, keepdims=True)
+    for k in range(3):
+        weights = (angles * normal[:, k, None]).ravel()
+        summed[:, k] = np.bincount(index, weights=weights, minlength=len(vertices))
+    norm = np.sqrt(np.einsum("vc,vc->v", summed, summed))
     with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(norm > 0, summed / norm, 0.0)
+        summed /= np.where(norm > 0, norm, np.inf)[:, None]
+    return summed
 
 
 def load_mesh_parts(path: Path, smooth: bool = True, shape_index: int = 0) -> LoadedMesh:
