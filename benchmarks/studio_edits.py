@@ -10,6 +10,9 @@ the device), and where the time went (render/tracer.SceneLoad). Edits:
 * ``move large``: the million-triangle object moved by a millimetre;
 * ``hide small``: a small object removed.
 
+Columns after the two times: the two-level run's seconds in each step of set_scene (render/tracer.SceneLoad) and in
+sampling the first pass, the megabytes it sent to the device, and the mesh trees it built.
+
 Each edit is timed with two levels (the default: large meshes keep their own trees, render/instancing.py) and
 with one (every triangle in one world-space tree, as before), in the same run, and the ratio printed. Scenes:
 ``marbles_on_sand`` (a million triangles of sand made in code) and a Cornell box holding a bumpy ball of
@@ -117,12 +120,13 @@ def run_scene(renderer, name: str, scene: Scene, small: str, large: str, materia
     print(f"\n{name}: {scene.camera.resolution[0]}x{scene.camera.resolution[1]}, first sample after each edit "
           f"(median of {repeat}); where the time went in the two-level run")
     print(f"{'edit':<12} {'two levels':>11} {'one level':>10} {'speed-up':>9}   "
-          f"{'place':>6} {'trees':>6} {'pack':>6} {'upload':>6} {'kernel':>6} mesh trees built")
+          f"{'place':>6} {'trees':>6} {'pack':>6} {'upload':>6} {'kernel':>6} {'sample':>6} {'MB sent':>8} mesh trees built")
     for edit in results["two levels"]:
         two, load = results["two levels"][edit]
         one, _ = results["one level"][edit]
         print(f"{edit:<12} {two:>10.3f}s {one:>9.3f}s {one / two:>8.1f}x   {load.place:>6.3f} {load.trees:>6.3f} "
-              f"{load.pack:>6.3f} {load.upload:>6.3f} {load.kernel:>6.3f} {load.mesh_trees_built}")
+              f"{load.pack:>6.3f} {load.upload:>6.3f} {load.kernel:>6.3f} {two - load.total:>6.3f} "
+              f"{load.uploaded_bytes / 1e6:>8.1f} {load.mesh_trees_built}")
     sys.stdout.flush()
 
 

@@ -146,9 +146,12 @@ def test_edits_that_leave_a_mesh_as_it_was_rebuild_no_tree(renderer, bumpy_ball,
         session.set_scene(moved)
         assert session._groups.built == 0, "moving an object keeps its mesh's tree"
         assert session.gpu_scene.packed.group_trees[0] is first.group_trees[0]
+        group_bytes = sum(part.nbytes for name in ("kd_nodes", "prim_refs", "geometry", "shading")
+                          for part in session.gpu_scene.packed.arrays[name][:1])
         recoloured = dataclasses.replace(moved, materials={**moved.materials, "clay": Diffuse(albedo=(0.1, 0.2, 0.9))})
         session.set_scene(recoloured)
         assert session._groups.built == 0, "a material edit keeps every tree"
+        assert session.load.uploaded_bytes < group_bytes / 10, "and sends none of the mesh's rows to the device"
         reassigned = dataclasses.replace(recoloured, nodes=[dataclasses.replace(recoloured.nodes[0], material="paint"),
                                                             *recoloured.nodes[1:]])
         session.set_scene(reassigned)
@@ -212,3 +215,39 @@ def test_a_relief_moved_keeps_its_tree_and_small_scenes_stay_one_level(renderer)
         assert not session.flat_scene.groups and not scene_features(session.gpu_scene.packed).instances
     finally:
         session.release()
+
+
+def test_an_edited_session_renders_what_a_new_one_does(renderer, bumpy_ball, monkeypatch):
+    """Buffers kept or rewritten in part after an edit (buffers.GpuScene) hold what a new session would upload:
+    the same image, sample for sample."""
+    monkeypatch.setattr(instancing, "INSTANCE_MIN_TRIANGLES", 1000)
+    import lenslab.render.tracer as tracer
+
+    monkeypatch.setattr(tracer, "INSTANCE_MIN_TRIANGLES", 1000)
+    scene = placed_balls(bumpy_ball, TRANSFORMS[:2])
+    edited = replace_marble(scene, Transform(translate=(-0.3, -0.4, 0.9)))  # a world sphere moved
+    edited = dataclasses.replace(edited, materials={**edited.materials, "clay": Diffuse(albedo=(0.2, 0.6, 0.3))})
+
+    def image(session):
+        while not session.done(2):
+            session.step(1.0, target_spp=2)
+        return session.image()
+
+    session = RenderSession(renderer, scene)
+    try:
+        image(session)
+        session.set_scene(edited)
+        assert session.load.uploaded_bytes < session.gpu_scene.packed.nbytes / 4
+        kept = image(session)
+    finally:
+        session.release()
+    fresh = RenderSession(renderer, edited)
+    try:
+        assert np.array_equal(kept, image(fresh))
+    finally:
+        fresh.release()
+
+
+def replace_marble(scene: Scene, transform: Transform) -> Scene:
+    return dataclasses.replace(scene, nodes=[dataclasses.replace(node, transform=transform) if node.name == "marble"
+                                             else node for node in scene.nodes])

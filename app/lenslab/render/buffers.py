@@ -315,9 +315,10 @@ def _reference_budget_warning(kdtree: KdTree) -> str:
 
 @dataclass(frozen=True)
 class PackedScene:
-    """Everything the trace kernel reads about the scene, as arrays and uniform values."""
+    """Everything the trace kernel reads about the scene, as arrays and uniform values. A buffer made of parts
+    laid one after another (the mesh groups' and the world's, render/instancing.py) is a tuple of arrays."""
 
-    arrays: dict[str, np.ndarray]
+    arrays: dict[str, np.ndarray | tuple[np.ndarray, ...]]
     uniforms: dict[str, object]
     kdtree: KdTree  # the world's own primitives' tree
     prim_count: int  # rows of the geometry buffer: the groups' triangles, the world's, its spheres
@@ -333,21 +334,39 @@ class PackedScene:
 
     @property
     def nbytes(self) -> int:
-        return sum(a.nbytes for a in self.arrays.values())
+        return sum(buffer_bytes(a) for a in self.arrays.values())
+
+    def world_geometry(self) -> np.ndarray:
+        """The world's own primitives' geometry rows, (P, GEOMETRY_ROWS, 4)."""
+        rows = self.arrays["geometry"]
+        rows = rows[-1] if isinstance(rows, tuple) else rows
+        count = self.prim_count - self.first_world_prim
+        return rows.reshape(-1, 4)[: GEOMETRY_ROWS * count].reshape(count, GEOMETRY_ROWS, 4)
+
+
+def buffer_parts(value) -> tuple[np.ndarray, ...]:
+    """A packed buffer as its parts (one, or the tuple it is)."""
+    return value if isinstance(value, tuple) else (value,)
+
+
+def buffer_bytes(value) -> int:
+    return sum(part.nbytes for part in buffer_parts(value))
 
 
 def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None = None,
                base_dir: Path | None = None, lights: Sequence[Light] = (),
-               environment_importance: bool = True, packed_groups: Sequence[PackedGroup] | None = None) -> PackedScene:
+               environment_importance: bool = True, packed_groups: Sequence[PackedGroup] | None = None,
+               group_cache: GroupCache | None = None) -> PackedScene:
     """Arrays and uniforms for the trace kernel; ``base_dir`` resolves relative texture paths.
     ``environment_importance=False`` samples an environment map uniformly (to measure what importance
     sampling gains). ``kdtree`` is the world's own primitives' tree (built here when None); ``packed_groups`` are
-    the mesh groups' trees and rows (render/instancing.py; a GroupCache keeps them from one edit to the next), packed
-    here when None."""
+    the mesh groups' trees and rows (render/instancing.py; ``group_cache``, a GroupCache, keeps them and their
+    moved trees from one edit to the next), packed here when None."""
     if kdtree is None:
         kdtree = kdtree_cache.kdtree(flat.prim_bounds(), triangles=flat.triangles)
+    group_cache = group_cache or GroupCache()
     if packed_groups is None:
-        packed_groups = GroupCache().packed_groups(flat)
+        packed_groups = group_cache.packed_groups(flat)
     first_world_prim = sum(len(g.geometry) for g in packed_groups)
     n_tri, n_prim = flat.triangle_count, flat.prim_count
     material_ids = np.concatenate([flat.triangle_material, flat.sphere_material]).astype(np.int32)
@@ -416,11 +435,14 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
     geometry[n_tri:, 0] = flat.spheres
     geometry[n_tri:, 1, 3] = material_ids[n_tri:].view(np.float32)
     geometry[n_tri:, 2, 3] = light_of_prim[n_tri:].view(np.float32)
-    layers = join_layers(packed_groups, flat, kdtree, geometry, shading)
+    layers = join_layers(packed_groups, flat, kdtree, geometry, shading, group_cache)
 
     material_rows = MaterialTable(flat.materials, textures, flat.material_names).rows()
 
-    def at_least_one(a: np.ndarray) -> np.ndarray:  # GL refuses zero-sized buffers
+    def at_least_one(a):  # GL refuses zero-sized buffers
+        if isinstance(a, tuple):
+            parts = tuple(np.ascontiguousarray(part) for part in a)
+            return parts if sum(part.nbytes for part in parts) else (np.zeros(4, parts[-1].dtype),)
         return a if a.size else np.zeros(4, a.dtype)
 
     arrays = {
@@ -434,7 +456,7 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
         "light_choice": light_choice,
         "image_data": textures.texels(),
     }
-    arrays = {name: at_least_one(np.ascontiguousarray(a)) for name, a in arrays.items()}
+    arrays = {name: at_least_one(a if isinstance(a, tuple) else np.ascontiguousarray(a)) for name, a in arrays.items()}
     uniforms = {
         "triangle_count": layers.triangle_count,
         "scene_min": tuple(float(v) for v in kdtree.bounds[0]),
@@ -451,16 +473,21 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
     }
     tree_warnings = [_reference_budget_warning(tree) for tree in (*(g.tree for g in packed_groups), kdtree)
                      if tree.budget_leaves]
-    return PackedScene(arrays, uniforms, kdtree, len(layers.geometry), (*tree_warnings, *textures.warnings),
+    return PackedScene(arrays, uniforms, kdtree, sum(len(part) for part in layers.geometry),
+                       (*tree_warnings, *textures.warnings),
                        group_trees=tuple(g.tree for g in packed_groups), first_world_prim=layers.first_world_prim,
                        instance_materials=tuple(i.material for i in flat.instances))
 
 
 class GpuScene:
-    """The packed scene uploaded to a GL context; releases its buffers when done."""
+    """The packed scene uploaded to a GL context; releases its buffers when done.
 
-    def __init__(self, ctx, packed: PackedScene, max_block_bytes: int):
-        too_big = {name: a.nbytes for name, a in packed.arrays.items() if a.nbytes > max_block_bytes}
+    Made from the ``previous`` GpuScene of the same session (an edit), it keeps each buffer whose parts are the
+    same arrays as before and rewrites only the parts from the first that changed, in place where the buffer is
+    large enough: after a material edit or a move, a mesh group's rows and tree are not uploaded again."""
+
+    def __init__(self, ctx, packed: PackedScene, max_block_bytes: int, previous: GpuScene | None = None):
+        too_big = {name: buffer_bytes(a) for name, a in packed.arrays.items() if buffer_bytes(a) > max_block_bytes}
         if too_big:
             name, size = max(too_big.items(), key=lambda item: item[1])
             raise SceneTooLarge(
@@ -472,7 +499,43 @@ class GpuScene:
         self.packed = packed
         self.ctx = ctx
         make_current(ctx)
-        self.buffers = {name: ctx.buffer(a.tobytes()) for name, a in packed.arrays.items()}
+        self.buffers = {}
+        self.uploaded_bytes = 0  # what this scene sent to the device (the rest was kept from the previous one)
+        try:
+            for name, value in packed.arrays.items():
+                self.buffers[name] = self._upload(name, buffer_parts(value), previous)
+        except Exception:
+            # Some of the previous scene's buffers may be this one's now, or half rewritten: neither is usable.
+            self.release()
+            if previous is not None:
+                previous.release()
+            raise
+
+    def _upload(self, name: str, parts: tuple[np.ndarray, ...], previous: GpuScene | None):
+        total = sum(part.nbytes for part in parts)
+        kept = 0  # leading parts that are the very arrays the previous scene uploaded
+        if previous is not None and name in previous.buffers:
+            old = buffer_parts(previous.packed.arrays[name])
+            while kept < min(len(parts), len(old)) and parts[kept] is old[kept]:
+                kept += 1
+            buffer = previous.buffers[name]
+            if kept == len(parts) == len(old):
+                return previous.buffers.pop(name)
+            if kept and buffer.size >= total:
+                previous.buffers.pop(name)
+                self._write(buffer, parts, kept)
+                return buffer
+        buffer = self.ctx.buffer(reserve=total)
+        self._write(buffer, parts, 0)
+        return buffer
+
+    def _write(self, buffer, parts: tuple[np.ndarray, ...], first: int) -> None:
+        offset = sum(part.nbytes for part in parts[:first])
+        for part in parts[first:]:
+            if part.nbytes:
+                buffer.write(part.tobytes() if not part.flags.c_contiguous else part, offset=offset)
+            offset += part.nbytes
+            self.uploaded_bytes += part.nbytes
 
     def bind(self) -> None:  # callers (RenderSession.step, cast_rays) have made the context current
         for name, buffer in self.buffers.items():

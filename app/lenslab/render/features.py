@@ -89,8 +89,7 @@ def scene_features(packed: PackedScene) -> KernelFeatures:
     prim_count, triangle_count = packed.prim_count, int(uniforms["triangle_count"])
     materials = arrays["materials"][: int(uniforms["texture_base"])].reshape(-1, MATERIAL_ROWS, 4)
     # The world's primitives name their materials; a mesh group's triangles take their instance's.
-    rows = arrays["geometry"].reshape(-1, 4)  # (an empty scene's buffer is one placeholder row)
-    world_rows = rows[GEOMETRY_ROWS * packed.first_world_prim + 1:GEOMETRY_ROWS * prim_count:GEOMETRY_ROWS, 3]
+    world_rows = packed.world_geometry()[:, 1, 3]
     used = np.union1d(np.unique(world_rows.view(np.int32)), np.asarray(packed.instance_materials, np.int32))
     # The records primitives name, and every record those hold (a blend's two, a light's surface ...).
     records = materials[np.asarray(sorted(held_materials(materials, used)), dtype=np.int64)]

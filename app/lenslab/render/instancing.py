@@ -72,6 +72,15 @@ def pack_group(group: MeshGroup) -> PackedGroup:
     return PackedGroup(tree, geometry, shading)
 
 
+@dataclass(frozen=True)
+class PlacedGroup:
+    """A packed group's tree as it reads from its place in the scene's buffers (moved_tree)."""
+
+    place: tuple[int, int, int]  # first node, first reference, first primitive
+    nodes: np.ndarray
+    refs: np.ndarray
+
+
 class GroupCache:
     """Packed groups by key, kept from one version of a scene to the next (a RenderSession holds one).
 
@@ -84,6 +93,7 @@ class GroupCache:
     def __init__(self):
         self._packed: dict[tuple, PackedGroup] = {}
         self._groups: dict[tuple, MeshGroup] = {}
+        self._placed: dict[int, PlacedGroup] = {}  # by id of the PackedGroup, while it is in _packed
         self.new_trees: list[KdTree] = []
 
     @property
@@ -102,17 +112,30 @@ class GroupCache:
                 self.new_trees.append(self._packed[group.key].tree)
             packed[group.key], groups[group.key] = self._packed[group.key], group
         self._packed, self._groups = packed, groups
+        kept = {id(group) for group in packed.values()}
+        self._placed = {key: placed for key, placed in self._placed.items() if key in kept}
         return [packed[group.key] for group in flat.groups]
+
+    def placed(self, group: PackedGroup, place: tuple[int, int, int]) -> PlacedGroup:
+        """The group's tree moved to ``place``: the same arrays as last time where the place is the same."""
+        placed = self._placed.get(id(group))
+        if placed is None or placed.place != place:
+            placed = PlacedGroup(place, *moved_tree(group.tree, *place))
+            if id(group) in {id(g) for g in self._packed.values()}:
+                self._placed[id(group)] = placed
+        return placed
 
 
 @dataclass(frozen=True)
 class Layers:
-    """The scene's trees and rows joined into the buffers' layout (see the module docstring)."""
+    """The scene's trees and rows in the buffers' layout (see the module docstring), each buffer as its parts in
+    order: a part per group, then the world's. A group's parts are the same arrays from one edit to the next
+    while the groups before it are the same, so GpuScene uploads only the parts that changed."""
 
-    kd_nodes: np.ndarray  # (M, 2) uint32
-    prim_refs: np.ndarray  # (R,) int32
-    geometry: np.ndarray  # (P, GEOMETRY_ROWS, 4) float32: the groups' triangles, the world's, its spheres
-    shading: np.ndarray  # (T, SHADING_ROWS, 4) float32
+    kd_nodes: tuple[np.ndarray, ...]  # (M_i, 2) uint32 each
+    prim_refs: tuple[np.ndarray, ...]  # (R_i,) int32 each
+    geometry: tuple[np.ndarray, ...]  # (P_i, GEOMETRY_ROWS, 4) float32: the groups' triangles, the world's, its spheres
+    shading: tuple[np.ndarray, ...]  # (T_i, SHADING_ROWS, 4) float32
     instances: np.ndarray  # (I, INSTANCE_ROWS, 4) float32
     world_root: int
     first_world_prim: int  # the world's own primitive i is row first_world_prim + i
@@ -149,35 +172,30 @@ def instance_rows(flat: FlatScene, roots: list[int], boxes: list[np.ndarray]) ->
 
 
 def join_layers(packed_groups: list[PackedGroup], flat: FlatScene, world_tree: KdTree, world_geometry: np.ndarray,
-                world_shading: np.ndarray) -> Layers:
-    """The groups' and the world's trees and rows in one set of buffers (see the module docstring)."""
+                world_shading: np.ndarray, cache: GroupCache | None = None) -> Layers:
+    """The groups' and the world's trees and rows in one set of buffers (see the module docstring). ``cache``
+    keeps the groups' moved trees, so that an unchanged group gives the same arrays as last time."""
+    cache = cache or GroupCache()
     node_parts, ref_parts, roots, boxes = [], [], [], []
     first_node = first_ref = first_prim = 0
     for group in packed_groups:
-        nodes, refs = moved_tree(group.tree, first_node, first_ref, first_prim)
-        node_parts.append(nodes)
-        ref_parts.append(refs)
+        placed = cache.placed(group, (first_node, first_ref, first_prim))
+        node_parts.append(placed.nodes)
+        ref_parts.append(placed.refs)
         roots.append(first_node)
         boxes.append(group.tree.bounds)
-        first_node += len(nodes)
-        first_ref += len(refs)
+        first_node += len(placed.nodes)
+        first_ref += len(placed.refs)
         first_prim += len(group.geometry)
     group_triangles = first_prim
     # The world's primitives follow the groups' triangles, its spheres after its triangles: every world primitive
     # moves by the groups' triangle count.
     nodes, refs = moved_tree(world_tree, first_node, first_ref, group_triangles)
-    node_parts.append(nodes)
-    ref_parts.append(refs)
-    if packed_groups:
-        geometry = np.concatenate([g.geometry for g in packed_groups] + [world_geometry])
-        shading = np.concatenate([g.shading for g in packed_groups] + [world_shading])
-    else:
-        geometry, shading = world_geometry, world_shading
     return Layers(
-        kd_nodes=np.concatenate(node_parts) if len(node_parts) > 1 else node_parts[0],
-        prim_refs=np.concatenate(ref_parts) if len(ref_parts) > 1 else ref_parts[0],
-        geometry=geometry,
-        shading=shading,
+        kd_nodes=(*node_parts, nodes),
+        prim_refs=(*ref_parts, refs),
+        geometry=(*(g.geometry for g in packed_groups), world_geometry),
+        shading=(*(g.shading for g in packed_groups), world_shading),
         instances=instance_rows(flat, roots, boxes),
         world_root=first_node,
         first_world_prim=group_triangles,

@@ -289,6 +289,7 @@ class SceneLoad:
     trees_built: int  # kd-trees built or read back (the world's, and the mesh groups' not kept from before)
     trees_from_cache: int  # of those, read back from the on-disk cache
     mesh_trees_built: int  # of those, mesh groups' (render/instancing.py): 0 after an edit that kept every mesh
+    uploaded_bytes: int  # sent to the device (buffers kept from before the edit are not: buffers.GpuScene)
 
     @property
     def total(self) -> float:
@@ -370,11 +371,11 @@ class RenderSession:
         trees = time.perf_counter()
         packed = pack_scene(self.flat_scene, scene.environment, kdtree=world_tree, base_dir=scene.base_dir(),
                             lights=scene.lights, environment_importance=self.environment_importance,
-                            packed_groups=packed_groups)
+                            packed_groups=packed_groups, group_cache=self._groups)
         packing = time.perf_counter()
         # What the render survives but the user should hear about: unmapped mesh materials, missing textures.
         self.warnings = [*self.flat_scene.warnings, *packed.warnings]
-        gpu_scene = GpuScene(self.ctx, packed, self.renderer.limits.max_storage_block_bytes)
+        gpu_scene = GpuScene(self.ctx, packed, self.renderer.limits.max_storage_block_bytes, previous=self._gpu_scene)
         if self._gpu_scene is not None:
             self._gpu_scene.release()
         self._gpu_scene = gpu_scene
@@ -387,7 +388,7 @@ class RenderSession:
         self.load = SceneLoad(place=placed - start, trees=trees - placed, pack=packing - trees, upload=uploaded - packing,
                               kernel=time.perf_counter() - uploaded, trees_built=len(built),
                               trees_from_cache=sum(tree.from_cache for tree in built),
-                              mesh_trees_built=self._groups.built)
+                              mesh_trees_built=self._groups.built, uploaded_bytes=gpu_scene.uploaded_bytes)
 
     @in_context
     def set_camera(self, camera: ThinLensCamera) -> None:
