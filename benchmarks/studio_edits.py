@@ -19,7 +19,9 @@ with one (every triangle in one world-space tree, as before), in the same run, a
 ``--triangles`` read from a PLY file. kd-trees go to a cache folder of the run's own, so that the one-level
 build may read back a tree it has already built (as it would in the studio), and nothing else's.
 
-Usage: python benchmarks/studio_edits.py [--triangles 1310720] [--width 320] [--repeat 3] [--scenes a,b]
+Last, the sampling rate of each scene with two levels and with one (the cost of walking two levels).
+
+Usage: python benchmarks/studio_edits.py [--triangles 1310720] [--width 320] [--repeat 3] [--spp 8] [--scenes a,b]
 """
 
 from __future__ import annotations
@@ -92,11 +94,12 @@ def first_sample(session: RenderSession, scene: Scene) -> float:
     return time.perf_counter() - start
 
 
-def run_scene(renderer, name: str, scene: Scene, small: str, large: str, material: str, width: int, repeat: int):
+def run_scene(renderer, name: str, scene: Scene, small: str, large: str, material: str, width: int, repeat: int,
+              sample_spp: int):
     scene = dataclasses.replace(scene, camera=dataclasses.replace(
         scene.camera, resolution=(width, round(width * scene.camera.resolution[1] / scene.camera.resolution[0]))))
     variants = edits(scene, small, large, material)
-    results = {}
+    results, rates = {}, {}
     for levels, threshold in (("two levels", instancing.INSTANCE_MIN_TRIANGLES), ("one level", 1 << 62)):
         tracer_module.INSTANCE_MIN_TRIANGLES = threshold
         start = time.perf_counter()
@@ -106,6 +109,12 @@ def run_scene(renderer, name: str, scene: Scene, small: str, large: str, materia
         session.ctx.finish()
         opened = time.perf_counter() - start
         times = {"open": (opened, session.load)}
+        session.reset()
+        start = time.perf_counter()
+        while session.samples_per_pixel < sample_spp:
+            session.step(0.25, target_spp=sample_spp)
+        session.ctx.finish()
+        rates[levels] = session.width * session.height * sample_spp / (time.perf_counter() - start) / 1e6
         for edit, edited in variants.items():
             seconds, loads = [], []
             for _ in range(repeat):
@@ -127,6 +136,8 @@ def run_scene(renderer, name: str, scene: Scene, small: str, large: str, materia
         print(f"{edit:<12} {two:>10.3f}s {one:>9.3f}s {one / two:>8.1f}x   {load.place:>6.3f} {load.trees:>6.3f} "
               f"{load.pack:>6.3f} {load.upload:>6.3f} {load.kernel:>6.3f} {two - load.total:>6.3f} "
               f"{load.uploaded_bytes / 1e6:>8.1f} {load.mesh_trees_built}")
+    print(f"sampling ({sample_spp} spp): {rates['two levels']:.3g} M samples/s with two levels, "
+          f"{rates['one level']:.3g} with one ({rates['two levels'] / rates['one level']:.2f}x)")
     sys.stdout.flush()
 
 
@@ -135,6 +146,7 @@ def main() -> None:
     parser.add_argument("--triangles", type=int, default=1_310_720, help="of the Cornell box's bumpy ball")
     parser.add_argument("--width", type=int, default=320)
     parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--spp", type=int, default=8, help="samples per pixel of the sampling-rate comparison")
     parser.add_argument("--scenes", default="marbles_on_sand,cornell_ball")
     parser.add_argument("--cache", type=Path, default=Path.home() / ".cache" / "lenslab" / "benchmarks")
     args = parser.parse_args()
@@ -142,12 +154,17 @@ def main() -> None:
     os.environ["LENSLAB_KDTREE_CACHE"] = tempfile.mkdtemp(prefix="lenslab-edits-trees-")
     renderer = Renderer()
     print(f"device: {renderer.describe()['renderer']}")
+    # The compiled kd-tree build's machine code loaded before anything is timed, so that the first opening does
+    # not pay for it alone.
+    from lenslab.render.bsp import build_kdtree
+
+    build_kdtree(np.random.default_rng(0).random((100, 2, 3)).astype(np.float32).cumsum(axis=1), builder="compiled")
     for name in args.scenes.split(","):
         if name == "marbles_on_sand":
             scene = open_scene("marbles_on_sand")
             small = next(n.name for n in scene.nodes if n.material == "glass")
             large = next(n.name for n in scene.nodes if n.shape is not None and n.shape.type_name == "relief")
-            run_scene(renderer, name, scene, small, large, "sand", args.width, args.repeat)
+            run_scene(renderer, name, scene, small, large, "sand", args.width, args.repeat, args.spp)
         elif name == "cornell_ball":
             box = open_scene("cornell_box")
             ball = bumpy_ball(args.cache, args.triangles)
@@ -156,7 +173,7 @@ def main() -> None:
             scene = dataclasses.replace(box, nodes=[*box.nodes, node],
                                         materials={**box.materials, "ball": Diffuse(albedo=(0.7, 0.7, 0.7))})
             small = next(n.name for n in box.nodes if n.shape is not None and n.shape.type_name == "box")
-            run_scene(renderer, name, scene, small, "bumpy ball", "ball", args.width, args.repeat)
+            run_scene(renderer, name, scene, small, "bumpy ball", "ball", args.width, args.repeat, args.spp)
         else:
             raise SystemExit(f"unknown scene {name!r}")
     renderer.release()

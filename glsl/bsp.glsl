@@ -134,6 +134,18 @@ bool trace_bsp(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
     return walk_tree(ray, world_root, scene_min, scene_max, t_min, any_hit, hit);
 }
 
+// Every primitive of the world's own, in one loop (they are few: render/features.py's FLAT_MAX_PRIMITIVES; with
+// instances, the world's primitives follow the mesh groups' triangles, from row first_world_prim).
+// The loop counter is the same in every lane, so each primitive is read once for all lanes and no lane waits
+// on another's path through a tree: on llvmpipe that is faster than the kd-tree up to a few dozen
+// primitives (docs/performance.md). No early exit for shadow rays: a break taken by some lanes only would
+// make the loop divergent, and the few tests it would save cost less than that.
+bool trace_all_primitives(Ray ray, float t_min, float t_max, out Hit hit) {
+    no_hit_yet(t_max, hit);
+    for (int i = 0; i < FLAT_PRIMITIVES; i++) keep_if_nearer(ray, first_world_prim + i, t_min, hit);
+    return hit.prim != NO_HIT;
+}
+
 #if HAS_INSTANCES
 // Two levels (docs/architecture.md, "Two levels"): the world's own primitives, then every instance of a mesh
 // group. A ray enters an instance by taking itself into the group's space (the direction is not renormalised,
@@ -141,8 +153,14 @@ bool trace_bsp(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
 // tree there. The instances are few (the large meshes of a scene) and every lane loops over the same ones, so
 // the loop does not diverge; a ray that misses an instance's box pays for one box test.
 bool trace_instances(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
+#if FLAT_PRIMITIVES > 0
+    // The world's own primitives are few (the large meshes are the instances): one loop, as in a small scene.
+    trace_all_primitives(ray, t_min, t_max, hit);
+    if (any_hit && hit.prim != NO_HIT) return true;
+#else
     no_hit_yet(t_max, hit);
     if (walk_tree(ray, world_root, scene_min, scene_max, t_min, any_hit, hit) && any_hit) return true;
+#endif
     for (int k = 0; k < instance_count; k++) {
         int row = INSTANCE_ROWS * k;
         vec4 r0 = instances[row], r1 = instances[row + 1], r2 = instances[row + 2];
@@ -158,24 +176,13 @@ bool trace_instances(Ray ray, float t_min, float t_max, bool any_hit, out Hit hi
 }
 #endif
 
-// Every primitive, in one loop (the scene's primitives are few: render/features.py's FLAT_MAX_PRIMITIVES).
-// The loop counter is the same in every lane, so each primitive is read once for all lanes and no lane waits
-// on another's path through a tree: on llvmpipe that is faster than the kd-tree up to a few dozen
-// primitives (docs/performance.md). No early exit for shadow rays: a break taken by some lanes only would
-// make the loop divergent, and the few tests it would save cost less than that.
-bool trace_all_primitives(Ray ray, float t_min, float t_max, out Hit hit) {
-    no_hit_yet(t_max, hit);
-    for (int prim = 0; prim < FLAT_PRIMITIVES; prim++) keep_if_nearer(ray, prim, t_min, hit);
-    return hit.prim != NO_HIT;
-}
-
 // Nearest hit with t in (t_min, t_max), through the kd-tree (and the instances' trees) or, in a small scene,
 // by testing everything.
 bool trace_scene(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
-#if FLAT_PRIMITIVES > 0
-    return trace_all_primitives(ray, t_min, t_max, hit);
-#elif HAS_INSTANCES
+#if HAS_INSTANCES
     return trace_instances(ray, t_min, t_max, any_hit, hit);
+#elif FLAT_PRIMITIVES > 0
+    return trace_all_primitives(ray, t_min, t_max, hit);
 #else
     return trace_bsp(ray, t_min, t_max, any_hit, hit);
 #endif

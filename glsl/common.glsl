@@ -37,6 +37,7 @@ uniform int triangle_count;   // every triangle in the geometry buffer: the grou
 uniform vec3 scene_min;       // the box of the world's own primitives' tree
 uniform vec3 scene_max;
 uniform int world_root;       // the row of that tree's root in kd_nodes (after the groups' trees)
+uniform int first_world_prim; // the world's own primitives' first row in geometry (after the groups' triangles)
 uniform int instance_count;
 
 uniform int light_count;      // entries in the light table

@@ -59,7 +59,7 @@ def test_denoise_convergence_prints_seconds_per_scene_and_metric(renderer, tmp_p
 
 @pytest.mark.gl
 def test_studio_edits_times_each_edit_with_two_levels_and_one(renderer, tmp_path):
-    out = run("studio_edits.py", "--scenes", "cornell_ball", "--triangles", 20000, "--width", 16, "--repeat", 1,
+    out = run("studio_edits.py", "--scenes", "cornell_ball", "--triangles", 20000, "--width", 16, "--repeat", 1, "--spp", 1,
               "--cache", tmp_path / "cache", tmp_path=tmp_path)
     rows = {line.split("  ")[0].strip(): line.split() for line in out.splitlines()
             if line.startswith(("open", "material", "move", "hide"))}
@@ -69,6 +69,7 @@ def test_studio_edits_times_each_edit_with_two_levels_and_one(renderer, tmp_path
         assert len(numbers) == 2 and all(float(n[:-1]) > 0 for n in numbers), (edit, row)
     # With two levels the opening builds the ball's tree, and no edit after it does (the last column).
     assert rows["open"][-1] == "1" and all(row[-1] == "0" for edit, row in rows.items() if edit != "open"), out
+    assert "M samples/s with two levels" in out
 
 
 @pytest.mark.gl

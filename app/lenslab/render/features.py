@@ -90,6 +90,7 @@ def scene_features(packed: PackedScene) -> KernelFeatures:
     materials = arrays["materials"][: int(uniforms["texture_base"])].reshape(-1, MATERIAL_ROWS, 4)
     # The world's primitives name their materials; a mesh group's triangles take their instance's.
     world_rows = packed.world_geometry()[:, 1, 3]
+    world_prims = prim_count - packed.first_world_prim
     used = np.union1d(np.unique(world_rows.view(np.int32)), np.asarray(packed.instance_materials, np.int32))
     # The records primitives name, and every record those hold (a blend's two, a light's surface ...).
     records = materials[np.asarray(sorted(held_materials(materials, used)), dtype=np.int64)]
@@ -111,7 +112,7 @@ def scene_features(packed: PackedScene) -> KernelFeatures:
         material_types=frozenset(int(code) for code in records[:, 0, 3]),
         nested_materials=bool(((records[:, 2, 0] >= 0) & np.isin(records[:, 0, 3], HOLDING_CODES)).any()),
         beckmann=bool(((records[:, 5, 3] == MICROFACET_BECKMANN) & ~np.isin(records[:, 0, 3], HOLDING_CODES)).any()),
-        flat_primitives=prim_count if not packed.instance_materials and renders_flat(packed.kdtree, prim_count) else 0,
+        flat_primitives=world_prims if renders_flat(packed.kdtree, world_prims) else 0,
         instances=bool(packed.instance_materials),
     )
 

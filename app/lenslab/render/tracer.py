@@ -531,6 +531,8 @@ class RenderSession:
         """The uniforms the trace kernel is given by name before each step: the scene's, the camera's and the
         settings' (each dispatch then sets its own tile and samples). The general kernel reads every one."""
         values = dict(self._gpu_scene.packed.uniforms)
+        if self.features.flat_primitives:  # only a kernel that loops over the world's primitives reads where they start
+            values["first_world_prim"] = self._gpu_scene.packed.first_world_prim
         values.update(camera_uniforms(self.frame))
         splat_pixels = self.width * self.height if self._splat_samples is not None else 0
         values.update(max_depth=self.settings.max_depth, rr_depth=self.settings.rr_depth, seed=self.settings.seed,
