@@ -107,7 +107,7 @@ def main() -> None:
     print("-" * len(header))
 
     def line(step: str, seconds: float) -> None:
-        print(f"{step:<28} {seconds:>8.3f} {count / seconds / 1e6:>14.3g}")
+        print(f"{step:<28} {seconds:>8.4f} {count / seconds / 1e6:>14.3g}")
         sys.stdout.flush()
 
     ply = None

@@ -47,15 +47,16 @@ from lenslab.scene.shapes import MeshFile
 from lenslab.scene.transform import Transform
 
 
-def bumpy_ball(folder: Path, triangles: int) -> Path:
-    """An icosphere of at least ``triangles`` triangles with bumps at several scales, as a binary PLY."""
+def bumpy_ball(folder: Path, triangles: int, seed: int = 1) -> Path:
+    """An icosphere of at least ``triangles`` triangles with bumps at several scales (``seed`` picks them), as a
+    binary PLY."""
     import trimesh
 
     subdivisions = max(0, int(np.ceil(np.log(max(triangles, 20) / 20) / np.log(4))))
-    path = folder / f"bumpy_ball_{subdivisions}.ply"
+    path = folder / f"bumpy_ball_{subdivisions}{'' if seed == 1 else f'_{seed}'}.ply"
     if not path.exists():
         ball = trimesh.creation.icosphere(subdivisions=subdivisions, radius=1.0)
-        rng = np.random.default_rng(1)
+        rng = np.random.default_rng(seed)
         v = ball.vertices
         bumps = sum(np.sin(k * v @ rng.normal(size=3) + rng.uniform(0, 6)) / k for k in (3, 7, 17, 41, 97))
         ball.vertices = v * (1 + 0.03 * bumps)[:, None]

@@ -79,4 +79,14 @@ def test_mesh_open_prints_a_rate_for_every_format_and_step(tmp_path):
              "kd-tree, compiled build", "kd-tree, levels build", "pack rows")
     for step in steps:
         line = next(line for line in out.splitlines() if line.startswith(step))
-        assert float(line.split()[-1]) > 0 and float(line.split()[-2]) > 0, line
+        assert float(line.split()[-1]) > 0 and float(line.split()[-2]) >= 0, line  # rate, seconds
+
+
+@pytest.mark.gl
+def test_instances_scale_places_a_grid_of_one_mesh_and_stores_it_once(renderer, tmp_path):
+    out = run("instances_scale.py", "--grid", 3, "--triangles", 20000, "--width", 12, "--spp", 1, "--cache",
+              tmp_path / "cache", tmp_path=tmp_path)
+    line = next(line for line in out.splitlines() if line.startswith("9 balls"))
+    placed, stored = (int(line.split()[k].replace(",", "")) for k in (2, 5))
+    assert placed == 9 * (stored - 2) + 2 and "1 mesh trees" in line  # the floor's two triangles, once
+    assert "M samples/s" in out
