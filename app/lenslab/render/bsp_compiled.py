@@ -220,6 +220,34 @@ def _best_split(prim_lo, prim_hi, start, count, box_lo, box_hi, sizes, empty_bon
 # Partitioning a node's references into its children
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _put(prim, prim_lo, prim_hi, out, r, straddles, axis, split, below, exact, halves):
+    """Copy reference ``r`` to row ``out`` for one side of the plane: cut at the plane when it straddles it, and
+    intersected with its triangle's part on that side when ``exact`` (``halves``: _triangle_halves). Returns
+    whether anything is left of it there. ``out`` may be ``r`` itself (the above side is compacted in place)."""
+    p = prim[r]
+    lo0, lo1, lo2 = prim_lo[r, 0], prim_lo[r, 1], prim_lo[r, 2]
+    hi0, hi1, hi2 = prim_hi[r, 0], prim_hi[r, 1], prim_hi[r, 2]
+    prim[out] = p
+    prim_lo[out, 0], prim_lo[out, 1], prim_lo[out, 2] = lo0, lo1, lo2
+    prim_hi[out, 0], prim_hi[out, 1], prim_hi[out, 2] = hi0, hi1, hi2
+    if not straddles:
+        return True
+    if below:
+        prim_hi[out, axis] = split
+    else:
+        prim_lo[out, axis] = split
+    if not exact:
+        return True
+    row = 0 if below else 2
+    ok = True
+    for c in range(3):
+        prim_lo[out, c] = max(prim_lo[out, c], halves[row, c])
+        prim_hi[out, c] = min(prim_hi[out, c], halves[row + 1, c])
+        ok = ok and prim_lo[out, c] <= prim_hi[out, c]
+    return ok
+
+
 @njit(cache=True, nogil=True)
 def _partition(prim, prim_lo, prim_hi, start, count, axis, split, triangles, triangle_count, halves):
     """Split the run ``[start, start + count)`` at the plane: afterwards the above child's references are
@@ -235,45 +263,19 @@ def _partition(prim, prim_lo, prim_hi, start, count, axis, split, triangles, tri
     n_above = 0
     for r in range(start, start + count):
         p = prim[r]
-        x0, y0, z0 = prim_lo[r, 0], prim_lo[r, 1], prim_lo[r, 2]
-        x1, y1, z1 = prim_hi[r, 0], prim_hi[r, 1], prim_hi[r, 2]
         lo_a, hi_a = prim_lo[r, axis], prim_hi[r, axis]
         goes_below = lo_a < split
         goes_above = hi_a > split or not goes_below
-        below_ok, above_ok = goes_below, goes_above
         straddles = goes_below and goes_above
-        if straddles and p < triangle_count:
-            has_below, has_above = _triangle_halves(triangles[p], axis, split, halves)
-            below_ok = has_below
-            above_ok = has_above
-        if below_ok:
-            out = below_at + n_below
-            prim[out] = p
-            prim_lo[out, 0], prim_lo[out, 1], prim_lo[out, 2] = x0, y0, z0
-            prim_hi[out, 0], prim_hi[out, 1], prim_hi[out, 2] = x1, y1, z1
-            if straddles:
-                prim_hi[out, axis] = split
-                if p < triangle_count:
-                    for c in range(3):
-                        prim_lo[out, c] = max(prim_lo[out, c], halves[0, c])
-                        prim_hi[out, c] = min(prim_hi[out, c], halves[1, c])
-                        below_ok = below_ok and prim_lo[out, c] <= prim_hi[out, c]
-            if below_ok:
-                n_below += 1
-        if above_ok:
-            out = start + n_above
-            prim[out] = p
-            prim_lo[out, 0], prim_lo[out, 1], prim_lo[out, 2] = x0, y0, z0
-            prim_hi[out, 0], prim_hi[out, 1], prim_hi[out, 2] = x1, y1, z1
-            if straddles:
-                prim_lo[out, axis] = split
-                if p < triangle_count:
-                    for c in range(3):
-                        prim_lo[out, c] = max(prim_lo[out, c], halves[2, c])
-                        prim_hi[out, c] = min(prim_hi[out, c], halves[3, c])
-                        above_ok = above_ok and prim_lo[out, c] <= prim_hi[out, c]
-            if above_ok:
-                n_above += 1
+        exact = straddles and p < triangle_count  # a triangle: each side gets the bounds of its own part
+        if exact:
+            goes_below, goes_above = _triangle_halves(triangles[p], axis, split, halves)
+        if goes_below and _put(prim, prim_lo, prim_hi, below_at + n_below, r, straddles, axis, split, True, exact,
+                             halves):
+            n_below += 1
+        if goes_above and _put(prim, prim_lo, prim_hi, start + n_above, r, straddles, axis, split, False, exact,
+                             halves):
+            n_above += 1
     # The below run moves down after the above one: to lower or equal positions, so a forward copy is safe.
     to = start + n_above
     for k in range(n_below):
