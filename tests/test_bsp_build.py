@@ -593,3 +593,21 @@ def test_the_compiled_build_stays_within_a_small_budget_and_is_exact(builder):
 def test_an_unknown_builder_is_refused():
     with pytest.raises(ValueError, match="builder"):
         build_kdtree(np.zeros((1, 2, 3), np.float32), builder="fast")
+
+
+def test_without_numba_the_automatic_choice_builds_with_numpy(builder, monkeypatch):
+    """A machine sent the project without numba still builds trees (and makes normals), the numpy way."""
+    import builtins
+
+    real_import = builtins.__import__
+
+    def no_numba(name, *args, **kwargs):
+        if name == "numba" or name.startswith("numba."):
+            raise ImportError("no numba here")
+        return real_import(name, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "__import__", no_numba)
+    monkeypatch.setattr(bsp, "COMPILED_MIN_PRIMITIVES", 0)
+    rng = np.random.default_rng(23)
+    tris = triangle_soup(rng, 200)
+    assert build_kdtree(triangle_bounds(tris), triangles=tris).params["builder"] == "levels"

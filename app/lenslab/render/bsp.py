@@ -242,7 +242,7 @@ def build_kdtree(
     root = root_bounds(prim_bounds)
     params_record = dict(traversal_cost=costs.traversal, intersection_cost=costs.intersection,
                          empty_bonus=costs.empty_bonus, max_bins=max_bins, min_bins=min_bins, leaf_prims=leaf_prims)
-    if builder == "compiled" or (builder == "auto" and prim_count >= COMPILED_MIN_PRIMITIVES):
+    if builder == "compiled" or (builder == "auto" and prim_count >= COMPILED_MIN_PRIMITIVES and compiled_available()):
         tree = _build_compiled(prim_bounds, triangles, root, costs, params, limit, min_bins, max_bins, start,
                                params_record)
         # The compiled build keeps the budget node by node, depth first; when it binds (rare: geometry piled up
@@ -277,6 +277,16 @@ def build_kdtree(
         budget_leaves=budget.leaves_made,
         params={**params_record, "builder": "levels"},
     )
+
+
+def compiled_available() -> bool:
+    """Whether numba (a dependency, but a device machine may be sent the project without it) can be imported:
+    ``builder="auto"`` builds with numpy where it cannot."""
+    try:
+        import numba  # noqa: F401
+    except ImportError:
+        return False
+    return True
 
 
 def _build_compiled(prim_bounds, triangles, root, costs: _Costs, params: _Params, limit: int, min_bins: int,

@@ -67,9 +67,12 @@ def smooth_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     is faster again once numba's machine code is loaded (a fraction of a second, once a process).
     """
     if len(faces) >= COMPILED_NORMALS_MIN_FACES:
-        from lenslab.scene.io.normals_compiled import smooth_normals as compiled
-
-        return compiled(np.ascontiguousarray(vertices), np.ascontiguousarray(faces))
+        try:
+            from lenslab.scene.io.normals_compiled import smooth_normals as compiled
+        except ImportError:  # numba missing (a device machine sent the project without it): numpy's way below
+            pass
+        else:
+            return compiled(np.ascontiguousarray(vertices), np.ascontiguousarray(faces))
     corners = np.asarray(vertices, np.float32)[faces]  # (F, 3, 3)
     a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
     ab, bc, ca = b - a, c - b, a - c  # edge k runs from corner k to corner k + 1
