@@ -21,7 +21,7 @@ into its parent when it is popped.
 Large trees are built by two or more threads (numba releases the GIL): the top of the tree is built first,
 until it has a subtree per thread and some, then the subtrees are built on a pool of threads, each into arrays of
 its own, and joined with their row numbers and reference offsets moved. The tree does not depend on the number
-of threads.
+of threads (unless the reference budget binds: each subtree then builds within its share of what is left).
 
 The reference budget (render/bsp.py, "Bounded work") is kept per node: a split whose new references would pass
 what is left becomes a leaf. Subtrees built in parallel each get a share of what is left in proportion to their
@@ -30,7 +30,6 @@ references, so the sum never passes the budget.
 
 from __future__ import annotations
 
-import os
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
@@ -40,6 +39,7 @@ KD_LEAF = 3  # as render/gpu_layout.KD_LEAF; passed in by bsp.py, checked equal 
 MIN_EXTENT = 1e-30
 PAD = 2.0**-20  # triangle part bounds grow by this fraction of the coordinates' size (a few ulps)
 BIN_SHRINK = 1.0 - 2.0**-20  # as bsp.py: the far face falls in the last bin despite rounding
+PARALLEL_MIN_PRIMITIVES = 200_000  # below this the top's bookkeeping costs more than a second thread saves
 
 # Build statistics, one slot each in the ``stats`` array the kernel fills.
 STAT_NODES, STAT_REFS, STAT_LEAVES, STAT_EMPTY, STAT_DEPTH, STAT_BUDGET_LEAVES, STAT_USED = range(7)
@@ -321,11 +321,10 @@ def _build(prim, prim_lo, prim_hi, count, box_lo, box_hi, first_depth, triangles
     st_parent = np.empty(stack_size, np.int64)
     st_lo = np.empty((stack_size, 3), np.float32)
     st_hi = np.empty((stack_size, 3), np.float32)
-    top = 0
     st_start[0], st_count[0], st_depth[0], st_parent[0] = 0, count, first_depth, -1
     st_lo[0] = box_lo
     st_hi[0] = box_hi
-    top = 1
+    top = 1  # nodes waiting on the stack: the root
 
     open_rows = np.empty(16, np.int64)
     open_lo = np.empty((16, 3), np.float32)
@@ -578,14 +577,4 @@ def build(prim_bounds, triangles, root, *, traversal_cost, intersection_cost, em
     root_area = float(extent[0] * extent[1] + extent[1] * extent[2] + extent[2] * extent[0])
     sah_cost = area_sum / root_area if root_area > 0 else 0.0
     return np.ascontiguousarray(nodes), np.ascontiguousarray(refs), deepest, leaves, empty, budget_leaves, sah_cost
-
-
-PARALLEL_MIN_PRIMITIVES = 200_000  # below this the top's bookkeeping costs more than a second thread saves
-
-
-def worker_count() -> int:
-    try:
-        return max(1, min(8, len(os.sched_getaffinity(0))))
-    except AttributeError:
-        return max(1, min(8, os.cpu_count() or 1))
 
