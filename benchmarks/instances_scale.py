@@ -6,6 +6,7 @@ triangles (131 M placed) fit in the 2 M triangles a storage block holds; on a GP
 different meshes instead (each its own file and tree), for the scale of unique triangles a GPU's memory holds.
 
 Usage: python benchmarks/instances_scale.py [--grid 10] [--triangles 1000000] [--width 160] [--spp 4] [--unique]
+       [--no-instance-tree]
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from pathlib import Path
 
 from studio_edits import bumpy_ball
 
+from lenslab.render import instancing
 from lenslab.render.tracer import Renderer, RenderSession
 from lenslab.scene.camera import ThinLensCamera
 from lenslab.scene.materials import Diffuse
@@ -32,9 +34,13 @@ def main() -> None:
     parser.add_argument("--width", type=int, default=160)
     parser.add_argument("--spp", type=int, default=4)
     parser.add_argument("--unique", action="store_true", help="a mesh file of its own for every ball")
+    parser.add_argument("--no-instance-tree", action="store_true",
+                        help="every ray tests every instance's box (no kd-tree over the instances)")
     parser.add_argument("--cache", type=Path, default=Path.home() / ".cache" / "lenslab" / "benchmarks")
     args = parser.parse_args()
     args.cache.mkdir(parents=True, exist_ok=True)
+    if args.no_instance_tree:
+        instancing.INSTANCE_TREE_MIN_INSTANCES = 1 << 62
     n = args.grid
     files = []
     for k in range(n * n if args.unique else 1):

@@ -147,11 +147,80 @@ bool trace_all_primitives(Ray ray, float t_min, float t_max, out Hit hit) {
 }
 
 #if HAS_INSTANCES
-// Two levels (docs/architecture.md, "Two levels"): the world's own primitives, then every instance of a mesh
-// group. A ray enters an instance by taking itself into the group's space (the direction is not renormalised,
-// so that t measures the same distance in both spaces and hits compare across instances) and walks the group's
-// tree there. The instances are few (the large meshes of a scene) and every lane loops over the same ones, so
-// the loop does not diverge; a ray that misses an instance's box pays for one box test.
+// Enter instance k: take the ray into its group's space (the direction is not renormalised, so that t measures
+// the same distance in both spaces and hits compare across instances) and walk the group's tree there.
+bool enter_instance(Ray ray, int k, float t_min, bool any_hit, inout Hit hit) {
+    int row = INSTANCE_ROWS * k;
+    vec4 r0 = instances[row], r1 = instances[row + 1], r2 = instances[row + 2];
+    Ray local = Ray(vec3(dot(r0.xyz, ray.o) + r0.w, dot(r1.xyz, ray.o) + r1.w, dot(r2.xyz, ray.o) + r2.w),
+                    vec3(dot(r0.xyz, ray.d), dot(r1.xyz, ray.d), dot(r2.xyz, ray.d)));
+    vec4 box_min = instances[row + 3], box_max = instances[row + 4];
+    if (!walk_tree(local, floatBitsToInt(box_min.w), box_min.xyz, box_max.xyz, t_min, any_hit, hit)) return false;
+    hit.instance = k;
+    return true;
+}
+
+// The instances' own kd-tree, over their world boxes (render/instancing.py; built when a scene has many): every
+// leaf the ray's interval crosses, nearest first, each of its instances entered, until the nearest hit lies before
+// what is left. A plain stack of INSTANCE_TREE_DEPTH entries (the tree is built no deeper); an instance in several
+// leaves is entered again only when another leaf came between.
+bool walk_instance_tree(Ray ray, float t_min, bool any_hit, inout Hit hit) {
+    vec3 inv_dir = 1.0 / mix(ray.d, vec3(1e-30), equal(ray.d, vec3(0.0)));
+    vec2 span = intersect_box(ray, inv_dir, instances_min, instances_max);
+    float t0 = max(span.x, t_min);
+    float t1 = min(span.y, hit.t);
+    if (t0 > t1) return false;
+    int stack_node[INSTANCE_TREE_DEPTH];
+    vec2 stack_span[INSTANCE_TREE_DEPTH];
+    int depth = 0;
+    int node = instance_root;
+    int last = -1;
+    bool kept = false;
+    while (true) {
+        uvec2 n = kd_nodes[node];
+        if ((n.y & 3u) != uint(KD_LEAF)) {
+            uint axis = n.y & 3u;
+            float split = uintBitsToFloat(n.x);
+            float t_plane = (split - ray.o[axis]) * inv_dir[axis];
+            bool below_first = ray.o[axis] < split || (ray.o[axis] == split && ray.d[axis] < 0.0);
+            int first = below_first ? node + 1 : int(n.y >> 2);
+            int second = below_first ? int(n.y >> 2) : node + 1;
+            if (t_plane > t1 || t_plane <= 0.0) {
+                node = first;
+            } else if (t_plane < t0) {
+                node = second;
+            } else {  // both, the far one later (a plane crossed exactly at an end visits both, as bsp.glsl does)
+                stack_node[depth] = second;
+                stack_span[depth] = vec2(t_plane, t1);
+                depth++;
+                node = first;
+                t1 = t_plane;
+            }
+            continue;
+        }
+        int count = int(n.y >> 2);
+        int first_ref = int(n.x);
+        for (int i = 0; i < count; i++) {
+            int k = prim_refs[first_ref + i];
+            if (k != last && enter_instance(ray, k, t_min, any_hit, hit)) {
+                kept = true;
+                if (any_hit) return true;
+            }
+            last = k;
+        }
+        if (depth == 0) break;
+        depth--;
+        node = stack_node[depth];
+        t0 = stack_span[depth].x;
+        t1 = min(stack_span[depth].y, hit.t);
+        if (t0 > t1) break;  // the nearest interval left lies beyond the nearest hit: so does everything else
+    }
+    return kept;
+}
+
+// Two levels (docs/architecture.md, "Two levels"): the world's own primitives, then the instances of mesh groups.
+// A few instances (a product shot's large meshes) are entered in one loop that every lane runs alike; a ray that
+// misses an instance's box pays for one box test. Many are found through their own tree (instance_root >= 0).
 bool trace_instances(Ray ray, float t_min, float t_max, bool any_hit, out Hit hit) {
 #if FLAT_PRIMITIVES > 0
     // The world's own primitives are few (the large meshes are the instances): one loop, as in a small scene.
@@ -161,15 +230,11 @@ bool trace_instances(Ray ray, float t_min, float t_max, bool any_hit, out Hit hi
     no_hit_yet(t_max, hit);
     if (walk_tree(ray, world_root, scene_min, scene_max, t_min, any_hit, hit) && any_hit) return true;
 #endif
-    for (int k = 0; k < instance_count; k++) {
-        int row = INSTANCE_ROWS * k;
-        vec4 r0 = instances[row], r1 = instances[row + 1], r2 = instances[row + 2];
-        Ray local = Ray(vec3(dot(r0.xyz, ray.o) + r0.w, dot(r1.xyz, ray.o) + r1.w, dot(r2.xyz, ray.o) + r2.w),
-                        vec3(dot(r0.xyz, ray.d), dot(r1.xyz, ray.d), dot(r2.xyz, ray.d)));
-        vec4 box_min = instances[row + 3], box_max = instances[row + 4];
-        if (walk_tree(local, floatBitsToInt(box_min.w), box_min.xyz, box_max.xyz, t_min, any_hit, hit)) {
-            hit.instance = k;
-            if (any_hit) return true;
+    if (instance_root >= 0) {
+        walk_instance_tree(ray, t_min, any_hit, hit);
+    } else {
+        for (int k = 0; k < instance_count; k++) {
+            if (enter_instance(ray, k, t_min, any_hit, hit) && any_hit) return true;
         }
     }
     return hit.prim != NO_HIT;

@@ -39,6 +39,9 @@ uniform vec3 scene_max;
 uniform int world_root;       // the row of that tree's root in kd_nodes (after the groups' trees)
 uniform int first_world_prim; // the world's own primitives' first row in geometry (after the groups' triangles)
 uniform int instance_count;
+uniform int instance_root;    // the instances' own tree's root in kd_nodes (after the world's), or -1: none
+uniform vec3 instances_min;   // that tree's box
+uniform vec3 instances_max;
 
 uniform int light_count;      // entries in the light table
 uniform vec3 env_radiance;    // constant environment

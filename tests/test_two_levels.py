@@ -251,3 +251,29 @@ def test_an_edited_session_renders_what_a_new_one_does(renderer, bumpy_ball, mon
 def replace_marble(scene: Scene, transform: Transform) -> Scene:
     return dataclasses.replace(scene, nodes=[dataclasses.replace(node, transform=transform) if node.name == "marble"
                                              else node for node in scene.nodes])
+
+
+def test_many_instances_are_found_through_their_own_tree(renderer, bumpy_ball, monkeypatch):
+    """Past INSTANCE_TREE_MIN_INSTANCES, rays find instances through a kd-tree over their boxes: the same hits as
+    the one-level scene, and the same image as the loop over every instance."""
+    grid = [Transform(translate=(0.55 * i - 1.4, 0.3 * ((i + j) % 3) - 0.3, -0.6 * j), rotate_deg=(0, 37 * i, 0),
+                      scale=(0.25, 0.25 + 0.05 * j, 0.25)) for i in range(6) for j in range(3)]
+    scene = placed_balls(bumpy_ball, grid)
+    one_level = flatten_scene(scene)
+    two_levels = flatten_scene(scene, instance_min_triangles=1000)
+    assert len(two_levels.instances) == 18 >= instancing.INSTANCE_TREE_MIN_INSTANCES
+    origins, directions = rays_at(scene, np.random.default_rng(8))
+    expected, expected_nodes = cast(renderer, one_level, scene, origins, directions)
+    hits, nodes = cast(renderer, two_levels, scene, origins, directions)
+    hit = np.isfinite(expected.t)
+    assert (nodes[hit] < 18).sum() > 300, "many rays hit a ball"
+    assert np.array_equal(np.isfinite(hits.t), hit)
+    assert np.allclose(hits.t[hit], expected.t[hit], rtol=1e-5, atol=1e-6)
+    assert (nodes[hit] == expected_nodes[hit]).mean() > 0.999
+
+    assert pack_scene(two_levels, scene.environment, base_dir=scene.base_dir()).uniforms["instance_root"] >= 0
+    through_tree, _ = render(renderer, scene, 1000, monkeypatch)
+    monkeypatch.setattr(instancing, "INSTANCE_TREE_MIN_INSTANCES", 1000)
+    assert pack_scene(two_levels, scene.environment, base_dir=scene.base_dir()).uniforms["instance_root"] == -1
+    every_one, _ = render(renderer, scene, 1000, monkeypatch)
+    assert np.array_equal(through_tree, every_one)

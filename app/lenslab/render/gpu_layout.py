@@ -56,6 +56,9 @@ SHADING_ROWS = 4
 KD_LEAF = 3
 # -- Instances of mesh groups (render/instancing.py, glsl/common.glsl): vec4 rows per instance.
 INSTANCE_ROWS = 8
+# A scene of many instances finds them through a kd-tree over their world boxes, built no deeper than this (the
+# stack glsl/bsp.glsl's walk_instance_tree keeps).
+INSTANCE_TREE_DEPTH = 16
 
 # -- Lights: LIGHT_ROWS vec4 rows per light in the light table (buffers.pack_scene, glsl/lights.glsl), its
 # kind in row 0, x.

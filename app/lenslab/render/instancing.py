@@ -19,14 +19,17 @@ from dataclasses import dataclass
 import numpy as np
 
 from lenslab.render import kdtree_cache
-from lenslab.render.bsp import KdTree
-from lenslab.render.gpu_layout import GEOMETRY_ROWS, INSTANCE_ROWS, KD_LEAF, SHADING_ROWS
+from lenslab.render.bsp import KdTree, build_kdtree
+from lenslab.render.gpu_layout import GEOMETRY_ROWS, INSTANCE_ROWS, INSTANCE_TREE_DEPTH, KD_LEAF, SHADING_ROWS
 from lenslab.scene.flatten import FlatScene, MeshGroup
 
 # Meshes of at least this many triangles become groups. Smaller ones join the world's own tree, where small
 # scenes keep their one-level walk (and the loop over every primitive of render/features.py); a large mesh's tree
 # takes long enough to build (about 10 ms per 10,000 triangles) that keeping it is worth a second tree to walk.
 INSTANCE_MIN_TRIANGLES = 10_000
+# From this many instances on, rays find them through a kd-tree over their world boxes instead of testing each
+# (glsl/bsp.glsl's walk_instance_tree); below it the loop over all of them, which never diverges, is cheaper.
+INSTANCE_TREE_MIN_INSTANCES = 8
 NO_MATERIAL = -1  # a group triangle's material field: the instance's material is used (glsl/surface.glsl)
 NO_LIGHT = -1
 
@@ -137,6 +140,8 @@ class Layers:
     geometry: tuple[np.ndarray, ...]  # (P_i, GEOMETRY_ROWS, 4) float32: the groups' triangles, the world's, its spheres
     shading: tuple[np.ndarray, ...]  # (T_i, SHADING_ROWS, 4) float32
     instances: np.ndarray  # (I, INSTANCE_ROWS, 4) float32
+    instance_tree: KdTree | None  # over the instances' world boxes, when there are many (its root: instance_root)
+    instance_root: int  # -1 without an instance tree
     world_root: int
     first_world_prim: int  # the world's own primitive i is row first_world_prim + i
     triangle_count: int
@@ -191,12 +196,25 @@ def join_layers(packed_groups: list[PackedGroup], flat: FlatScene, world_tree: K
     # The world's primitives follow the groups' triangles, its spheres after its triangles: every world primitive
     # moves by the groups' triangle count.
     nodes, refs = moved_tree(world_tree, first_node, first_ref, group_triangles)
+    node_parts.append(nodes)
+    ref_parts.append(refs)
+    # Many instances: a kd-tree over their world boxes after the world's tree, its references instance numbers.
+    instance_tree, instance_root = None, -1
+    if len(flat.instances) >= INSTANCE_TREE_MIN_INSTANCES:
+        boxes_in_world = np.array([instance.bounds for instance in flat.instances], np.float32)
+        instance_tree = build_kdtree(boxes_in_world, max_depth_limit=INSTANCE_TREE_DEPTH, builder="levels")
+        instance_root = first_node + len(nodes)
+        top_nodes, top_refs = moved_tree(instance_tree, instance_root, first_ref + len(refs), 0)
+        node_parts.append(top_nodes)
+        ref_parts.append(top_refs)
     return Layers(
-        kd_nodes=(*node_parts, nodes),
-        prim_refs=(*ref_parts, refs),
+        kd_nodes=tuple(node_parts),
+        prim_refs=tuple(ref_parts),
         geometry=(*(g.geometry for g in packed_groups), world_geometry),
         shading=(*(g.shading for g in packed_groups), world_shading),
         instances=instance_rows(flat, roots, boxes),
+        instance_tree=instance_tree,
+        instance_root=instance_root,
         world_root=first_node,
         first_world_prim=group_triangles,
         triangle_count=group_triangles + flat.triangle_count,
