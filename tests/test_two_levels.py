@@ -277,3 +277,22 @@ def test_many_instances_are_found_through_their_own_tree(renderer, bumpy_ball, m
     assert pack_scene(two_levels, scene.environment, base_dir=scene.base_dir()).uniforms["instance_root"] == -1
     every_one, _ = render(renderer, scene, 1000, monkeypatch)
     assert np.array_equal(through_tree, every_one)
+
+
+def test_a_mitsuba_shapegroup_placed_three_times_is_one_mesh_group(bumpy_ball, tmp_path):
+    """Mitsuba's shapegroup and instance (and any nodes that name the same mesh file) store the mesh once."""
+    from lenslab.scene.io.mitsuba_xml import load_mitsuba_scene
+
+    instances = "".join(f'<shape type="instance"><ref id="balls"/><transform name="to_world"><translate x="{x}"/>'
+                        f'<rotate y="1" angle="{20 * x}"/></transform></shape>' for x in (-1, 0, 1))
+    path = tmp_path / "scene.xml"
+    path.write_text(f'''<scene version="3.0.0">
+        <shape type="shapegroup" id="balls">
+            <shape type="ply"><string name="filename" value="{bumpy_ball / 'ball.ply'}"/></shape>
+        </shape>
+        {instances}
+    </scene>''')
+    scene = load_mitsuba_scene(path)
+    flat = flatten_scene(scene, instance_min_triangles=1000)
+    assert len(flat.groups) == 1 and len(flat.instances) == 3
+    assert flat.stored_triangle_count == 5120 and flat.placed_triangle_count == 3 * 5120
