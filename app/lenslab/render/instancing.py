@@ -9,7 +9,9 @@ keeps them from one version of the scene to the next, by the group's key (docs/a
 Layout in the scene's buffers (glsl/common.glsl): the groups' triangles come first in the geometry and shading
 buffers, then the world's own triangles, then its spheres (a primitive is a sphere when its index is at least
 ``triangle_count``); the groups' trees come first in ``kd_nodes`` and ``prim_refs``, each moved to its place (its
-child rows, leaf offsets and primitive numbers offset), then the world's tree, whose root is ``world_root``.
+child rows, leaf offsets and primitive numbers offset), then the world's tree, whose root is ``world_root``, then,
+for a scene of many instances, a tree over the instances' world boxes whose references are instance numbers
+(``instance_root``; -1 without one). The instance table (``INSTANCE_ROWS`` vec4 each) is a buffer of its own.
 """
 
 from __future__ import annotations
