@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import atexit
+import builtins
 import os
 import shutil
 import tempfile
@@ -43,3 +44,19 @@ def mitsuba():
     if not works:
         pytest.skip(why)
     return mitsuba_env.load_mitsuba()
+
+
+@pytest.fixture
+def hide_package(monkeypatch):
+    """A function that makes a package (and its modules) fail to import for the rest of the test, as on a machine
+    without it. Modules already imported stay in sys.modules; a test that needs them gone removes them itself."""
+    real_import = builtins.__import__
+    hidden: set[str] = set()
+
+    def importing(name, *args, **kwargs):
+        if name.split(".")[0] in hidden:
+            raise ImportError(f"No module named '{name}'")
+        return real_import(name, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "__import__", importing)
+    return hidden.add

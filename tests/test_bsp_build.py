@@ -595,19 +595,15 @@ def test_an_unknown_builder_is_refused():
         build_kdtree(np.zeros((1, 2, 3), np.float32), builder="fast")
 
 
-def test_without_numba_the_automatic_choice_builds_with_numpy(builder, monkeypatch):
+def test_without_numba_the_automatic_choice_builds_with_numpy(builder, monkeypatch, hide_package):
     """A machine sent the project without numba still builds trees (and makes normals), the numpy way."""
-    import builtins
+    from lenslab.scene.io import meshes
 
-    real_import = builtins.__import__
-
-    def no_numba(name, *args, **kwargs):
-        if name == "numba" or name.startswith("numba."):
-            raise ImportError("no numba here")
-        return real_import(name, *args, **kwargs)
-
-    monkeypatch.setattr(builtins, "__import__", no_numba)
+    hide_package("numba")
     monkeypatch.setattr(bsp, "COMPILED_MIN_PRIMITIVES", 0)
+    monkeypatch.setattr(meshes, "COMPILED_NORMALS_MIN_FACES", 0)
     rng = np.random.default_rng(23)
     tris = triangle_soup(rng, 200)
     assert build_kdtree(triangle_bounds(tris), triangles=tris).params["builder"] == "levels"
+    normals = meshes.smooth_normals(tris.reshape(-1, 3), np.arange(3 * len(tris)).reshape(-1, 3))
+    assert np.allclose(np.linalg.norm(normals, axis=1), 1.0, atol=1e-5)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import builtins
 import sys
 
 import numpy as np
@@ -72,17 +71,10 @@ def test_difference_image_colours():
     assert tuple(diff[0, 0]) == (255, 0, 0) and tuple(diff[1, 1]) == (0, 0, 255) and tuple(diff[0, 1]) == (255, 255, 255)
 
 
-def test_missing_mitsuba_is_one_line_and_status_1(monkeypatch, capsys):
-    real_import = builtins.__import__
-
-    def no_mitsuba(name, *args, **kwargs):
-        if name == "mitsuba" or name.startswith("mitsuba."):
-            raise ImportError("No module named 'mitsuba'")
-        return real_import(name, *args, **kwargs)
-
+def test_missing_mitsuba_is_one_line_and_status_1(monkeypatch, capsys, hide_package):
     monkeypatch.setattr(mitsuba_env, "_mitsuba", None)
     monkeypatch.delitem(sys.modules, "mitsuba", raising=False)
-    monkeypatch.setattr(builtins, "__import__", no_mitsuba)
+    hide_package("mitsuba")
     from lenslab.cli import main
 
     assert main(["validate", "--scenes", "bokeh"]) == 1

@@ -536,7 +536,7 @@ class GpuScene:
         offset = sum(part.nbytes for part in parts[:first])
         for part in parts[first:]:
             if part.nbytes:
-                buffer.write(part.tobytes() if not part.flags.c_contiguous else part, offset=offset)
+                buffer.write(part, offset=offset)  # pack_scene made every part contiguous
             offset += part.nbytes
             self.uploaded_bytes += part.nbytes
 
