@@ -63,7 +63,7 @@ def main() -> None:
     opened = time.perf_counter() - start
     flat, load = session.flat_scene, session.load
     print(f"{n * n} balls: {flat.placed_triangle_count:,} triangles placed, {flat.stored_triangle_count:,} stored, "
-          f"{len(flat.groups)} mesh trees; opened in {opened:.2f} s: read and placed {load.place:.2f} s, trees "
+          f"{len(flat.groups)} mesh trees; opened in {opened:.2f} s: read {load.read:.2f} s, placed {load.place:.2f} s, trees "
           f"{load.trees:.2f} s, packed {load.pack:.2f} s, uploaded {load.upload:.2f} s ({load.uploaded_bytes / 1e6:.0f} MB)")
     start = time.perf_counter()
     while session.samples_per_pixel < args.spp:

@@ -3,7 +3,8 @@
 The same bumpy ball of ``--triangles`` (at least) is written as binary PLY, ASCII PLY, OBJ (positions, normals,
 texture coordinates), GLB and Mitsuba ``.serialized`` (zlib); each file is read the way a scene reads it
 (scene/io/meshes.load_mesh_parts, its cache emptied first: the file read, parsed, checked, smooth normals made
-where it has none), best of ``--repeat``, on this process's one thread unless numpy's own use more. Then the
+where it has none), best of ``--repeat``; the text formats also through trimesh's parser alone, as they were
+read before scene/io/text_meshes.py; on this process's one thread unless numpy's own use more. Then the
 steps after reading, for one mesh node: placing it (scene/flatten.py: a mesh group in its own space), building
 its kd-tree (render/bsp.py, the compiled build, on all cores), and packing its rows for the GPU
 (render/instancing.py). Printed per step: seconds and millions of triangles per second.
@@ -57,12 +58,12 @@ def write(ball, folder: Path, kind: str) -> Path:
         path = folder / "ball_ascii.ply"
         path.write_bytes(trimesh.exchange.ply.export_ply(ball, encoding="ascii", include_attributes=False))
     elif kind == "obj":
-        path = folder / "ball.obj"
-        uv = (ball.vertices[:, :2] + 1) / 2
-        textured = trimesh.Trimesh(ball.vertices, ball.faces, vertex_normals=ball.vertex_normals, process=False,
-                                   visual=trimesh.visual.TextureVisuals(uv=uv))
-        path.write_text(trimesh.exchange.obj.export_obj(textured, include_normals=True, include_texture=True,
-                                                        write_texture=False, mtl_name=None))
+        path = folder / "ball.obj"  # as exporters write it: eight decimals, a uv and a normal per vertex
+        with open(path, "w") as out:
+            np.savetxt(out, ball.vertices, fmt="v %.8f %.8f %.8f")
+            np.savetxt(out, (ball.vertices[:, :2] + 1) / 2, fmt="vt %.8f %.8f")
+            np.savetxt(out, ball.vertex_normals, fmt="vn %.8f %.8f %.8f")
+            np.savetxt(out, np.repeat(ball.faces + 1, 3, axis=1), fmt="f %d/%d/%d %d/%d/%d %d/%d/%d")
     elif kind == "glb":
         path = folder / "ball.glb"
         path.write_bytes(trimesh.exchange.gltf.export_glb(trimesh.Scene(ball), include_normals=True))
@@ -122,6 +123,11 @@ def main() -> None:
         seconds, loaded = best_of(args.repeat, read)
         assert sum(part.mesh.triangle_count for part in loaded.parts) == count, kind
         line(f"read {kind}", seconds)
+        if kind in ("ply-ascii", "obj"):  # what reading them took before the compiled reader: trimesh's parser
+            import trimesh
+
+            seconds, _ = best_of(1, lambda: trimesh.load(str(path), process=False, force="scene"))
+            line(f"  trimesh's parser alone", seconds)
 
     path = ply or write(ball, folder, "ply")
     scene = Scene(nodes=[Node("ball", shape=MeshFile(path.name))], source_path=folder / "scene.json")

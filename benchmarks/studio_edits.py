@@ -130,11 +130,11 @@ def run_scene(renderer, name: str, scene: Scene, small: str, large: str, materia
     print(f"\n{name}: {scene.camera.resolution[0]}x{scene.camera.resolution[1]}, first sample after each edit "
           f"(median of {repeat}); where the time went in the two-level run")
     print(f"{'edit':<12} {'two levels':>11} {'one level':>10} {'speed-up':>9}   "
-          f"{'place':>6} {'trees':>6} {'pack':>6} {'upload':>6} {'kernel':>6} {'sample':>6} {'MB sent':>8} mesh trees built")
+          f"{'read':>6} {'place':>6} {'trees':>6} {'pack':>6} {'upload':>6} {'kernel':>6} {'sample':>6} {'MB sent':>8} mesh trees built")
     for edit in results["two levels"]:
         two, load = results["two levels"][edit]
         one, _ = results["one level"][edit]
-        print(f"{edit:<12} {two:>10.3f}s {one:>9.3f}s {one / two:>8.1f}x   {load.place:>6.3f} {load.trees:>6.3f} "
+        print(f"{edit:<12} {two:>10.3f}s {one:>9.3f}s {one / two:>8.1f}x   {load.read:>6.3f} {load.place:>6.3f} {load.trees:>6.3f} "
               f"{load.pack:>6.3f} {load.upload:>6.3f} {load.kernel:>6.3f} {two - load.total:>6.3f} "
               f"{load.uploaded_bytes / 1e6:>8.1f} {load.mesh_trees_built}")
     print(f"sampling ({sample_spp} spp): {rates['two levels']:.3g} M samples/s with two levels, "

@@ -481,7 +481,7 @@ def test_a_render_logged_to_a_file_prints_progress_lines(renderer, tmp_path, cap
     lines = err.splitlines()
     assert status == 0 and lines[-1].startswith("wrote ")
     assert re.fullmatch(r"lenslab: loaded: 36 triangles, 0 spheres; kd-tree of \d+ nodes built in [0-9.]+ s; "
-                        r"read and placed in [0-9.]+ s, packed in [0-9.]+ s, uploaded in [0-9.]+ s, "
+                        r"mesh files read in [0-9.]+ s, placed in [0-9.]+ s, packed in [0-9.]+ s, uploaded in [0-9.]+ s, "
                         r"kernel ready in [0-9.]+ s; ready to sample after [0-9.]+ s", lines.pop(0)), err
     assert lines[:-1] and all(re.fullmatch(r"lenslab: rendering: [0-3] of 3 spp after \d+ s \([0-9.]+ M samples/s\)",
                                            line) for line in lines[:-1]), err

@@ -274,13 +274,30 @@ class Pick:
     node_index: int  # that node's index in the flattened scene's nodes (depth first)
 
 
+class _TimedMeshReads:
+    """flatten_scene's mesh loader (scene/io/meshes.load_mesh_parts), adding up the seconds spent in it."""
+
+    def __init__(self):
+        self.seconds = 0.0
+
+    def __call__(self, path, smooth: bool, shape_index: int):
+        from lenslab.scene.io.meshes import load_mesh_parts
+
+        start = time.perf_counter()
+        try:
+            return load_mesh_parts(path, smooth, shape_index)
+        finally:
+            self.seconds += time.perf_counter() - start
+
+
 @dataclass(frozen=True)
 class SceneLoad:
     """Where the time of the last set_scene went, in seconds, and what it made (the CLI's load line, the
-    benchmarks). ``place``: reading mesh files and placing every primitive (scene/flatten.py); ``trees``: building
-    or reading back the kd-trees; ``pack``: the rest of the packing (materials, lights, textures, joining the
+    benchmarks). ``read``: reading mesh files (nothing when they were read before and are unchanged);
+    ``place``: placing every primitive (scene/flatten.py); ``trees``: building or reading back the kd-trees; ``pack``: the rest of the packing (materials, lights, textures, joining the
     layers); ``upload``: the buffers to the device; ``kernel``: choosing (and, the first time, compiling) it."""
 
+    read: float
     place: float
     trees: float
     pack: float
@@ -293,12 +310,12 @@ class SceneLoad:
 
     @property
     def total(self) -> float:
-        return self.place + self.trees + self.pack + self.upload + self.kernel
+        return self.read + self.place + self.trees + self.pack + self.upload + self.kernel
 
     def describe_steps(self) -> str:
         """Every step but the trees' (which the CLI's load line names with the trees)."""
-        return (f"read and placed in {self.place:.2f} s, packed in {self.pack:.2f} s, uploaded in {self.upload:.2f} s, "
-                f"kernel ready in {self.kernel:.2f} s")
+        return (f"mesh files read in {self.read:.2f} s, placed in {self.place:.2f} s, packed in {self.pack:.2f} s, "
+                f"uploaded in {self.upload:.2f} s, kernel ready in {self.kernel:.2f} s")
 
 
 @dataclass(frozen=True)
@@ -357,7 +374,8 @@ class RenderSession:
         start = time.perf_counter()
         # Large meshes stay in their own space with trees of their own, kept from one edit to the next
         # (render/instancing.py): an edit that leaves a mesh as it was never rebuilds its tree.
-        flat_scene = flatten_scene(scene, instance_min_triangles=INSTANCE_MIN_TRIANGLES,
+        reading = _TimedMeshReads()
+        flat_scene = flatten_scene(scene, mesh_loader=reading, instance_min_triangles=INSTANCE_MIN_TRIANGLES,
                                    known_groups=self._groups.known_groups())
         self._check_triangle_count(flat_scene.stored_triangle_count, "the scene has")
         placed = time.perf_counter()
@@ -385,7 +403,7 @@ class RenderSession:
         self.program = self._trace_program(self.settings.sampler)
         self.set_camera(scene.camera)
         built = [world_tree, *self._groups.new_trees]
-        self.load = SceneLoad(place=placed - start, trees=trees - placed, pack=packing - trees, upload=uploaded - packing,
+        self.load = SceneLoad(read=reading.seconds, place=placed - start - reading.seconds, trees=trees - placed, pack=packing - trees, upload=uploaded - packing,
                               kernel=time.perf_counter() - uploaded, trees_built=len(built),
                               trees_from_cache=sum(tree.from_cache for tree in built),
                               mesh_trees_built=self._groups.built, uploaded_bytes=gpu_scene.uploaded_bytes)

@@ -64,6 +64,7 @@ from lenslab.color import srgb_to_linear
 from lenslab.image_files import read_pixels
 from lenslab.scene.io.meshes import LoadedMesh, MeshLoadError, MeshPart, check_geometry, smooth_normals
 from lenslab.scene.io.mitsuba_serialized import read_serialized
+from lenslab.scene.io.text_meshes import TextMeshPiece, read_ascii_ply, read_obj
 from lenslab.scene.materials import Conductor, Dielectric, Diffuse, Emissive, Material, Plastic
 from lenslab.scene.shapes import TriangleMesh
 from lenslab.scene.textures import Checkerboard, ImageTexture, InlineImageTexture, Texture
@@ -238,6 +239,10 @@ class NoMaterials:
     def load_trimesh(self):
         import trimesh
 
+        if self.path.suffix.lower() == ".ply":
+            piece = read_ascii_ply(self.path)  # None for a binary PLY, or one outside the compiled reader's subset
+            if piece is not None:
+                return _text_scene([piece], self.path)
         return trimesh.load(str(self.path), process=False, force="scene")
 
     def material_for(self, geometry) -> Mapped | None:
@@ -259,6 +264,23 @@ class SerializedMesh(NoMaterials):
         visual = trimesh.visual.TextureVisuals(uv=mesh.uvs) if mesh.uvs is not None else None
         return trimesh.Scene(trimesh.Trimesh(mesh.vertices, mesh.faces, vertex_normals=mesh.normals, visual=visual,
                                              process=False))
+
+
+def _text_scene(pieces: list[TextMeshPiece], path: Path):
+    """The pieces text_meshes read, as the trimesh scene its parsers would have made: one geometry per material,
+    named by it (the file's name where there is none), its ``usemtl`` name as the visual's material."""
+    import trimesh
+
+    scene = trimesh.Scene()
+    for piece in pieces:
+        material = trimesh.visual.material.SimpleMaterial(name=piece.material) if piece.material else None
+        visual = None
+        if material is not None or piece.uvs is not None:
+            visual = trimesh.visual.TextureVisuals(uv=piece.uvs, material=material)
+        mesh = trimesh.Trimesh(piece.vertices, piece.faces, vertex_normals=piece.normals, visual=visual,
+                               process=False, validate=False)
+        scene.add_geometry(mesh, geom_name=piece.material or path.name)
+    return scene
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -403,14 +425,29 @@ def _check_mtl_numbers(library: Path, material: str, keys: dict[str, tuple[str, 
                 raise MeshLoadError(f"{library}: material '{material}': {written} {value}: not a finite number")
 
 
+def _mtllib_statements(text: bytes) -> list[str]:
+    """The values of an OBJ's ``mtllib`` statements. Found with bytes.find, which skips a hundred megabytes of
+    vertices in milliseconds, where a multi-line regular expression tries every line start."""
+    values = []
+    at = text.find(b"mtllib")
+    while at >= 0:
+        line_start = text.rfind(b"\n", 0, at) + 1
+        line_end = text.find(b"\n", at)
+        line_end = len(text) if line_end < 0 else line_end
+        match = re.fullmatch(rb"[ \t]*mtllib[ \t]+(.+?)[ \t\r]*", text[line_start:line_end])
+        if match:
+            values.append(match.group(1).decode("utf-8", "replace"))
+        at = text.find(b"mtllib", line_end)
+    return values
+
+
 class ObjMaterials:
     def __init__(self, path: Path, notes: Notes):
         self.path, self.notes = path, notes
         self.definitions: dict[str, tuple[dict[str, tuple[str, str]], Path]] = {}  # name -> (keys, MTL folder)
         self._mapped: dict[str, Mapped] = {}
-        text = path.read_bytes()
-        for match in re.finditer(rb"^[ \t]*mtllib[ \t]+(.+?)[ \t]*$", text, re.MULTILINE):
-            self._read_library(match.group(1).decode("utf-8", "replace"))
+        for value in _mtllib_statements(path.read_bytes()):
+            self._read_library(value)
 
     def _read_library(self, value: str) -> None:
         names = [value] if os.path.isfile(self.path.parent / value) else value.split()
@@ -427,6 +464,9 @@ class ObjMaterials:
     def load_trimesh(self):
         import trimesh
 
+        pieces = read_obj(self.path)  # None for a file outside the compiled reader's subset
+        if pieces is not None:
+            return _text_scene(pieces, self.path)
         return trimesh.load(str(self.path), process=False, force="scene")
 
     def material_for(self, geometry) -> Mapped | None:
