@@ -49,6 +49,11 @@ def test_a_token_that_is_no_decimal_is_outside_the_subset(text):
 
 
 # -- OBJ ----------------------------------------------------------------------------------------------------
+def read_obj(path):
+    reading = text_meshes.read_obj(path.read_bytes())
+    return None if reading is None else reading.pieces
+
+
 def corner_table(vertices, faces, normals=None, uvs=None) -> np.ndarray:
     """Each triangle's corners as rows of (position, uv, normal), each triangle rotated to start at its least
     corner (the winding kept) and the triangles sorted: two readings of a file compare equal when they hold the
@@ -104,10 +109,11 @@ def cube_obj(corner_form: str, *, polygons=True, relative=False, crlf=False, clu
 def test_obj_reads_the_triangles_trimesh_reads(tmp_path, form, variant):
     path = tmp_path / "cube.obj"
     path.write_text(cube_obj(form, **variant), newline="")
-    pieces = text_meshes.read_obj(path)
+    pieces = read_obj(path)
     assert pieces is not None
     if variant.get("clutter"):
         assert [piece.material for piece in pieces] == ["red", "blue"]
+        assert text_meshes.read_obj(path.read_bytes()).libraries == ["cube.mtl"]
     plain = tmp_path / "plain.obj"  # trimesh reads no comment at the end of a face's line
     plain.write_text(cube_obj(form, **variant).replace("  # tri", ""), newline="")
     theirs = trimesh_pieces(plain)
@@ -131,7 +137,7 @@ def test_obj_reads_the_triangles_trimesh_reads(tmp_path, form, variant):
 def test_relative_indices_count_back_from_the_line(tmp_path):
     path = tmp_path / "two.obj"
     path.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\nv 5 5 5\nv 6 5 5\nv 5 6 5\nf -3 -2 -1\n")
-    (piece,) = text_meshes.read_obj(path)
+    (piece,) = read_obj(path)
     assert np.array_equal(piece.vertices[piece.faces][1], [[5, 5, 5], [6, 5, 5], [5, 6, 5]])
 
 
@@ -140,7 +146,7 @@ def test_an_exported_ball_reads_as_trimesh_reads_it(tmp_path):
     ball.vertices = ball.vertices * (1 + 0.1 * np.sin(7 * ball.vertices[:, :1]))
     path = tmp_path / "ball.obj"
     path.write_text(trimesh.exchange.obj.export_obj(ball, include_normals=True))
-    (piece,) = text_meshes.read_obj(path)
+    (piece,) = read_obj(path)
     (theirs,) = trimesh_pieces(path)
     assert np.array_equal(piece.vertices, theirs.vertices) and np.array_equal(piece.faces, theirs.faces)
     assert np.array_equal(piece.normals, theirs._cache.cache["vertex_normals"])
@@ -159,7 +165,7 @@ def test_an_exported_ball_reads_as_trimesh_reads_it(tmp_path):
 def test_what_is_outside_the_subset_goes_to_trimesh(tmp_path, text):
     path = tmp_path / "odd.obj"
     path.write_text(text)
-    assert text_meshes.read_obj(path) is None
+    assert read_obj(path) is None
 
 
 def test_vertex_colours_are_still_reported(tmp_path):
@@ -251,7 +257,16 @@ def test_without_numba_trimesh_reads_the_text_formats(tmp_path, hide_package, mo
     mesh_materials._load_cached.cache_clear()
     path = tmp_path / "cube.obj"
     path.write_text(cube_obj("{p}/{t}/{n}"))
-    assert text_meshes.read_obj(path) is None
+    assert read_obj(path) is None
     loaded = load_mesh_parts(path)
     assert sum(part.mesh.triangle_count for part in loaded.parts) == 12
     assert math.isfinite(float(loaded.parts[0].mesh.vertices.sum()))
+
+
+def test_a_file_trimesh_reads_keeps_its_materials(tmp_path):
+    (tmp_path / "a.mtl").write_text("newmtl red\nKd 1 0 0\n")
+    path = tmp_path / "lines.obj"  # a line statement: outside the compiled subset
+    path.write_text("mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\nusemtl red\nf 1 2 3\n")
+    assert read_obj(path) is None
+    (part,) = load_mesh_parts(path).parts
+    assert part.name == "red" and part.material.albedo == (1.0, 0.0, 0.0)

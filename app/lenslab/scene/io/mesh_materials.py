@@ -446,7 +446,10 @@ class ObjMaterials:
         self.path, self.notes = path, notes
         self.definitions: dict[str, tuple[dict[str, tuple[str, str]], Path]] = {}  # name -> (keys, MTL folder)
         self._mapped: dict[str, Mapped] = {}
-        for value in _mtllib_statements(path.read_bytes()):
+        text = path.read_bytes()
+        self._compiled_reading = read_obj(text)  # None for a file outside the compiled reader's subset
+        libraries = self._compiled_reading.libraries if self._compiled_reading else _mtllib_statements(text)
+        for value in libraries:
             self._read_library(value)
 
     def _read_library(self, value: str) -> None:
@@ -464,9 +467,8 @@ class ObjMaterials:
     def load_trimesh(self):
         import trimesh
 
-        pieces = read_obj(self.path)  # None for a file outside the compiled reader's subset
-        if pieces is not None:
-            return _text_scene(pieces, self.path)
+        if self._compiled_reading is not None:
+            return _text_scene(self._compiled_reading.pieces, self.path)
         return trimesh.load(str(self.path), process=False, force="scene")
 
     def material_for(self, geometry) -> Mapped | None:

@@ -47,6 +47,20 @@ def _skip_line(data, i, n):
 
 
 @njit(cache=True)
+def _beyond_exact(data, start, end):
+    """Whether the digits in ``data[start:end]`` (a decimal point among them perhaps) make an integer beyond
+    2^53, or one too long for 63 bits."""
+    digits = 0
+    mantissa = 0
+    for k in range(start, end):
+        if data[k] != 46:
+            digits += 1
+            if digits <= 18:
+                mantissa = mantissa * 10 + (data[k] - 48)
+    return digits > 18 or mantissa > _EXACT_MANTISSA
+
+
+@njit(cache=True)
 def _read_exponent(data, i, n):
     """The exponent after an ``e``: (value, index after it, ok)."""
     negative = False
@@ -75,7 +89,6 @@ def _read_float(data, i, n, powers):
     while i < n and 48 <= data[i] <= 57:
         mantissa = mantissa * 10 + (data[i] - 48)
         i += 1
-    digits = i - start
     scale = 0  # the power of ten the mantissa's last digit stands at
     if i < n and data[i] == 46:  # .
         i += 1
@@ -84,15 +97,16 @@ def _read_float(data, i, n, powers):
             mantissa = mantissa * 10 + (data[i] - 48)
             i += 1
         scale = fraction - i
-        digits += i - fraction
-    if digits == 0:
+    if i == start or (i == start + 1 and data[start] == 46):
         return 0.0, i, NOT_A_NUMBER
+    # Perhaps more digits than a double holds exactly: counted where it is rare.
+    beyond_exact = i - start > 15 and _beyond_exact(data, start, i)
     if i < n and (data[i] == 101 or data[i] == 69):  # e E
         exponent, i, ok = _read_exponent(data, i + 1, n)
         if not ok:
             return 0.0, i, NOT_A_NUMBER
         scale += exponent
-    if digits > 15 and (digits > 18 or mantissa > _EXACT_MANTISSA):
+    if beyond_exact:
         return 0.0, i, INEXACT
     if mantissa == 0:
         value = 0.0
@@ -131,7 +145,9 @@ def _ends_token(data, i, n):
 # OBJ
 # ---------------------------------------------------------------------------------------------------------
 # What a line states, from its first word.
-_UNKNOWN, _POSITION, _UV, _NORMAL, _FACE, _USEMTL, _IGNORED = range(7)
+_UNKNOWN, _POSITION, _UV, _NORMAL, _FACE, _USEMTL, _MTLLIB, _IGNORED = range(8)
+# The kinds of named statements obj_parse returns the names of.
+USEMTL, MTLLIB = 0, 1
 
 
 @njit(cache=True, inline="always")
@@ -143,9 +159,9 @@ def _word_is(data, i, n, a, b, c, d, e, f):
 
 @njit(cache=True)
 def _statement(data, i, n):
-    """What the line at ``data[i:]`` (its first non-blank byte) states: v, vt, vn, f and usemtl are read; o, g, s
-    and mtllib carry nothing the geometry needs (the normals are the file's or made smooth; mesh_materials.py
-    reads the libraries); anything else puts the file outside the subset."""
+    """What the line at ``data[i:]`` (its first non-blank byte) states: v, vt, vn, f, usemtl and mtllib are read
+    (the libraries' names for mesh_materials.py); o, g and s carry nothing the geometry needs (the normals are
+    the file's or made smooth); anything else puts the file outside the subset."""
     c = data[i]
     if c == 118:  # v
         if _ends_token(data, i + 1, n):
@@ -162,7 +178,7 @@ def _statement(data, i, n):
     if _word_is(data, i, n, 117, 115, 101, 109, 116, 108):  # usemtl
         return _USEMTL
     if _word_is(data, i, n, 109, 116, 108, 108, 105, 98):  # mtllib
-        return _IGNORED
+        return _MTLLIB
     return _UNKNOWN
 
 
@@ -180,7 +196,7 @@ def _continued(data, end, n):
 @njit(cache=True)
 def obj_counts(data):
     """Pass one: (status, byte offset of the first statement outside the subset, vertices, texture coordinates,
-    normals, triangles (polygons fanned), usemtl statements)."""
+    normals, triangles (polygons fanned), usemtl and mtllib statements)."""
     n = data.shape[0]
     nv = nvt = nvn = ntri = nmtl = 0
     i = 0
@@ -215,7 +231,7 @@ def obj_counts(data):
             if corners < 3:
                 return OUTSIDE_SUBSET, line, 0, 0, 0, 0, 0
             ntri += corners - 2
-        elif statement == _USEMTL:
+        elif statement == _USEMTL or statement == _MTLLIB:
             nmtl += 1
         elif statement == _UNKNOWN:
             return OUTSIDE_SUBSET, line, 0, 0, 0, 0, 0
@@ -240,14 +256,15 @@ def _obj_index(value, count):
 def obj_parse(data, nv, nvt, nvn, ntri, nmtl, powers):
     """Pass two: positions (nv, 3), texture coordinates (nvt, 2), normals (nvn, 3); each triangle's corners as
     position, texture-coordinate and normal indices (ntri, 3, 3; -1 where the corner has none); each triangle's
-    usemtl statement (-1 before the first); each usemtl statement's name as a byte span (nmtl, 2); and a status
+    usemtl statement (-1 before the first); each usemtl and mtllib statement's value as a byte span and its kind
+    (nmtl, [start, end, USEMTL or MTLLIB]); and a status
     with the byte offset of the statement that put the file outside the subset."""
     positions = np.empty((nv, 3), np.float64)
     uvs = np.empty((nvt, 2), np.float64)
     normals = np.empty((nvn, 3), np.float64)
     corners = np.empty((ntri, 3, 3), np.int32)
     materials = np.empty(ntri, np.int32)
-    names = np.empty((nmtl, 2), np.int64)
+    names = np.empty((nmtl, 3), np.int64)
     n = data.shape[0]
     kv = kvt = kvn = kt = km = 0
     current = -1
@@ -335,7 +352,7 @@ def obj_parse(data, nv, nvt, nvn, ntri, nmtl, powers):
                     kt += 1
                 last_p, last_t, last_n = p, t, nrm
                 count += 1
-        elif statement == _USEMTL:
+        elif statement == _USEMTL or statement == _MTLLIB:
             i = _skip_blanks(data, i + 6, n)
             start = i
             while i < n and data[i] != _NEWLINE:
@@ -344,7 +361,9 @@ def obj_parse(data, nv, nvt, nvn, ntri, nmtl, powers):
             while end > start and _is_blank(data[end - 1]):
                 end -= 1
             names[km, 0], names[km, 1] = start, end
-            current = km
+            names[km, 2] = USEMTL if statement == _USEMTL else MTLLIB
+            if statement == _USEMTL:
+                current = km
             km += 1
         i = _skip_line(data, i, n)
     return READ, -1, positions, uvs, normals, corners, materials, names

@@ -47,13 +47,19 @@ def _compiled():
 # ---------------------------------------------------------------------------------------------------------
 # OBJ
 # ---------------------------------------------------------------------------------------------------------
-def read_obj(path: Path) -> list[TextMeshPiece] | None:
-    """The OBJ file's faces as pieces, one per material in the order they are first used; None where the file is
-    outside the subset read here."""
+@dataclass(frozen=True)
+class TextObj:
+    pieces: list[TextMeshPiece]  # one per material, in the order they are first used
+    libraries: list[str]  # the values of the mtllib statements
+
+
+def read_obj(text: bytes) -> TextObj | None:
+    """An OBJ file's faces as pieces, one per material, and its material libraries; None where the file is outside
+    the subset read here."""
     compiled = _compiled()
     if compiled is None:
         return None
-    data = np.frombuffer(Path(path).read_bytes(), np.uint8)
+    data = np.frombuffer(text, np.uint8)
     status, _offset, nv, nvt, nvn, ntri, nmtl = compiled.obj_counts(data)
     if status != compiled.READ:
         return None
@@ -61,10 +67,12 @@ def read_obj(path: Path) -> list[TextMeshPiece] | None:
         data, nv, nvt, nvn, ntri, nmtl, compiled.POWERS_OF_TEN)
     if status != compiled.READ:
         return None
-    names = [bytes(data[start:end]).decode("utf-8", "replace") for start, end in spans]
+    values = [text[start:end].decode("utf-8", "replace") for start, end, _kind in spans]
+    libraries = [value for value, (_s, _e, kind) in zip(values, spans) if kind == compiled.MTLLIB]
     # One piece per material name (a name used in several usemtl statements is one material).
-    unique = list(dict.fromkeys(names))
-    statement_piece = np.array([unique.index(name) for name in names] + [-1], np.int64)
+    unique = list(dict.fromkeys(value for value, (_s, _e, kind) in zip(values, spans) if kind == compiled.USEMTL))
+    statement_piece = np.array([unique.index(value) if kind == compiled.USEMTL else -1
+                                for value, (_s, _e, kind) in zip(values, spans)] + [-1], np.int64)
     piece_of_triangle = statement_piece[materials]  # -1 (no usemtl yet) indexes the appended -1
     pieces = []
     for piece in [-1] + list(range(len(unique))):
@@ -79,7 +87,7 @@ def read_obj(path: Path) -> list[TextMeshPiece] | None:
         vertices, faces, piece_normals, piece_uvs = mesh
         pieces.append(TextMeshPiece(None if piece < 0 else unique[piece], vertices, faces, piece_normals,
                                     piece_uvs))
-    return pieces
+    return TextObj(pieces, libraries)
 
 
 def _indexed(corners: np.ndarray, positions: np.ndarray, uvs: np.ndarray, normals: np.ndarray):
