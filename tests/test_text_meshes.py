@@ -168,7 +168,7 @@ def test_what_is_outside_the_subset_goes_to_trimesh(tmp_path, text):
     assert read_obj(path) is None
 
 
-def test_vertex_colours_are_still_reported(tmp_path):
+def test_vertex_colours_are_still_reported(tmp_path, compiled_for_every_size):
     path = tmp_path / "coloured.obj"
     path.write_text("v 0 0 0 1 0 0\nv 1 0 0 1 0 0\nv 0 1 0 1 0 0\nf 1 2 3\n")
     loaded = load_mesh_parts(path)
@@ -176,7 +176,19 @@ def test_vertex_colours_are_still_reported(tmp_path):
     assert any("vertex colours" in w for w in loaded.warnings)
 
 
-def test_obj_materials_come_from_every_library(tmp_path):
+@pytest.fixture
+def compiled_for_every_size(monkeypatch):
+    """Small files are left to trimesh (mesh_materials.TEXT_COMPILED_MIN_BYTES); these tests read theirs compiled."""
+    monkeypatch.setattr(mesh_materials, "TEXT_COMPILED_MIN_BYTES", 0)
+    mesh_materials._load_cached.cache_clear()
+    yield
+    mesh_materials._load_cached.cache_clear()
+
+
+@pytest.mark.parametrize("compiled", [True, False], ids=["compiled", "trimesh"])
+def test_obj_materials_come_from_every_library(tmp_path, monkeypatch, compiled):
+    if compiled:
+        monkeypatch.setattr(mesh_materials, "TEXT_COMPILED_MIN_BYTES", 0)
     (tmp_path / "a.mtl").write_text("newmtl red\nKd 1 0 0\n")
     (tmp_path / "b.mtl").write_text("newmtl blue\nKd 0 0 1\n")
     path = tmp_path / "two.obj"
@@ -242,7 +254,7 @@ def test_ascii_ply_outside_the_subset_goes_to_trimesh(tmp_path, header, body):
     assert text_meshes.read_ascii_ply(path) is None
 
 
-def test_binary_ply_is_not_for_the_text_reader(tmp_path):
+def test_binary_ply_is_not_for_the_text_reader(tmp_path, compiled_for_every_size):
     path = tmp_path / "ball.ply"
     path.write_bytes(trimesh.exchange.ply.export_ply(trimesh.creation.icosphere(subdivisions=1)))
     assert text_meshes.read_ascii_ply(path) is None
@@ -250,7 +262,7 @@ def test_binary_ply_is_not_for_the_text_reader(tmp_path):
 
 
 # -- without numba ------------------------------------------------------------------------------------------
-def test_without_numba_trimesh_reads_the_text_formats(tmp_path, hide_package, monkeypatch):
+def test_without_numba_trimesh_reads_the_text_formats(tmp_path, hide_package, monkeypatch, compiled_for_every_size):
     hide_package("numba")
     monkeypatch.delitem(sys.modules, "lenslab.scene.io.text_compiled")
     monkeypatch.delattr(lenslab.scene.io, "text_compiled")
@@ -263,7 +275,7 @@ def test_without_numba_trimesh_reads_the_text_formats(tmp_path, hide_package, mo
     assert math.isfinite(float(loaded.parts[0].mesh.vertices.sum()))
 
 
-def test_a_file_trimesh_reads_keeps_its_materials(tmp_path):
+def test_a_file_trimesh_reads_keeps_its_materials(tmp_path, compiled_for_every_size):
     (tmp_path / "a.mtl").write_text("newmtl red\nKd 1 0 0\n")
     path = tmp_path / "lines.obj"  # a line statement: outside the compiled subset
     path.write_text("mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\nusemtl red\nf 1 2 3\n")

@@ -70,6 +70,11 @@ from lenslab.scene.shapes import TriangleMesh
 from lenslab.scene.textures import Checkerboard, ImageTexture, InlineImageTexture, Texture
 from lenslab.scene.transform import transform_normals, transform_points
 
+# Text mesh files (OBJ, ASCII PLY) smaller than this are parsed by trimesh: loading the compiled reader's machine code
+# takes about half a second in each process (and numba some ten seconds to make it, once a machine), more than
+# trimesh spends on a file this small (0.2 s).
+TEXT_COMPILED_MIN_BYTES = 4 * 2 ** 20
+
 # What an unreadable embedded image becomes: the renderer's own placeholder for a missing texture file.
 PLACEHOLDER = Checkerboard(color_a=(1.0, 0.0, 1.0), color_b=(0.0, 0.0, 0.0), tiles=(16.0, 16.0))
 
@@ -239,7 +244,7 @@ class NoMaterials:
     def load_trimesh(self):
         import trimesh
 
-        if self.path.suffix.lower() == ".ply":
+        if self.path.suffix.lower() == ".ply" and self.path.stat().st_size >= TEXT_COMPILED_MIN_BYTES:
             piece = read_ascii_ply(self.path)  # None for a binary PLY, or one outside the compiled reader's subset
             if piece is not None:
                 return _text_scene([piece], self.path)
@@ -425,6 +430,20 @@ def _check_mtl_numbers(library: Path, material: str, keys: dict[str, tuple[str, 
                 raise MeshLoadError(f"{library}: material '{material}': {written} {value}: not a finite number")
 
 
+def _all_libraries_resolver(path: Path, libraries: bytes):
+    """A trimesh resolver that answers every request for an MTL file with ``libraries`` (all the OBJ's material
+    libraries, joined), and any other (a texture) from the OBJ's folder."""
+    import trimesh
+
+    class AllLibraries(trimesh.resolvers.FilePathResolver):
+        def get(self, name: str) -> bytes:
+            if name.strip().lower().endswith(".mtl"):
+                return libraries
+            return super().get(name)
+
+    return AllLibraries(str(path))
+
+
 def _mtllib_statements(text: bytes) -> list[str]:
     """The values of an OBJ's ``mtllib`` statements. Found with bytes.find, which skips a hundred megabytes of
     vertices in milliseconds, where a multi-line regular expression tries every line start."""
@@ -446,8 +465,10 @@ class ObjMaterials:
         self.path, self.notes = path, notes
         self.definitions: dict[str, tuple[dict[str, tuple[str, str]], Path]] = {}  # name -> (keys, MTL folder)
         self._mapped: dict[str, Mapped] = {}
+        self._library_files: list[Path] = []
         text = path.read_bytes()
-        self._compiled_reading = read_obj(text)  # None for a file outside the compiled reader's subset
+        # None for a small file, or one outside the compiled reader's subset: trimesh reads those.
+        self._compiled_reading = read_obj(text) if len(text) >= TEXT_COMPILED_MIN_BYTES else None
         libraries = self._compiled_reading.libraries if self._compiled_reading else _mtllib_statements(text)
         for value in libraries:
             self._read_library(value)
@@ -460,6 +481,7 @@ class ObjMaterials:
                 self.notes.add_file(f"material library '{name}' not found ({library}): its materials render "
                                     "with the node's material or the default grey")
                 continue
+            self._library_files.append(library)
             for material, keys in parse_mtl(library.read_text("utf-8", "replace")).items():
                 _check_mtl_numbers(library, material, keys)
                 self.definitions.setdefault(material, (keys, library.parent))
@@ -469,7 +491,10 @@ class ObjMaterials:
 
         if self._compiled_reading is not None:
             return _text_scene(self._compiled_reading.pieces, self.path)
-        return trimesh.load(str(self.path), process=False, force="scene")
+        # trimesh reads only the first library an OBJ names; handed all of them as one, it names every material
+        # the faces use, as the compiled reader does.
+        resolver = _all_libraries_resolver(self.path, b"\n".join(library.read_bytes() for library in self._library_files))
+        return trimesh.load(str(self.path), process=False, force="scene", resolver=resolver)
 
     def material_for(self, geometry) -> Mapped | None:
         name = getattr(getattr(geometry.visual, "material", None), "name", None)
