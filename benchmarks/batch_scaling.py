@@ -28,15 +28,14 @@ def bracket(folder: Path, shots: int, size: int, spp: int, split: int = 1) -> li
 
 def in_process(shots) -> float:
     """Seconds to render and write every shot here, one after another, as `lenslab SCENE --headless` would."""
-    from lenslab.cli import HEADLESS_DISPATCH_SECONDS
-    from lenslab.render.job import RenderJob
+    from lenslab.render.job import OFFLINE_DISPATCH_SECONDS, RenderJob
     from lenslab.render.tracer import Renderer
 
     start = time.perf_counter()
     renderer = Renderer()
     for shot in shots:
         job = RenderJob(renderer, shot.open_scene(), spp=shot.overrides.spp,
-                        dispatch_seconds=HEADLESS_DISPATCH_SECONDS)
+                        dispatch_seconds=OFFLINE_DISPATCH_SECONDS)
         job.run()
         job.write(shot.output)
         job.release()

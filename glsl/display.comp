@@ -15,14 +15,17 @@ uniform ivec2 image_size;
 uniform float exposure_scale;  // 2^stops
 uniform int tone_map;          // TONE_MAP_CLAMP, TONE_MAP_REINHARD or TONE_MAP_FILMIC
 
+// The curves' numbers are #defines from the Python that owns them (render/gpu_layout.py): FILMIC_* from
+// lenslab.render.film, SRGB_* from lenslab.color. None is typed here.
+
 vec3 filmic(vec3 x) {  // Narkowicz's fit of the ACES reference rendering transform (film._filmic)
-    const float a = 2.51, b = 0.03, c = 2.43, d = 0.59, e = 0.14;
-    return clamp((x * (a * x + b)) / (x * (c * x + d) + e), 0.0, 1.0);
+    return clamp((x * (FILMIC_A * x + FILMIC_B)) / (x * (FILMIC_C * x + FILMIC_D) + FILMIC_E), 0.0, 1.0);
 }
 
 vec3 linear_to_srgb(vec3 x) {  // IEC 61966-2-1, as lenslab.color
     x = clamp(x, 0.0, 1.0);
-    return mix(1.055 * pow(x, vec3(1.0 / 2.4)) - 0.055, 12.92 * x, lessThanEqual(x, vec3(0.0031308)));
+    return mix(SRGB_SCALE * pow(x, vec3(1.0 / SRGB_EXPONENT)) - SRGB_OFFSET, SRGB_LINEAR_SLOPE * x,
+               lessThanEqual(x, vec3(SRGB_LINEAR_CUTOFF)));
 }
 
 void main() {

@@ -83,7 +83,7 @@ def test_nonsense_limits_are_refused(renderer, bad):
 
 
 def test_a_time_limit_that_ends_inside_a_pass_of_many_dispatches_finishes_that_pass(renderer, tmp_path, monkeypatch):
-    """Issue 12: at 4096 x 4096 a pass takes many dispatches, and a time limit that ended after the first few
+    """At 4096 x 4096 a pass takes many dispatches, and a time limit that ended after the first few
     wrote "0 spp" with 0.5% of the pixels lit. Forced here on a small image with dispatches of a few pixels."""
     from lenslab.render.tracer import RenderSession
 

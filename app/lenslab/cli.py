@@ -18,114 +18,16 @@ import warnings
 from pathlib import Path
 
 from lenslab import __version__
+from lenslab.command_line import (EXIT_ERROR, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, CliError, CommandParser,
+                                  add_option, number_argument, parse_defines)
 from lenslab.messages import describe_os_error, one_line
-from lenslab.scene.fields import declared_choices, declared_range
 
-EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
-HEADLESS_DISPATCH_SECONDS = 0.25
 #: With stderr not a terminal (a log), a line of progress this often, so that a long render shows it is alive.
 PROGRESS_LINE_SECONDS = 10.0
 
 
-class CliError(Exception):
-    """A failure to report as one line, with an exit status."""
-
-    def __init__(self, message: str, status: int = EXIT_ERROR):
-        super().__init__(message)
-        self.status = status
-
-
-class CommandParser(argparse.ArgumentParser):
-    """argparse for every ``lenslab`` command: a usage error is a CliError of one line, not a usage block."""
-
-    def error(self, message: str):
-        raise CliError(f"{message} (see {self.prog} --help)", EXIT_USAGE)
-
-
-def _bound(value: float) -> str:
-    return str(int(value)) if float(value).is_integer() else f"{value:g}"
-
-
-def number_argument(kind, low: float, high: float):
-    """An argparse type: an int or float in [low, high], refused in one line naming the value."""
-    def parse(text: str):
-        try:
-            value = kind(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected {'a whole number' if kind is int else 'a number'}, "
-                                             f"not '{text}'") from None
-        if not low <= value <= high or value != value:
-            raise argparse.ArgumentTypeError(f"{text} is out of range [{_bound(low)}, {_bound(high)}]")
-        return value
-
-    return parse
-
-
-def _declared(kind, cls, field_name: str):
-    """An argument checked against the range the scene class declares for the field it sets."""
-    return number_argument(kind, *declared_range(cls, field_name))
-
-
-def _f_number_argument(text: str) -> float:
-    """An f-number as a photographer writes it ("2.8", "f/2.8"): a marked stop is its exact value."""
-    from lenslab.optics.stops import parse_f_number
-
-    try:
-        return parse_f_number(text)
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
-
-
-def _shutter_argument(text: str) -> float:
-    from lenslab.optics.exposure import parse_shutter
-
-    try:
-        return parse_shutter(text)
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
-
-
-def _preset_argument(find):
-    """An argparse type: the name of a lens or sensor preset there is (the name as given: the scene overrides
-    look it up again). A preset file that cannot be read is an error of its own, not a usage error."""
-    from lenslab.optics.presetfiles import PresetError
-
-    def parse(text: str) -> str:
-        try:
-            find(text)
-        except PresetError as exc:
-            raise CliError(str(exc)) from None
-        except ValueError as exc:
-            raise argparse.ArgumentTypeError(str(exc)) from None
-        return text
-
-    return parse
-
-
-def _aperture_image_argument(text: str) -> str:
-    """A file of the stop's shape, relative to the current folder: made absolute, as the scene reads its own
-    aperture image relative to the scene's folder."""
-    path = Path(text).expanduser()
-    if not path.is_file():
-        raise argparse.ArgumentTypeError(f"no such file: {text}")
-    return str(path.resolve())
-
-
-def _blades_argument(text: str) -> int:
-    from lenslab.optics.lenses import MAX_APERTURE_BLADES
-
-    blades = number_argument(int, 0, MAX_APERTURE_BLADES)(text)
-    if blades in (1, 2):
-        raise argparse.ArgumentTypeError(f"{text}: a stop has 0 blades (round) or at least 3")
-    return blades
-
-
 def build_parser() -> argparse.ArgumentParser:
-    from lenslab.optics.lenses import find_lens
-    from lenslab.optics.sensors import find_sensor
-    from lenslab.scene.camera import MAX_IMAGE_SIDE, ThinLensCamera
     from lenslab.scene.io.loader import shipped_scene_names
-    from lenslab.scene.scene import RenderSettings
 
     p = CommandParser(
         prog="lenslab",
@@ -134,9 +36,9 @@ def build_parser() -> argparse.ArgumentParser:
         epilog="Examples:\n"
         "  lenslab cornell_box --headless -o cornell.png --spp 64\n"
         "  lenslab dof_chart --headless -o dof.exr --spp 16 --denoise\n"
-        "  lenslab my_scene.json --headless -o shot.exr --f-stop 1.4 --focus-distance 2.5 --time-limit 60\n"
-        "  lenslab product_shot --headless -o p.exr --lens '85mm f/1.4' --f-stop 2 --iso 400 --shutter 1/60\n"
-        "The camera settings override the scene's camera for this render only. A marked stop (--f-stop 11) is\n"
+        "  lenslab my_scene.json --headless -o shot.exr --f-number 1.4 --focus-distance 2.5 --time-limit 60\n"
+        "  lenslab product_shot --headless -o p.exr --lens '85mm f/1.4' --f-number 2 --iso 400 --shutter 1/60\n"
+        "The camera settings override the scene's camera for this render only. A marked stop (--f-number 11) is\n"
         "the exact stop (2^3.5); focus is measured from the sensor plane unless the scene says otherwise, and a\n"
         "mounted lens focuses no nearer than its minimum. In the default compensated exposure brightness does not\n"
         "change with the f-number; with --iso or --shutter each stop is a stop of light.\n"
@@ -149,62 +51,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("scene", nargs="?", help="a scene file (.json), a folder holding scene.json, or a shipped scene name")
     p.add_argument("--headless", action="store_true", help="render to a file without opening a window")
     p.add_argument("-o", "--output", metavar="FILE", help="with --headless: where to write the image, .exr (linear, float) or .png (sRGB)")
-    p.add_argument("--spp", type=_declared(int, RenderSettings, "spp"), metavar="N",
-                   help="samples per pixel (default: the scene's; with --time-limit alone, as many as fit)")
-    p.add_argument("--time-limit", type=number_argument(float, 0.001, 1e7), metavar="SECONDS",
-                   help="stop after this long, keeping what has been rendered (at least one sample in every pixel)")
-    p.add_argument("--width", type=number_argument(int, 1, MAX_IMAGE_SIDE), metavar="W", help="image width in pixels")
-    p.add_argument("--height", type=number_argument(int, 1, MAX_IMAGE_SIDE), metavar="H", help="image height in pixels")
-    p.add_argument("--f-stop", type=_f_number_argument, metavar="N",
-                   help="aperture as an f-number, e.g. 2.8 or f/2.8 (1.4 is wide open and blurry, 16 is deep focus)")
-    p.add_argument("--focal-length", type=_declared(float, ThinLensCamera, "focal_length_mm"), metavar="MM",
-                   help="lens focal length in millimetres (sets the field of view with the sensor width)")
-    p.add_argument("--focus-distance", type=_declared(float, ThinLensCamera, "focus_distance_m"), metavar="M",
-                   help="distance to the plane of focus, in metres")
+    for name in ("spp", "time_limit", "width", "height", "f_number", "focal_length", "focus_distance"):
+        add_option(p, name)
     camera = p.add_argument_group("camera and lens")
-    camera.add_argument("--lens", type=_preset_argument(find_lens), metavar="NAME",
-                        help="mount a lens preset: its focal lengths, stops, iris and minimum focus "
-                             "(see --list-lenses; the name's beginning will do where only one lens has it: 85mm)")
-    camera.add_argument("--sensor", type=_preset_argument(find_sensor), metavar="NAME",
-                        help="a sensor preset: its size and circle of confusion (see --list-sensors)")
-    camera.add_argument("--sensor-fit", choices=declared_choices(ThinLensCamera, "sensor_fit"),
-                        help="which part of the sensor the image shows (auto: the long sides together)")
-    camera.add_argument("--focus-from", choices=declared_choices(ThinLensCamera, "focus_from"),
-                        help="what --focus-distance is measured from (default: the scene's; new scenes: sensor)")
-    camera.add_argument("--no-focus-breathing", dest="focus_breathing", action="store_const", const=False,
-                        help="hold the framing: the sensor one focal length behind the lens at every focus")
-    camera.add_argument("--coc", type=_declared(float, ThinLensCamera, "circle_of_confusion_mm"), metavar="MM",
-                        help="circle of confusion for the depth-of-field readout and metadata")
-    camera.add_argument("--blades", type=_blades_argument, metavar="N", help="aperture blades: 0 round, or 3 to 32")
-    camera.add_argument("--blade-curvature", type=_declared(float, ThinLensCamera, "blade_curvature"), metavar="C",
-                        help="0 straight blades (polygonal bokeh) to 1 round")
-    camera.add_argument("--anamorphic", type=_declared(float, ThinLensCamera, "anamorphic_squeeze"),
-                        metavar="SQUEEZE", help="anamorphic squeeze: bokeh height over width (e.g. 1.33, 2)")
-    camera.add_argument("--barrel-clipping", type=_declared(float, ThinLensCamera, "barrel_clipping"), metavar="C",
-                        help="cat's-eye bokeh toward the frame's corners, 0 to 1")
-    camera.add_argument("--aperture-image", type=_aperture_image_argument, metavar="FILE",
-                        help="a grayscale image of the stop (custom bokeh), relative to the current folder")
-    camera.add_argument("--exposure-mode", choices=declared_choices(ThinLensCamera, "exposure_mode"),
-                        help="compensated (brightness kept) or physical (each stop a stop of light)")
-    camera.add_argument("--iso", type=_declared(float, ThinLensCamera, "iso"), metavar="S",
-                        help="sensor speed; implies --exposure-mode physical")
-    camera.add_argument("--shutter", type=_shutter_argument, metavar="T",
-                        help="exposure time, e.g. 1/125 or 2s; implies --exposure-mode physical")
+    for name in ("lens", "sensor", "sensor_fit", "focus_from", "focus_breathing", "circle_of_confusion",
+                 "aperture_blades", "blade_curvature", "anamorphic_squeeze", "barrel_clipping", "aperture_image",
+                 "exposure_mode", "iso", "shutter"):
+        add_option(camera, name)
     camera.add_argument("--list-lenses", action="store_true", help="print the lens presets and exit")
     camera.add_argument("--list-sensors", action="store_true", help="print the sensor presets and exit")
-    p.add_argument("--seed", type=_declared(int, RenderSettings, "seed"), metavar="S",
-                   help="random seed: the same seed gives the same image")
-    p.add_argument("--max-depth", type=_declared(int, RenderSettings, "max_depth"), metavar="D",
-                   help="longest light path in segments (2 = direct light only)")
-    p.add_argument("--sampler", choices=declared_choices(RenderSettings, "sampler"),
-                   help="sample pattern (default: the scene's)")
-    p.add_argument("--clamp", type=_declared(float, RenderSettings, "clamp"), metavar="L",
-                   help="tame fireflies: cap the radiance one sample may add (biased; 0 = off, the default)")
-    p.add_argument("--exposure", type=number_argument(float, -30, 30), default=0.0, metavar="STOPS",
-                   help="PNG only: brighten (+) or darken (-) by this many stops")
-    p.add_argument("--tone-map", choices=("clamp", "reinhard", "filmic"),
-                   help="PNG only: how radiance above 1 is brought into the displayable range (default: clamp; the "
-                        "studio shows and exports filmic unless told otherwise)")
+    for name in ("seed", "max_depth", "sampler", "clamp", "tone_map"):
+        add_option(p, name)
+    add_option(p, "exposure", default=0.0)
     p.add_argument("--denoise", action="store_true",
                    help="write the image denoised (Intel Open Image Denoise, guided by the first-hit albedo and normal "
                         "rendered beside it); an EXR also keeps the noisy image and the guides as layers")
@@ -248,16 +106,6 @@ def _check_output(path_text: str | None) -> Path:
     return path
 
 
-def parse_defines(items: list[str]) -> dict[str, str]:
-    defines = {}
-    for item in items:
-        name, sep, value = item.partition("=")
-        if not sep or not name.strip():
-            raise CliError(f"-D {item}: expected NAME=VALUE", EXIT_USAGE)
-        defines[name.strip()] = value
-    return defines
-
-
 def _warn(message: str) -> None:
     print(one_line(message, prefix="lenslab: warning: "), file=sys.stderr)
 
@@ -269,18 +117,12 @@ def _error(message: object) -> None:
 def scene_overrides(args):
     """The command line's settings for this render, on top of the scene's own (headless and studio alike)."""
     from lenslab.optics.presetfiles import PresetError
+    from lenslab.scene.options import SCENE_OPTIONS
     from lenslab.scene.overrides import SceneOverrides
 
     try:
-        return SceneOverrides(
-            f_number=args.f_stop, focal_length_mm=args.focal_length, focus_distance_m=args.focus_distance,
-            width=args.width, height=args.height, spp=args.spp, seed=args.seed, max_depth=args.max_depth,
-            sampler=args.sampler, clamp=args.clamp, lens=args.lens, sensor=args.sensor, sensor_fit=args.sensor_fit,
-            focus_from=args.focus_from, focus_breathing=args.focus_breathing, circle_of_confusion_mm=args.coc,
-            aperture_blades=args.blades, blade_curvature=args.blade_curvature, anamorphic_squeeze=args.anamorphic,
-            barrel_clipping=args.barrel_clipping, aperture_image=args.aperture_image,
-            exposure_mode=args.exposure_mode, iso=args.iso, shutter_s=args.shutter,
-            defines=parse_defines(args.defines))
+        return SceneOverrides(**{option.name: getattr(args, option.name) for option in SCENE_OPTIONS},
+                              defines=parse_defines(args.defines))
     except PresetError:
         raise
     except ValueError as exc:  # settings that do not go together (f/1.2 on an f/1.4 lens): a usage error
@@ -347,7 +189,7 @@ def _load_line(session, ready_after: float) -> str:
 
 
 def render_headless(args) -> int:
-    from lenslab.render.job import RenderJob
+    from lenslab.render.job import OFFLINE_DISPATCH_SECONDS, RenderJob
     from lenslab.limits import SceneTooLarge
     from lenslab.render.tracer import Renderer
     from lenslab.scene.scene import SceneError
@@ -373,7 +215,7 @@ def render_headless(args) -> int:
     try:
         with _loading_status(console, "building the kd-tree and compiling the kernel"):
             job = RenderJob(renderer, scene, spp=args.spp, time_limit=args.time_limit,
-                            dispatch_seconds=HEADLESS_DISPATCH_SECONDS, feature_buffers=args.denoise)
+                            dispatch_seconds=OFFLINE_DISPATCH_SECONDS, feature_buffers=args.denoise)
     except (SceneError, SceneTooLarge, ValueError) as exc:  # found only when the scene is packed: name its file
         raise SceneError.in_file(scene.source_path or args.scene, exc) from None
     session = job.session

@@ -12,6 +12,16 @@ import numpy as np
 #: Rec. 709's luminance of linear red, green and blue (ITU-R BT.709, the Y of its primaries).
 REC709_LUMINANCE = (0.2126, 0.7152, 0.0722)
 
+# The sRGB curve's numbers (IEC 61966-2-1): encoded = SRGB_SCALE * linear ** (1 / SRGB_EXPONENT) - SRGB_OFFSET,
+# and SRGB_LINEAR_SLOPE * linear at or below SRGB_LINEAR_CUTOFF (SRGB_ENCODED_CUTOFF on the encoded side). The
+# only copy: glsl/display.comp gets the encoding ones as #defines of the same names (render/gpu_layout.py).
+SRGB_SCALE = 1.055
+SRGB_OFFSET = 0.055
+SRGB_EXPONENT = 2.4
+SRGB_LINEAR_SLOPE = 12.92
+SRGB_LINEAR_CUTOFF = 0.0031308
+SRGB_ENCODED_CUTOFF = 0.04045
+
 
 def luminance(rgb):
     """Luminance of linear Rec. 709 colours: (..., 3) values (any float array) or one (r, g, b)."""
@@ -23,12 +33,14 @@ def luminance(rgb):
 def srgb_to_linear(c):
     c = np.asarray(c)
     c = np.clip(c.astype(np.result_type(c.dtype, np.float32), copy=False), 0.0, 1.0)
-    return _as_given(np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4))
+    return _as_given(np.where(c <= SRGB_ENCODED_CUTOFF, c / SRGB_LINEAR_SLOPE,
+                              ((c + SRGB_OFFSET) / SRGB_SCALE) ** SRGB_EXPONENT))
 
 
 def linear_to_srgb(x):
     x = np.clip(x, 0.0, 1.0)
-    return _as_given(np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055))
+    return _as_given(np.where(x <= SRGB_LINEAR_CUTOFF, SRGB_LINEAR_SLOPE * x,
+                              SRGB_SCALE * np.power(x, 1 / SRGB_EXPONENT) - SRGB_OFFSET))
 
 
 def _as_given(values: np.ndarray):

@@ -13,7 +13,7 @@ import threading
 import time
 
 from lenslab.batch.spec import Batch, BatchError, read_batch
-from lenslab.cli import EXIT_ERROR, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, CliError, CommandParser, number_argument
+from lenslab.command_line import EXIT_ERROR, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, CliError, CommandParser, number_argument
 from lenslab.messages import one_line
 
 MAX_LOCAL_WORKERS = 256

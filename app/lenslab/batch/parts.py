@@ -102,8 +102,7 @@ def _renderer(device: int | None):
 def render_part(shot: Shot, part: int, parts: int, *, device: int | None = None,
                 on_progress: Callable[[JobProgress], None] | None = None) -> PartResult:
     """Render part ``part`` of ``parts`` of ``shot`` on this process's GL context for ``device``."""
-    from lenslab.cli import HEADLESS_DISPATCH_SECONDS
-    from lenslab.render.job import RenderJob
+    from lenslab.render.job import OFFLINE_DISPATCH_SECONDS, RenderJob
     from lenslab.scene.scene import SceneError
 
     warnings: list[str] = []
@@ -114,7 +113,7 @@ def render_part(shot: Shot, part: int, parts: int, *, device: int | None = None,
         return PartResult(part, None, 0, 0.0, warnings=warnings)
     try:
         job = RenderJob(_renderer(device), scene, spp=spp, time_limit=shot.time_limit,
-                        dispatch_seconds=HEADLESS_DISPATCH_SECONDS, first_sample=first)
+                        dispatch_seconds=OFFLINE_DISPATCH_SECONDS, first_sample=first)
     except (SceneError, ValueError) as exc:  # found only when the scene is packed for the GPU: name its file
         raise SceneError.in_file(scene.source_path or shot.scene, exc) from None
     try:

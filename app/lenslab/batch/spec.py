@@ -32,7 +32,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from lenslab.limits import LARGEST_NUMBER
-from lenslab.render.film import EXPORT_SUFFIXES, TONE_MAPS
+from lenslab.render.film import EXPORT_SUFFIXES
+from lenslab.scene.options import OLD_NAMES, OPTIONS, SCENE_OPTIONS
 from lenslab.scene.overrides import SceneOverrides
 
 #: Parts one shot may be split into (one per worker).
@@ -43,27 +44,10 @@ class BatchError(ValueError):
     """A batch file that cannot be used; the message is one line naming the file (and the shot and key)."""
 
 
-# The keys a shot may have: what each sets, and what kind of value it takes.
-_OVERRIDE_KEYS = {  # batch key: SceneOverrides field
-    "f_number": "f_number", "focal_length": "focal_length_mm", "focus_distance": "focus_distance_m",
-    "width": "width", "height": "height", "spp": "spp", "seed": "seed", "max_depth": "max_depth",
-    "sampler": "sampler", "clamp": "clamp", "lens": "lens",
-    "sensor": "sensor", "sensor_fit": "sensor_fit", "focus_from": "focus_from", "coc": "circle_of_confusion_mm",
-    "blades": "aperture_blades", "blade_curvature": "blade_curvature", "anamorphic": "anamorphic_squeeze",
-    "barrel_clipping": "barrel_clipping", "aperture_image": "aperture_image", "exposure_mode": "exposure_mode",
-    "iso": "iso", "shutter": "shutter_s", "focus_breathing": "focus_breathing",
-}
-_KINDS = {
-    "name": str, "scene": str, "output": str, "lens": str, "sampler": str, "tone_map": str,
-    "f_number": float, "focal_length": float, "focus_distance": float, "clamp": float, "time_limit": float,
-    "exposure": float,
-    "sensor": str, "sensor_fit": str, "focus_from": str, "aperture_image": str, "exposure_mode": str,
-    "coc": float, "blade_curvature": float, "anamorphic": float, "barrel_clipping": float, "iso": float,
-    "shutter": float,  # seconds, or text as a camera shows it: "1/125"
-    "blades": int, "focus_breathing": bool,
-    "width": int, "height": int, "spp": int, "seed": int, "max_depth": int, "split": int,
-    "defines": dict,
-}
+# The keys a shot may have: every option of scene/options.py by its name (or an older spelling), and the shot's
+# own. What kind of value each takes.
+_SHOT_KEYS = {"name": str, "scene": str, "output": str, "split": int, "defines": dict}
+_KINDS = {**{name: option.kind for name, option in OPTIONS.items()}, **_SHOT_KEYS}
 _NOT_SWEPT = ("name", "output", "defines")  # one value per shot
 _TOP_LEVEL = ("defaults", "shots", "contact_sheet")
 
@@ -118,7 +102,7 @@ def parse_batch(text: str, path: Path) -> Batch:
     defaults = document.get("defaults", {})
     if not isinstance(defaults, dict):
         raise BatchError(f"{path}: 'defaults' must be a table of shot settings")
-    _check_keys(defaults, f"{path}, defaults")
+    defaults = _check_keys(defaults, f"{path}, defaults")
     entries = document.get("shots")
     if not isinstance(entries, list) or not entries or not all(isinstance(e, dict) for e in entries):
         raise BatchError(f"{path}: no shots: give at least one [[shots]] table (TOML) or a \"shots\" list (JSON)")
@@ -126,8 +110,7 @@ def parse_batch(text: str, path: Path) -> Batch:
     shots: list[Shot] = []
     for number, entry in enumerate(entries, start=1):
         where = f"{path}, shot {number}" + (f" ('{entry['name']}')" if isinstance(entry.get("name"), str) else "")
-        _check_keys(entry, where)
-        shots.extend(_expand(number, {**defaults, **entry}, folder, where))
+        shots.extend(_expand(number, {**defaults, **_check_keys(entry, where)}, folder, where))
     _check_outputs(shots, path)
     contact_sheet = document.get("contact_sheet")
     if contact_sheet is not None:
@@ -171,10 +154,17 @@ def _did_you_mean(word: str, choices) -> str:
     return f" (did you mean '{close[0]}'?)" if close else ""
 
 
-def _check_keys(table: dict, where: str) -> None:
-    for key in table:
-        if key not in _KINDS:
+def _check_keys(table: dict, where: str) -> dict:
+    """``table`` with every key known, older spellings of an option under its name ("coc" -> circle_of_confusion)."""
+    named = {}
+    for key, value in table.items():
+        name = OLD_NAMES.get(key, key)
+        if name not in _KINDS:
             raise BatchError(f"{where}: unknown key '{key}'{_did_you_mean(key, _KINDS)}")
+        if name in named:
+            raise BatchError(f"{where}: '{key}' and '{name}' are one setting: give it once")
+        named[name] = value
+    return named
 
 
 # -- sweeps --------------------------------------------------------------------------------------------------
@@ -200,13 +190,12 @@ def _kind_name(kind) -> str:
 
 def _scalar(key: str, value, where: str):
     kind = _KINDS[key]
-    if key == "shutter" and isinstance(value, str):
-        from lenslab.optics.exposure import parse_shutter
-
-        try:
-            return parse_shutter(value)
+    option = OPTIONS.get(key)
+    if isinstance(value, str) and kind is not str and option is not None and option.parse_text is not None:
+        try:  # a number written as a camera shows it: "1/125" s, "f/2.8"
+            return option.from_text(value)
         except ValueError as exc:
-            raise BatchError(f"{where}: shutter: {exc}") from None
+            raise BatchError(f"{where}: {key}: {str(exc).removeprefix(key + ' ')}") from None
     ok = (isinstance(value, str) if kind is str else
           isinstance(value, dict) if kind is dict else
           isinstance(value, bool) if kind is bool else
@@ -303,15 +292,6 @@ def _describe(values: dict, keys) -> str:
     return ", ".join(words)
 
 
-def _in_batch_words(message: str) -> str:
-    """A scene override's message with its field named as the batch file names it ("anamorphic_squeeze 9 is out
-    of range" -> "anamorphic 9 is out of range")."""
-    for key, field_name in _OVERRIDE_KEYS.items():
-        if key != field_name and message.startswith(field_name + " "):
-            return key + message[len(field_name):]
-    return message
-
-
 def _shot(number: int, index: int, values: dict, swept: list[str], folder: Path, where: str) -> Shot:
     output = folder / _output_name(values, index, where)
     if output.suffix.lower() not in EXPORT_SUFFIXES:
@@ -321,20 +301,16 @@ def _shot(number: int, index: int, values: dict, swept: list[str], folder: Path,
     if "aperture_image" in values:  # relative to the batch file, as the outputs are
         values = {**values, "aperture_image": str(folder / Path(values["aperture_image"]).expanduser())}
     try:
-        overrides = SceneOverrides(**{field_name: values[key] for key, field_name in _OVERRIDE_KEYS.items()
-                                      if key in values},
+        overrides = SceneOverrides(**{option.name: values[option.name] for option in SCENE_OPTIONS
+                                      if option.name in values},
                                    defines={str(k): str(v) for k, v in values.get("defines", {}).items()})
+        time_limit = values.get("time_limit")
+        if time_limit is not None:
+            OPTIONS["time_limit"].check(time_limit)
+        exposure = OPTIONS["exposure"].check(values.get("exposure", 0.0))
+        tone_map = OPTIONS["tone_map"].check(values.get("tone_map", "clamp"))
     except ValueError as exc:
-        raise BatchError(f"{where}: {_in_batch_words(str(exc))}") from None
-    time_limit = values.get("time_limit")
-    if time_limit is not None and not 0 < time_limit <= 1e7:
-        raise BatchError(f"{where}: time_limit: {time_limit:g} s is out of range (0, 1e7]")
-    exposure = values.get("exposure", 0.0)
-    if not -30 <= exposure <= 30:
-        raise BatchError(f"{where}: exposure: {exposure:g} stops is out of range [-30, 30]")
-    tone_map = values.get("tone_map", "clamp")
-    if tone_map not in TONE_MAPS:
-        raise BatchError(f"{where}: tone_map: '{tone_map}' is not one of {', '.join(TONE_MAPS)}")
+        raise BatchError(f"{where}: {exc}") from None
     split = values.get("split", 1)
     if not 1 <= split <= MAX_SPLIT:
         raise BatchError(f"{where}: split: {split} is out of range [1, {MAX_SPLIT}]")
@@ -381,6 +357,9 @@ def _output_name(values: dict, index: int, where: str) -> str:
     template = values["output"]
     fields = {key: value for key, value in values.items() if key not in ("output", "defines")}
     fields["index"] = index
+    for old_name, name in OLD_NAMES.items():  # a pattern written with an option's older name still works
+        if name in fields:
+            fields.setdefault(old_name, fields[name])
     if "shutter" in fields:
         fields["shutter"] = _ShutterTime(fields["shutter"])
     if any(ord(char) < 32 or ord(char) == 127 for char in template):

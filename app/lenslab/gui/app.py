@@ -1,6 +1,6 @@
 """Starting the studio: ``lenslab`` opens the window, ``lenslab SCENE`` opens it on a scene.
 
-``run_studio`` is called by ``lenslab.cli`` with the scene, the command line's overrides (``--f-stop``,
+``run_studio`` is called by ``lenslab.cli`` with the scene, the command line's overrides (``--f-number``,
 ``--spp``, ``--clamp``, ``-D`` ...: the same :class:`~lenslab.scene.overrides.SceneOverrides` a headless render
 applies) and ``--device``, builds the QApplication with LensLab's look and desktop identity, and returns the
 exit status of the event loop.

@@ -746,8 +746,9 @@ class RenderWorker(QThread):
             return False
         request = start.request
         try:
-            # An export's dispatches are the headless render's: long enough to keep the device busy, short
-            # enough for a cancel to be felt within a tenth of a second.
+            # An export's dispatches are the session's default, not the headless job's longer ones
+            # (job.OFFLINE_DISPATCH_SECONDS): long enough to keep the device busy, short enough for a cancel
+            # to be felt within a tenth of a second.
             job = RenderJob(self._renderer, request.scene, spp=request.target_spp, time_limit=request.seconds,
                             dispatch_seconds=max(self.dispatch_seconds, DEFAULT_DISPATCH_SECONDS),
                             feature_buffers=request.denoise)

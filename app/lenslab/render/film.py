@@ -18,9 +18,10 @@ import numpy as np
 from lenslab.atomic import atomic_path, write_failure_reason
 from lenslab.color import linear_to_srgb
 from lenslab.limits import image_too_large
+from lenslab.scene.options import OPTIONS
 
 EXPORT_SUFFIXES = (".exr", ".png")
-TONE_MAPS = ("clamp", "reinhard", "filmic")
+TONE_MAPS = OPTIONS["tone_map"].allowed  # the operators below, as the options table names them
 
 
 class ExportError(RuntimeError):
@@ -62,10 +63,18 @@ def merge(*accumulations: np.ndarray) -> np.ndarray:
     return np.sum(accumulations, axis=0)
 
 
+# Narkowicz's fit of the ACES reference rendering transform, x (a x + b) / (x (c x + d) + e): a gentle shoulder
+# that keeps highlights. The only copy: glsl/display.comp gets them as #defines of the same names
+# (render/gpu_layout.py).
+FILMIC_A = 2.51
+FILMIC_B = 0.03
+FILMIC_C = 2.43
+FILMIC_D = 0.59
+FILMIC_E = 0.14
+
+
 def _filmic(x: np.ndarray) -> np.ndarray:
-    # Narkowicz's fit of the ACES reference rendering transform: a gentle shoulder that keeps highlights.
-    a, b, c, d, e = 2.51, 0.03, 2.43, 0.59, 0.14
-    return np.clip((x * (a * x + b)) / (x * (c * x + d) + e), 0.0, 1.0)
+    return np.clip((x * (FILMIC_A * x + FILMIC_B)) / (x * (FILMIC_C * x + FILMIC_D) + FILMIC_E), 0.0, 1.0)
 
 
 def tone_map(linear: np.ndarray, exposure_stops: float = 0.0, operator: str = "clamp") -> np.ndarray:
@@ -139,7 +148,8 @@ def write_image(path: str | os.PathLike, linear: np.ndarray, metadata: dict[str,
         pixels = to_8bit(tone_map(linear, exposure_stops, tone_map_operator))
         spec = oiio.ImageSpec(width, height, 3, oiio.UINT8)
         spec.attribute("oiio:ColorSpace", "sRGB")
-        metadata.update({"lenslab:DisplayExposureStops": float(exposure_stops), "lenslab:ToneMap": tone_map_operator})
+        metadata.update({OPTIONS["exposure"].metadata: float(exposure_stops),
+                         OPTIONS["tone_map"].metadata: tone_map_operator})
         # PNG keeps Exif's own tags in its eXIf chunk and only text besides: LensLab's values become text.
         metadata = {key: (_as_text(value) if key.startswith("lenslab:") else value) for key, value in metadata.items()
                     if key not in MATRIX_ATTRIBUTES}

@@ -1,4 +1,5 @@
-"""What the host and the shaders must agree on, declared once: record sizes, type codes and binding points.
+"""What the host and the shaders must agree on, declared once: record sizes, type codes and binding points,
+and the numbers of the display curves.
 
 Python packs the scene's buffers with these values (render/buffers.py, render/textures.py, render/bsp.py)
 and gl.load_shader_source hands every one of them to every compute shader as a #define of the same name
@@ -9,7 +10,11 @@ compile instead of reading the buffers askew.
 
 from __future__ import annotations
 
+import math
+
+from lenslab import color as _color
 from lenslab.optics.aperture import APERTURE_KINDS, ROUNDED_BLADE_BINS as _ROUNDED_BLADE_BINS
+from lenslab.render import film as _film
 
 # -- Materials: MATERIAL_ROWS vec4 rows per material (buffers.pack_material, glsl/bsdf.glsl), its type
 # code in row 0, w.
@@ -103,6 +108,18 @@ INSTANCES_BINDING = 10  # the instance table (render/instancing.py)
 TONE_MAP_CLAMP = 0
 TONE_MAP_REINHARD = 1
 TONE_MAP_FILMIC = 2
+# display.comp's curves, with the numbers of the Python that applies them on the CPU (defined there, once):
+# lenslab.color's sRGB encoding and lenslab.render.film's filmic fit. Floats: see glsl_float.
+SRGB_SCALE = _color.SRGB_SCALE
+SRGB_OFFSET = _color.SRGB_OFFSET
+SRGB_EXPONENT = _color.SRGB_EXPONENT
+SRGB_LINEAR_SLOPE = _color.SRGB_LINEAR_SLOPE
+SRGB_LINEAR_CUTOFF = _color.SRGB_LINEAR_CUTOFF
+FILMIC_A = _film.FILMIC_A
+FILMIC_B = _film.FILMIC_B
+FILMIC_C = _film.FILMIC_C
+FILMIC_D = _film.FILMIC_D
+FILMIC_E = _film.FILMIC_E
 # raycast.comp's rays in and hits out; bsdf_probe.comp's items in and results out.
 RAYS_BINDING = 6
 HITS_BINDING = 7
@@ -117,6 +134,20 @@ APERTURE_TABLE_UNIT = 0
 ROUNDED_BLADE_BINS = _ROUNDED_BLADE_BINS
 
 
-def glsl_defines() -> dict[str, int]:
-    """Every constant above by its own name: the #defines each compute shader is compiled with."""
-    return {name: value for name, value in globals().items() if name.isupper() and type(value) is int}
+def glsl_defines() -> dict[str, int | str]:
+    """Every constant above by its own name: the #defines each compute shader is compiled with. An int is
+    itself; a float is its text as GLSL reads it (:func:`glsl_float`)."""
+    return {name: glsl_float(value) if type(value) is float else value for name, value in globals().items()
+            if name.isupper() and not name.startswith("_") and type(value) in (int, float)}
+
+
+def glsl_float(value: float) -> str:
+    """``value`` as a GLSL float literal: Python's repr, the shortest text that reads back as this very number
+    (so GLSL's float32 is the one the same number typed in the shader gave), with a decimal point always."""
+    if not math.isfinite(value) or abs(value) > 3.4028234663852886e38:  # float32's largest
+        raise ValueError(f"{value!r}: GLSL's float has no literal for it")
+    text = repr(float(value))
+    if "." not in text:  # 1e-05, 3e+38: GLSL reads these too, but they must not be mistaken for an int
+        mantissa, _, exponent = text.partition("e")
+        text = f"{mantissa}.0" + (f"e{exponent}" if exponent else "")
+    return f"({text})" if text.startswith("-") else text

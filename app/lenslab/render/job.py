@@ -26,10 +26,14 @@ from lenslab.optics.sensors import crop_factor
 from lenslab.optics.stops import format_f_number
 from lenslab.render.tracer import DEFAULT_DISPATCH_SECONDS, Renderer, RenderSession
 from lenslab.scene.camera import CameraFrame
+from lenslab.scene.options import OPTIONS
 from lenslab.scene.scene import Scene
 
 #: :meth:`RenderJob.run` renders for about this long between progress reports.
 REPORT_SECONDS = 0.5
+#: The GPU time of one dispatch for a job no one watches sample by sample (``--headless``, batch parts, validate):
+#: longer than the session's default, so less of it goes to launching kernels and reading progress back.
+OFFLINE_DISPATCH_SECONDS = 0.25
 
 
 @dataclass(frozen=True)
@@ -183,10 +187,33 @@ def image_metadata(scene: Scene, spp: int, frame: CameraFrame) -> dict[str, obje
     sensor_w, sensor_h = cam.sensor_mm
     pixels_per_cm = float(frame.width / (film_w / 10.0))  # the picture spans film_w of the focal plane
     light_fraction = frame.aperture.light_fraction
+    # What the render used for each option a user can give (scene/options.py), under the option's metadata name.
+    used: dict[str, object] = {
+        "f_number": float(cam.f_number),
+        "focal_length": float(cam.focal_length_mm),
+        "focus_distance": float(cam.focus_distance_m),
+        "sensor_fit": cam.sensor_fit,
+        "focus_from": cam.focus_from,
+        "focus_breathing": int(cam.focus_breathing),
+        "circle_of_confusion": float(cam.coc_mm(frame.width, frame.height)),
+        "aperture_blades": int(cam.aperture_blades),
+        "blade_curvature": float(cam.blade_curvature),
+        "anamorphic_squeeze": float(cam.anamorphic_squeeze),
+        "barrel_clipping": float(cam.barrel_clipping),
+        "exposure_mode": cam.exposure_mode,
+        "spp": int(spp),
+        "seed": int(scene.render.seed),
+        "max_depth": int(scene.render.max_depth),
+        "sampler": scene.render.sampler,
+        "clamp": float(scene.render.clamp),
+    }
+    if cam.aperture_image:
+        used["aperture_image"] = cam.aperture_image
+    if cam.exposure_mode == "physical":
+        used.update(shutter=float(cam.shutter_s), iso=int(round(cam.iso)))
     metadata: dict[str, object] = {
         "Software": f"LensLab {__version__}",
-        "FNumber": float(cam.f_number),
-        "Exif:FocalLength": float(cam.focal_length_mm),
+        **{OPTIONS[name].metadata: value for name, value in used.items()},
         "Exif:FocalLengthIn35mmFilm": int(round(cam.focal_length_mm * crop_factor(sensor_w, sensor_h))),
         "Exif:SubjectDistance": float(cam.focus_distance_m),
         # Sensor size in Exif's terms: pixels per centimetre of focal plane.
@@ -197,35 +224,17 @@ def image_metadata(scene: Scene, spp: int, frame: CameraFrame) -> dict[str, obje
         "lenslab:Aperture": format_f_number(cam.f_number),  # the marked stop ("f/11" for 11.31)
         "lenslab:SensorWidthMM": float(sensor_w),
         "lenslab:SensorHeightMM": float(sensor_h),
-        "lenslab:SensorFit": cam.sensor_fit,
         "lenslab:ImageWidthMM": float(film_w),
         "lenslab:ImageHeightMM": float(film_h),
-        "lenslab:FocusDistanceM": float(cam.focus_distance_m),
-        "lenslab:FocusFrom": cam.focus_from,
-        "lenslab:FocusBreathing": int(cam.focus_breathing),
         "lenslab:PlaneOfFocusM": float(frame.focus_distance),
         "lenslab:ImageDistanceMM": float(frame.image_distance_mm),
-        "lenslab:CircleOfConfusionMM": float(cam.coc_mm(frame.width, frame.height)),
-        "lenslab:ApertureBlades": int(cam.aperture_blades),
-        "lenslab:BladeCurvature": float(cam.blade_curvature),
-        "lenslab:AnamorphicSqueeze": float(cam.anamorphic_squeeze),
-        "lenslab:BarrelClipping": float(cam.barrel_clipping),
         "lenslab:ApertureLightFraction": float(light_fraction),
-        "lenslab:ExposureMode": cam.exposure_mode,
         "lenslab:ExposureScale": float(cam.exposure_scale(light_fraction)),
-        "lenslab:SamplesPerPixel": int(spp),
-        "lenslab:Seed": int(scene.render.seed),
-        "lenslab:MaxDepth": int(scene.render.max_depth),
-        "lenslab:Sampler": scene.render.sampler,
-        "lenslab:Clamp": float(scene.render.clamp),
         "worldtocamera": world_to_camera(frame),
         "worldtoNDC": world_to_ndc(frame),
     }
-    if cam.aperture_image:
-        metadata["lenslab:ApertureImage"] = cam.aperture_image
     if cam.exposure_mode == "physical":
-        metadata.update({"ExposureTime": float(cam.shutter_s), "Exif:PhotographicSensitivity": int(round(cam.iso)),
-                         "lenslab:EV100": ev100(cam.f_number, cam.shutter_s, cam.iso)})
+        metadata["lenslab:EV100"] = ev100(cam.f_number, cam.shutter_s, cam.iso)
     return metadata
 
 

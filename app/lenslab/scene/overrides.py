@@ -1,4 +1,4 @@
-"""Settings given for one render on top of a scene's own: the command line's ``--f-stop 1.4 --spp 256 -D res=512``.
+"""Settings given for one render on top of a scene's own: the command line's ``--f-number 1.4 --spp 256 -D res=512``.
 
 ``lenslab SCENE --headless`` and ``lenslab SCENE`` (the studio) both open their scene through
 :meth:`SceneOverrides.open`, so a setting given on the command line means the same in both. The scene file is
@@ -10,7 +10,6 @@ from __future__ import annotations
 import dataclasses
 import os
 from pathlib import Path
-from dataclasses import dataclass, field
 from typing import Callable
 
 from lenslab.optics.lenses import find_lens
@@ -18,75 +17,26 @@ from lenslab.optics.sensors import find_sensor
 from lenslab.optics.thinlens import format_distance, sensor_distance_m
 from lenslab.optics.stops import exact_f_number, format_f_number
 from lenslab.scene.camera import MAX_IMAGE_SIDE, ThinLensCamera
-from lenslab.scene.fields import declared_choices, declared_range
-from lenslab.scene.scene import RenderSettings, Scene
-
-# The overrides named as the camera's and the render settings' fields they set.
-_CAMERA_FIELDS = ("f_number", "focal_length_mm", "focus_distance_m", "focus_from", "focus_breathing", "sensor_fit",
-                  "circle_of_confusion_mm", "aperture_blades", "blade_curvature", "anamorphic_squeeze",
-                  "barrel_clipping", "aperture_image", "exposure_mode", "iso", "shutter_s")
-_RENDER_FIELDS = ("spp", "seed", "max_depth", "sampler", "clamp")
+from lenslab.scene.options import SCENE_OPTIONS
+from lenslab.scene.scene import Scene
 
 
-@dataclass(frozen=True)
-class SceneOverrides:
-    f_number: float | None = None
-    focal_length_mm: float | None = None
-    focus_distance_m: float | None = None
-    width: int | None = None  # given alone, width or height keeps the scene's aspect ratio
-    height: int | None = None
-    spp: int | None = None
-    seed: int | None = None
-    max_depth: int | None = None
-    sampler: str | None = None
-    clamp: float | None = None
-    lens: str | None = None  # a lens preset's name: its focal length (a zoom's nearest), aperture range and iris
-    sensor: str | None = None  # a sensor preset's name: its size and, if it has one, its circle of confusion
-    focus_from: str | None = None
-    focus_breathing: bool | None = None
-    sensor_fit: str | None = None
-    circle_of_confusion_mm: float | None = None
-    aperture_blades: int | None = None
-    blade_curvature: float | None = None
-    anamorphic_squeeze: float | None = None
-    barrel_clipping: float | None = None
-    aperture_image: str | None = None  # absolute, or relative to the working folder (made absolute here)
-    exposure_mode: str | None = None  # given ISO or shutter alone, the physical mode
-    iso: float | None = None
-    shutter_s: float | None = None
-    defines: dict[str, str] = field(default_factory=dict)  # Mitsuba XML parameters ($name), as mitsuba -D
+class _OverridesMethods:
+    """What SceneOverrides does; its fields are made from the options table below the class."""
 
     def __post_init__(self):
-        for name in _CAMERA_FIELDS:
-            value = getattr(self, name)
-            if value is None or isinstance(value, bool):
-                continue
-            if isinstance(value, str):
-                choices = _declared_choices_or_none(ThinLensCamera, name)
-                if choices is not None and value not in choices:
-                    raise ValueError(f"{name} '{value}' is not one of {', '.join(choices)}")
-            else:
-                _check_range(name, value, declared_range(ThinLensCamera, name))
-        if self.aperture_blades in (1, 2):
-            raise ValueError("aperture_blades must be 0 (round) or at least 3")
+        for option in SCENE_OPTIONS:
+            value = getattr(self, option.name)
+            if value is not None:
+                object.__setattr__(self, option.name, option.check(value))
         if self.f_number is not None:  # a marked stop as typed means its exact value (f/11 is 11.31)
             object.__setattr__(self, "f_number", exact_f_number(self.f_number))
         if self.aperture_image:
             object.__setattr__(self, "aperture_image", str(Path(self.aperture_image).expanduser().resolve()))
-        if self.exposure_mode is None and (self.iso is not None or self.shutter_s is not None):
+        if self.exposure_mode is None and (self.iso is not None or self.shutter is not None):
             object.__setattr__(self, "exposure_mode", "physical")
         if self.sensor is not None:
             find_sensor(self.sensor)
-        for name in ("width", "height"):
-            _check_range(name, getattr(self, name), (1, MAX_IMAGE_SIDE))
-        for name in _RENDER_FIELDS:
-            value = getattr(self, name)
-            if name == "sampler":
-                if value is not None and value not in declared_choices(RenderSettings, name):
-                    raise ValueError(f"sampler '{value}' is not one of "
-                                     f"{', '.join(declared_choices(RenderSettings, name))}")
-            else:
-                _check_range(name, value, declared_range(RenderSettings, name))
         if self.lens is not None:
             self._check_lens()
 
@@ -94,8 +44,8 @@ class SceneOverrides:
         """A focal length or f-number given with a lens must be one the lens has: f/1.2 on an f/1.4 lens is
         refused, not quietly changed."""
         lens = find_lens(self.lens)
-        if self.focal_length_mm is not None and lens.clamp_focal_length(self.focal_length_mm) != self.focal_length_mm:
-            raise ValueError(f"focal_length {self.focal_length_mm:g} mm is not on the lens '{lens.name}' "
+        if self.focal_length is not None and lens.clamp_focal_length(self.focal_length) != self.focal_length:
+            raise ValueError(f"focal_length {self.focal_length:g} mm is not on the lens '{lens.name}' "
                              f"({lens.min_focal_length_mm:g}-{lens.max_focal_length_mm:g} mm)")
         if self.f_number is not None and lens.clamp_f_number(self.f_number) != self.f_number:
             raise ValueError(f"{format_f_number(self.f_number)} is not on the lens '{lens.name}' "
@@ -109,7 +59,7 @@ class SceneOverrides:
 
     def apply(self, scene: Scene) -> Scene:
         """A copy of ``scene`` with the overrides set; fields left at None keep the scene's value."""
-        camera_changes = {name: getattr(self, name) for name in _CAMERA_FIELDS if getattr(self, name) is not None}
+        camera_changes = self._changes("camera")
         if self.sensor is not None:
             sensor = find_sensor(self.sensor)
             camera_changes = {"sensor_mm": (sensor.width_mm, sensor.height_mm),
@@ -121,12 +71,21 @@ class SceneOverrides:
             camera_changes = {**mounted, **camera_changes}
         if self.width is not None or self.height is not None:
             camera_changes["resolution"] = self._resolution(scene.camera.resolution)
-        render_changes = {name: getattr(self, name) for name in _RENDER_FIELDS if getattr(self, name) is not None}
+        render_changes = self._changes("render")
         camera = dataclasses.replace(scene.camera, **camera_changes)
         if self.lens is not None:  # the lens's marked minimum first: it says more than the thin-lens limit
             _check_minimum_focus(camera, find_lens(self.lens))
         camera.validate()  # nothing nearer than the thin lens can focus, whatever the lens
         return dataclasses.replace(scene, camera=camera, render=dataclasses.replace(scene.render, **render_changes))
+
+    def _changes(self, owner: str) -> dict[str, object]:
+        """The given options that set fields of the scene's ``owner`` ("camera" or "render"), by field name."""
+        changes = {}
+        for option in SCENE_OPTIONS:
+            value = getattr(self, option.name)
+            if value is not None and option.sets.startswith(owner + "."):
+                changes[option.sets.split(".")[1]] = value
+        return changes
 
     def _resolution(self, scene_resolution: tuple[int, int]) -> tuple[int, int]:
         width, height = scene_resolution
@@ -135,6 +94,18 @@ class SceneOverrides:
         if self.height is not None and self.width is None:
             return min(MAX_IMAGE_SIDE, max(1, round(self.height * width / height))), self.height
         return self.width, self.height
+
+
+SceneOverrides = dataclasses.make_dataclass(
+    "SceneOverrides",
+    [(option.name, option.kind | None, None) for option in SCENE_OPTIONS]
+    # Mitsuba XML parameters ($name), as mitsuba -D
+    + [("defines", dict[str, str], dataclasses.field(default_factory=dict))],
+    bases=(_OverridesMethods,), frozen=True)
+SceneOverrides.__module__ = __name__
+SceneOverrides.__doc__ = """Settings for one render on top of the scene's: one field per option of scene/options.py,
+None where the scene's own value stays, and the Mitsuba defines. Checked when made (a ValueError of one line);
+``open`` reads a scene file with them, ``apply`` sets them on a scene already read."""
 
 
 def _check_minimum_focus(camera: ThinLensCamera, lens) -> None:
@@ -156,18 +127,3 @@ def _check_minimum_focus(camera: ThinLensCamera, lens) -> None:
         minimum += " from the sensor"
     if from_sensor < lens.min_focus_distance_m * (1 - 1e-9):
         raise ValueError(f"{said} is nearer than the lens '{lens.name}' focuses (minimum {minimum})")
-
-
-def _declared_choices_or_none(cls: type, name: str):
-    try:
-        return declared_choices(cls, name)
-    except KeyError:
-        return None
-
-
-def _check_range(name: str, value, bounds: tuple) -> None:
-    if value is None:
-        return
-    low, high = bounds
-    if not low <= value <= high:  # also refuses NaN
-        raise ValueError(f"{name} {value} is out of range [{low:g}, {high:g}]")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from lenslab.cli import EXIT_ERROR, EXIT_OK, EXIT_USAGE, CliError, CommandParser, number_argument
+from lenslab.command_line import EXIT_ERROR, EXIT_OK, EXIT_USAGE, CliError, CommandParser, number_argument
 from lenslab.messages import one_line
 from lenslab.validate.mitsuba_env import MitsubaUnavailable, load_mitsuba
 from lenslab.validate.runner import SCENE_NAMES
@@ -86,8 +86,8 @@ def run(argv: list[str]) -> int:
 
 
 def run_files(args) -> int:
-    """``--files``: each file rendered by both renderers and judged against issue 11's goal (validate/files.py)."""
-    from lenslab.cli import parse_defines
+    """``--files``: each file rendered by both renderers and judged against the agreement goal of validate/files.py."""
+    from lenslab.command_line import parse_defines
 
     for option, value in (("--scenes", args.scenes), ("--bias-spp", args.bias_spp), ("--write-docs", args.write_docs),
                           ("--docs-dir", args.docs_dir)):

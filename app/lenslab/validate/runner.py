@@ -33,7 +33,6 @@ SCENES_DIR = Path(__file__).resolve().parent / "scenes"
 SCENE_NAMES = ("cornell_dof", "glass_metal", "environment_depths", "bokeh", "point_sun", "light_bsdf", "beckmann",
                "spot", "rotated_env", "textured", "relief")
 MITSUBA_PASS_SPP = 256  # Mitsuba's LLVM wavefront holds every sample of a pass in memory
-LENSLAB_DISPATCH_SECONDS = 0.25  # as the CLI's --headless
 
 
 @dataclass
@@ -81,10 +80,10 @@ def render_lenslab(path: Path, spp: int, seed: int, res: int, renderer, warn: Ca
 def render_scene(scene, spp: int, renderer, warn: Callable[[str], None], start: float | None = None) -> Render:
     """An opened scene rendered to ``spp`` by the job ``--headless`` runs; ``seconds`` count from ``start``
     (when the file began to load), or from now."""
-    from lenslab.render.job import RenderJob
+    from lenslab.render.job import OFFLINE_DISPATCH_SECONDS, RenderJob
 
     start = time.perf_counter() if start is None else start
-    job = RenderJob(renderer, scene, spp=spp, dispatch_seconds=LENSLAB_DISPATCH_SECONDS)
+    job = RenderJob(renderer, scene, spp=spp, dispatch_seconds=OFFLINE_DISPATCH_SECONDS)
     for message in job.session.warnings:
         warn(message)
     try:

@@ -1,0 +1,238 @@
+"""The settings a user gives one render on top of the scene's own, each declared once.
+
+One row per option: its one name (the ``SceneOverrides`` field and the batch file's key; the command line's flag is
+the same words with dashes: ``focal_length``, ``--focal-length``), the kind of value, its range or choices (read
+from the scene field it sets, where it sets one: scene/fields.py), its unit, its help, the names it was known by
+before (still accepted: ``--f-stop``, ``coc``, ``blades``, ``anamorphic``), and the name an image's metadata
+gives it. ``cli.build_parser``, ``batch/spec.py``, ``SceneOverrides`` and ``render/job.image_metadata`` are made
+from this table; a new option is a new row.
+
+Values arrive three ways, all checked here: as text (the command line: ``"f/2.8"``, ``"1/125"``), as a batch
+file's number or string, or from Python. Problems are ValueErrors of one line naming the option.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+from lenslab.scene.camera import MAX_IMAGE_SIDE, ThinLensCamera
+from lenslab.scene.fields import declared_choices, declared_range
+from lenslab.scene.scene import RenderSettings
+
+
+@dataclass(frozen=True)
+class Option:
+    name: str
+    kind: type  # float, int, str or bool
+    help: str
+    sets: str = ""  # "camera.<field>" or "render.<field>" it overrides; "" where the overrides apply it by hand
+    unit: str = ""  # what the number is in, for help and messages
+    metavar: str = "VALUE"
+    bounds: tuple | None = None  # (low, high) where the option sets no declared field
+    choices: tuple[str, ...] | None = None  # for text options that set no declared field
+    parse_text: Callable[[str], object] | None = None  # text as a user writes it -> value (e.g. "1/125" -> 0.008)
+    old_names: tuple[str, ...] = ()  # spellings still accepted on the command line and in batch files
+    metadata: str = ""  # the image metadata key holding the value the render used ("" for none)
+    scene: bool = True  # False: how the image is made or written (time limit, display), not the scene
+    refuse: Callable[[object], str] | None = None  # a further rule: the reason a value in range is refused, or ""
+
+    @property
+    def flag(self) -> str:
+        return "--" + self.name.replace("_", "-")
+
+    @property
+    def old_flags(self) -> tuple[str, ...]:
+        return tuple("--" + name.replace("_", "-") for name in self.old_names)
+
+    @property
+    def scene_field(self) -> tuple[type, str] | None:
+        """(scene class, field name) this option sets, or None."""
+        if not self.sets:
+            return None
+        owner, name = self.sets.split(".")
+        return {"camera": ThinLensCamera, "render": RenderSettings}[owner], name
+
+    @property
+    def range(self) -> tuple | None:
+        if self.bounds is not None:
+            return self.bounds
+        if self.scene_field is None or self.kind not in (int, float):
+            return None
+        return declared_range(*self.scene_field)
+
+    @property
+    def allowed(self) -> tuple[str, ...] | None:
+        """The values a text option takes (None: any text, such as a preset's or a file's name)."""
+        if self.choices is not None:
+            return self.choices
+        if self.scene_field is None or self.kind is not str:
+            return None
+        try:
+            return declared_choices(*self.scene_field)
+        except KeyError:
+            return None
+
+    def from_text(self, text: str):
+        """The value a user's text means: a ValueError of one line where it means none."""
+        if self.parse_text is not None:
+            return self.check(self.parse_text(text))
+        if self.kind is str:
+            return self.check(text)
+        try:
+            value = self.kind(text)
+        except ValueError:
+            raise ValueError(f"expected {'a whole number' if self.kind is int else 'a number'}, not '{text}'") \
+                from None
+        return self.check(value)
+
+    def check(self, value):
+        """``value`` if this option takes it (a whole-number float is taken as an int); else a ValueError."""
+        if self.kind is str:
+            if not isinstance(value, str):
+                raise ValueError(f"{self.name}: expected text, not {value!r}")
+            if self.allowed is not None and value not in self.allowed:
+                raise ValueError(f"{self.name} '{value}' is not one of {', '.join(self.allowed)}")
+            return value
+        if self.kind is bool:
+            if not isinstance(value, bool):
+                raise ValueError(f"{self.name}: expected true or false, not {value!r}")
+            return value
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ValueError(f"{self.name}: expected a number, not {value!r}")
+        if self.kind is int:
+            if value != int(value):
+                raise ValueError(f"{self.name}: expected a whole number, not {value!r}")
+            value = int(value)
+        else:
+            value = float(value)
+        low, high = self.range
+        if not low <= value <= high:  # also refuses NaN
+            raise ValueError(f"{self.name} {value:g} is out of range [{_bound(low)}, {_bound(high)}]")
+        reason = self.refuse(value) if self.refuse is not None else ""
+        if reason:
+            raise ValueError(f"{self.name} {value:g}: {reason}")
+        return value
+
+
+def _bound(value: float) -> str:
+    return str(int(value)) if float(value).is_integer() else f"{value:g}"
+
+
+# -- text as users write it ---------------------------------------------------------------------------------------
+def _f_number(text: str) -> float:
+    from lenslab.optics.stops import parse_f_number
+
+    return parse_f_number(text)
+
+
+def _shutter(text: str) -> float:
+    from lenslab.optics.exposure import parse_shutter
+
+    return parse_shutter(text)
+
+
+def _blades_that_make_a_stop(blades) -> str:
+    return "a stop has 0 blades (round) or at least 3" if blades in (1, 2) else ""
+
+
+def _lens_name(text: str) -> str:
+    """The name of a lens preset there is, as given (the overrides look it up again when they mount it)."""
+    from lenslab.optics.lenses import find_lens
+
+    find_lens(text)
+    return text
+
+
+def _sensor_name(text: str) -> str:
+    from lenslab.optics.sensors import find_sensor
+
+    find_sensor(text)
+    return text
+
+
+def _existing_file(text: str) -> str:
+    """A file named relative to the current folder, made absolute (a scene reads its own relative to its folder)."""
+    path = Path(text).expanduser()
+    if not path.is_file():
+        raise ValueError(f"no such file: {text}")
+    return str(path.resolve())
+
+
+TONE_MAPS = ("clamp", "reinhard", "filmic")
+
+_ROWS = (
+    Option("f_number", float, "aperture as an f-number, e.g. 2.8 or f/2.8 (1.4 is wide open and blurry, 16 is deep "
+           "focus); a marked stop is its exact value (f/11 is 2^3.5)", "camera.f_number", metavar="N",
+           parse_text=_f_number, old_names=("f_stop",), metadata="FNumber"),
+    Option("focal_length", float, "lens focal length (sets the field of view with the sensor width)",
+           "camera.focal_length_mm", unit="mm", metavar="MM", metadata="Exif:FocalLength"),
+    Option("focus_distance", float, "distance to the plane of focus", "camera.focus_distance_m", unit="m",
+           metavar="M", metadata="lenslab:FocusDistanceM"),
+    Option("width", int, "image width in pixels (alone, the scene's aspect ratio is kept)", metavar="W",
+           bounds=(1, MAX_IMAGE_SIDE)),
+    Option("height", int, "image height in pixels (alone, the scene's aspect ratio is kept)", metavar="H",
+           bounds=(1, MAX_IMAGE_SIDE)),
+    Option("spp", int, "samples per pixel (default: the scene's; with a time limit alone, as many as fit)",
+           "render.spp", metavar="N", metadata="lenslab:SamplesPerPixel"),
+    Option("seed", int, "random seed: the same seed gives the same image", "render.seed", metavar="S",
+           metadata="lenslab:Seed"),
+    Option("max_depth", int, "longest light path in segments (2 = direct light only)", "render.max_depth",
+           metavar="D", metadata="lenslab:MaxDepth"),
+    Option("sampler", str, "sample pattern (default: the scene's)", "render.sampler", metadata="lenslab:Sampler"),
+    Option("clamp", float, "tame fireflies: cap the radiance one sample may add (biased; 0 = off, the default)",
+           "render.clamp", metavar="L", metadata="lenslab:Clamp"),
+    Option("lens", str, "mount a lens preset: its focal lengths, stops, iris and minimum focus (see --list-lenses; "
+           "the name's beginning will do where only one lens has it: 85mm)", metavar="NAME", parse_text=_lens_name),
+    Option("sensor", str, "a sensor preset: its size and circle of confusion (see --list-sensors)", metavar="NAME",
+           parse_text=_sensor_name),
+    Option("sensor_fit", str, "which part of the sensor the image shows (auto: the long sides together)",
+           "camera.sensor_fit", metadata="lenslab:SensorFit"),
+    Option("focus_from", str, "what the focus distance is measured from (default: the scene's; new scenes: sensor)",
+           "camera.focus_from", metadata="lenslab:FocusFrom"),
+    Option("focus_breathing", bool, "false holds the framing: the sensor one focal length behind the lens at every "
+           "focus", "camera.focus_breathing", metadata="lenslab:FocusBreathing"),
+    Option("circle_of_confusion", float, "circle of confusion for the depth-of-field readout and metadata",
+           "camera.circle_of_confusion_mm", unit="mm", metavar="MM", old_names=("coc",),
+           metadata="lenslab:CircleOfConfusionMM"),
+    Option("aperture_blades", int, "aperture blades: 0 round, or 3 to 32", "camera.aperture_blades", metavar="N",
+           refuse=_blades_that_make_a_stop, old_names=("blades",), metadata="lenslab:ApertureBlades"),
+    Option("blade_curvature", float, "0 straight blades (polygonal bokeh) to 1 round", "camera.blade_curvature",
+           metavar="C", metadata="lenslab:BladeCurvature"),
+    Option("anamorphic_squeeze", float, "anamorphic squeeze: bokeh height over width (e.g. 1.33, 2)",
+           "camera.anamorphic_squeeze", metavar="SQUEEZE", old_names=("anamorphic",),
+           metadata="lenslab:AnamorphicSqueeze"),
+    Option("barrel_clipping", float, "cat's-eye bokeh toward the frame's corners, 0 to 1", "camera.barrel_clipping",
+           metavar="C", metadata="lenslab:BarrelClipping"),
+    Option("aperture_image", str, "a grayscale image of the stop (custom bokeh), relative to the current folder",
+           "camera.aperture_image", metavar="FILE", parse_text=_existing_file, metadata="lenslab:ApertureImage"),
+    Option("exposure_mode", str, "compensated (brightness kept) or physical (each stop a stop of light)",
+           "camera.exposure_mode", metadata="lenslab:ExposureMode"),
+    Option("iso", float, "sensor speed; implies the physical exposure mode", "camera.iso", metavar="S",
+           metadata="Exif:PhotographicSensitivity"),
+    Option("shutter", float, "exposure time, e.g. 1/125 or 2s; implies the physical exposure mode",
+           "camera.shutter_s", unit="s", metavar="T", parse_text=_shutter, metadata="ExposureTime"),
+    # How the image is made and written, not the scene: the render job's and the output's.
+    Option("time_limit", float, "stop after this long, keeping what has been rendered (at least one sample in "
+           "every pixel)", unit="s", metavar="SECONDS", bounds=(0.001, 1e7), scene=False),
+    Option("exposure", float, "PNG only: brighten (+) or darken (-) by this many stops", unit="stops",
+           metavar="STOPS", bounds=(-30.0, 30.0), metadata="lenslab:DisplayExposureStops", scene=False),
+    Option("tone_map", str, "PNG only: how radiance above 1 is brought into the displayable range (default: clamp; "
+           "the studio shows and exports filmic unless told otherwise)", choices=TONE_MAPS,
+           metadata="lenslab:ToneMap", scene=False),
+)
+
+#: Every option by its name.
+OPTIONS: dict[str, Option] = {option.name: option for option in _ROWS}
+
+#: The options that override the scene (the fields of SceneOverrides), in the table's order.
+SCENE_OPTIONS: tuple[Option, ...] = tuple(option for option in _ROWS if option.scene)
+
+#: Older spellings -> the option's name.
+OLD_NAMES: dict[str, str] = {old: option.name for option in _ROWS for old in option.old_names}
+
+
+def option_named(name: str) -> Option:
+    """The option called ``name`` or by an older spelling of it; KeyError for neither."""
+    return OPTIONS[OLD_NAMES.get(name, name)]
