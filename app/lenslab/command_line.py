@@ -78,8 +78,14 @@ def add_option(parser, name: str, **changes) -> None:
     parser.add_argument(*flags, **settings)
 
 
+_UNIT_WORDS = {"mm": "millimetres", "m": "metres", "s": "seconds", "stops": "stops"}
+
+
 def _help(option: Option) -> str:
-    return option.help + (f" ({option.unit})" if option.unit and option.unit not in option.help else "")
+    """The option's help, its unit named where the help does not already name it."""
+    if not option.unit or _UNIT_WORDS.get(option.unit, option.unit) in option.help:
+        return option.help
+    return f"{option.help} ({_UNIT_WORDS.get(option.unit, option.unit)})"
 
 
 def parse_defines(items: list[str]) -> dict[str, str]:

@@ -6,7 +6,8 @@ Modules, one job each:
 * :mod:`.main_window`  - docks, menus, status bar, files, export, drag and drop
 * :mod:`.document`     - the open scene, its undo stack, selection and lens; targets that address its parts
 * :mod:`.commands`     - every edit as a QUndoCommand
-* :mod:`.worker`       - the render thread with its own GL context; :mod:`.controller` feeds it from the GUI
+* :mod:`.render_loop`  - the progressive render loop (preview, full passes, denoise, picks, exports), Qt-free
+* :mod:`.worker`       - the thread that carries the loop, with its own GL context; :mod:`.controller` feeds it
 * :mod:`.viewport`     - the converging picture, display transform, selection outline, plane-of-focus overlay
 * :mod:`.scene_tree`   - the outliner (a Qt item model over the scene)
 * :mod:`.properties`   - the property editor, generic over the scene's dataclass fields

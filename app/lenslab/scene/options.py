@@ -166,9 +166,9 @@ _ROWS = (
     Option("f_number", float, "aperture as an f-number, e.g. 2.8 or f/2.8 (1.4 is wide open and blurry, 16 is deep "
            "focus); a marked stop is its exact value (f/11 is 2^3.5)", "camera.f_number", metavar="N",
            parse_text=_f_number, old_names=("f_stop",), metadata="FNumber"),
-    Option("focal_length", float, "lens focal length (sets the field of view with the sensor width)",
+    Option("focal_length", float, "lens focal length in millimetres (sets the field of view with the sensor width)",
            "camera.focal_length_mm", unit="mm", metavar="MM", metadata="Exif:FocalLength"),
-    Option("focus_distance", float, "distance to the plane of focus", "camera.focus_distance_m", unit="m",
+    Option("focus_distance", float, "distance to the plane of focus, in metres", "camera.focus_distance_m", unit="m",
            metavar="M", metadata="lenslab:FocusDistanceM"),
     Option("width", int, "image width in pixels (alone, the scene's aspect ratio is kept)", metavar="W",
            bounds=(1, MAX_IMAGE_SIDE)),
@@ -191,8 +191,8 @@ _ROWS = (
            "camera.sensor_fit", metadata="lenslab:SensorFit"),
     Option("focus_from", str, "what the focus distance is measured from (default: the scene's; new scenes: sensor)",
            "camera.focus_from", metadata="lenslab:FocusFrom"),
-    Option("focus_breathing", bool, "false holds the framing: the sensor one focal length behind the lens at every "
-           "focus", "camera.focus_breathing", metadata="lenslab:FocusBreathing"),
+    Option("focus_breathing", bool, "off, the framing holds at every focus: the sensor one focal length behind "
+           "the lens", "camera.focus_breathing", metadata="lenslab:FocusBreathing"),
     Option("circle_of_confusion", float, "circle of confusion for the depth-of-field readout and metadata",
            "camera.circle_of_confusion_mm", unit="mm", metavar="MM", old_names=("coc",),
            metadata="lenslab:CircleOfConfusionMM"),
@@ -214,8 +214,8 @@ _ROWS = (
     Option("shutter", float, "exposure time, e.g. 1/125 or 2s; implies the physical exposure mode",
            "camera.shutter_s", unit="s", metavar="T", parse_text=_shutter, metadata="ExposureTime"),
     # How the image is made and written, not the scene: the render job's and the output's.
-    Option("time_limit", float, "stop after this long, keeping what has been rendered (at least one sample in "
-           "every pixel)", unit="s", metavar="SECONDS", bounds=(0.001, 1e7), scene=False),
+    Option("time_limit", float, "stop after this many seconds, keeping what has been rendered (at least one "
+           "sample in every pixel)", unit="s", metavar="SECONDS", bounds=(0.001, 1e7), scene=False),
     Option("exposure", float, "PNG only: brighten (+) or darken (-) by this many stops", unit="stops",
            metavar="STOPS", bounds=(-30.0, 30.0), metadata="lenslab:DisplayExposureStops", scene=False),
     Option("tone_map", str, "PNG only: how radiance above 1 is brought into the displayable range (default: clamp; "

@@ -1,0 +1,805 @@
+"""The viewport's render loop: what the render worker's thread does, without the thread and without Qt.
+
+The GUI thread never touches the GPU. It sends the worker immutable copies of what changed (a whole scene, a
+camera, render settings) through a queue; the loop applies only the latest of each, restarts accumulation and
+goes on rendering in bounded dispatches (``RenderSession.step``), publishing the image several times a second.
+Edits are therefore seen within one dispatch (about a sixtieth of a second) however long a render has run.
+
+The viewport's image is the widget's size (times a resolution scale), framed by ``ThinLensCamera.view_frame``:
+the export's frame (the sensor's gate) with some of the scene around it. After each restart the loop first
+renders one pass at a quarter of the resolution (a preview, enlarged smoothly), then the full resolution, whose
+first pass fills in over the preview tile by tile. The picture on screen is never thrown away for a worse one:
+after an edit the previous picture stays up until the new render has as many samples (up to HOLD_SPP), or for
+at most HOLD_SECONDS, so a drag still shows the newest state several times a second. Pixels not rendered yet
+(a first pass under way, or outside a render region) show the last picture. With the denoiser on, the pictures
+are Intel Open Image Denoise's, from the beauty and the first-hit albedo and normal the tracer accumulates. Each
+frame's picture is tone-mapped to 8 bits on the GPU with the viewport's exposure and tone curve
+(``RenderSession.display``), so neither thread does per-pixel work on the CPU; the linear image, for the
+viewport's pixel readout, comes along a few times a second. Once per change of view it casts one ray per pixel
+through the same kd-tree to find the node and the depth under every pixel: the viewport outlines the selection
+with the first and shows the plane of focus with the second. Click-to-focus picks and exports (a second
+``RenderSession`` on the same context, a ``RenderJob``) run here too.
+
+``RenderLoop`` is driven by its owner, one call at a time on one thread: ``handle(messages)`` with what the GUI
+sent since the last call, then ``step()`` (one dispatch, while ``busy``). Its state is ``phase``, a ``Phase``.
+Results go out through a ``LoopEvents`` object (the worker's turns each into a Qt signal, queued across
+threads). Frames are coalesced: the loop keeps only the newest and reports ``frame_ready`` once until the GUI has
+taken it (``take_frame``, from any thread), so a busy GUI never builds up a backlog.
+
+No Qt here, directly or indirectly (tests/gui/test_worker_messages.py checks): gui/worker.py carries the loop to
+a thread and its results to Qt signals.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import threading
+import time
+from dataclasses import dataclass
+from enum import Enum
+from pathlib import Path
+from typing import Callable, Protocol
+
+import numpy as np
+
+from lenslab.messages import one_line
+from lenslab.render.film import to_8bit, tone_map
+
+PREVIEW_DIVISOR = 4  # the preview pass renders at 1/4 of the width and height
+PREVIEW_MIN_PIXELS = 256 * 256  # images smaller than this skip the preview pass
+# The viewport's dispatches aim at a display frame: an edit is seen within one, and on a GPU that traces a
+# sample per pixel faster than that, each frame adds a pass. llvmpipe loses nothing by it (docs/performance.md).
+VIEWPORT_DISPATCH_SECONDS = 1 / 60
+FRAME_INTERVAL = 0.25  # seconds between published frames while a pass is in progress
+LINEAR_INTERVAL = 0.5  # seconds between linear images (the pixel readout's) while the render goes on
+# After an edit the previous picture stays up until the new render has this many samples per pixel (or as many
+# as the previous picture had, if fewer), or until HOLD_SECONDS have passed since the first edit it does not show.
+HOLD_SPP = 4
+HOLD_SECONDS = 0.15
+# The denoiser runs at most every DENOISE_MIN_INTERVAL seconds, and never more than a third of the time: it waits
+# twice as long as it took the last time before it runs again.
+DENOISE_MIN_INTERVAL = 0.25
+GBUFFER_INTERVAL = 0.3  # during a drag, the selection's outline and the depth buffer follow this often
+EXPORT_PROGRESS_INTERVAL = 0.1
+
+
+@dataclass(frozen=True)
+class Frame:
+    display: np.ndarray  # (H, W, 4) uint8 RGBA, made with display_settings; unsampled pixels show the preview
+    display_settings: tuple[float, str]  # (exposure in stops, tone map) the picture was made with
+    image: np.ndarray | None  # (H, W, 3) float32 linear radiance, or None: the last frame's still holds
+    width: int
+    height: int
+    samples_per_pixel: int
+    target_spp: int | None
+    samples_per_second: float
+    elapsed_seconds: float  # wall time since the last restart
+    generation: int
+    preview: bool  # only the quarter-resolution preview so far
+    converged: bool  # reached the target sample count
+    gate: tuple[float, float, float, float] | None = None  # the export's frame in the picture: x, y, w, h pixels
+    region: tuple[int, int, int, int] | None = None  # the render region being refined, pixels
+    denoised: bool = False  # the picture (and linear image) are the denoiser's
+
+
+@dataclass(frozen=True)
+class GBuffer:
+    """What is under each pixel of the viewport image (through the lens centre)."""
+
+    node_index: np.ndarray  # (H, W) int32 depth-first node index, -1 for the background
+    depth: np.ndarray  # (H, W) float32 distance along the view axis in metres, inf for the background
+    generation: int
+
+
+@dataclass(frozen=True)
+class PickResult:
+    request_id: int
+    generation: int
+    hit: bool
+    depth: float = math.nan  # along the view axis: the focus distance that makes the point sharp
+    point: tuple = ()
+    node_index: int = -1
+
+
+@dataclass(frozen=True)
+class ExportRequest:
+    scene: object  # a Scene copy whose camera resolution is the export size
+    path: Path
+    target_spp: int | None = None  # stop at this many samples per pixel ...
+    seconds: float | None = None  # ... or after this long (whichever comes first when both are given)
+    exposure_stops: float = 0.0
+    tone_map: str = "clamp"
+    denoise: bool = False  # write the denoised image (and, in an EXR, the noisy one and the guides as layers)
+
+
+@dataclass(frozen=True)
+class ExportProgress:
+    request_id: int
+    progress: object  # lenslab.render.job.JobProgress of the export's render job
+
+
+# -- messages from the GUI thread to the worker (through its queue) ---------------------------------------
+@dataclass(frozen=True)
+class SceneEdit:
+    scene: object  # a Scene copy
+    size: tuple[int, int]  # the viewport image, pixels
+    generation: int
+    margin: float | None = None  # framing: None, the export's; else ThinLensCamera.view_frame with this margin
+
+
+@dataclass(frozen=True)
+class CameraEdit:
+    camera: object  # a ThinLensCamera copy
+    size: tuple[int, int]
+    generation: int
+    view_changed: bool  # what the camera sees moved (not only its aperture or focus): refresh the g-buffer
+    margin: float | None = None  # as SceneEdit's
+
+
+@dataclass(frozen=True)
+class SettingsEdit:
+    settings: object  # RenderSettings
+    generation: int
+
+
+@dataclass(frozen=True)
+class DisplayEdit:
+    exposure: float  # stops
+    tone_map: str  # one of lenslab.render.film.TONE_MAPS
+
+
+@dataclass(frozen=True)
+class RegionEdit:
+    region: tuple[int, int, int, int] | None  # x, y, width, height in viewport pixels; None: the whole picture
+    generation: int
+
+
+@dataclass(frozen=True)
+class DenoiseEdit:
+    on: bool
+
+
+@dataclass(frozen=True)
+class Pause:
+    paused: bool
+
+
+@dataclass(frozen=True)
+class TargetSpp:
+    spp: int | None  # None: render on until paused
+
+
+@dataclass(frozen=True)
+class PickRequest:
+    u: float  # [0, 1] image coordinates, (0, 0) top left
+    v: float
+    request_id: int
+
+
+@dataclass(frozen=True)
+class ExportStart:
+    request_id: int
+    request: ExportRequest
+
+
+@dataclass(frozen=True)
+class ExportCancel:
+    request_id: int
+
+
+@dataclass(frozen=True)
+class Stop:
+    pass
+
+
+def preview_size(width: int, height: int) -> tuple[int, int]:
+    return max(1, math.ceil(width / PREVIEW_DIVISOR)), max(1, math.ceil(height / PREVIEW_DIVISOR))
+
+
+def upscale_smooth(image: np.ndarray, width: int, height: int) -> np.ndarray:
+    """``image`` (h, w, c) enlarged to (height, width, c) by bilinear interpolation between pixel centres (the
+    preview pass seen as a soft picture, not as blocks); uint8 in, uint8 out."""
+    h, w = image.shape[:2]
+    ys = np.clip((np.arange(height) + 0.5) * h / height - 0.5, 0, h - 1)
+    xs = np.clip((np.arange(width) + 0.5) * w / width - 0.5, 0, w - 1)
+    y0, x0 = np.floor(ys).astype(int), np.floor(xs).astype(int)
+    y1, x1 = np.minimum(y0 + 1, h - 1), np.minimum(x0 + 1, w - 1)
+    fy, fx = (ys - y0)[:, None, None], (xs - x0)[None, :, None]
+    src = image.astype(np.float32)
+    top = src[y0][:, x0] * (1 - fx) + src[y0][:, x1] * fx
+    bottom = src[y1][:, x0] * (1 - fx) + src[y1][:, x1] * fx
+    out = top * (1 - fy) + bottom * fy
+    return np.clip(np.rint(out), 0, 255).astype(np.uint8) if image.dtype == np.uint8 else out.astype(image.dtype)
+
+
+def opaque(rgb8: np.ndarray) -> np.ndarray:
+    """RGBA8 with alpha 255 from RGB8."""
+    return np.concatenate([rgb8, np.full(rgb8.shape[:2] + (1,), 255, np.uint8)], axis=2)
+
+
+class Phase(Enum):
+    """Where the viewport's render stands since the last restart."""
+
+    IDLE = "idle"  # nothing to render yet: no scene
+    PREVIEW = "preview"  # the quarter-resolution preview pass
+    FULL = "full"  # full-resolution passes, towards the target
+    DONE = "done"  # the target sample count is reached
+    ERROR = "error"  # the scene or camera cannot be rendered (scene_failed said why)
+
+
+class LoopEvents(Protocol):
+    """What the loop reports, each from the thread that drives it (the render worker's: gui/worker.py turns each
+    into the Qt signal of the same name)."""
+
+    def device_ready(self, info: dict) -> None: ...  # renderer.describe()
+
+    def frame_ready(self) -> None: ...  # take it with take_frame()
+
+    def gbuffer_ready(self, gbuffer: GBuffer) -> None: ...
+
+    def pick_ready(self, result: PickResult) -> None: ...
+
+    def restarted(self, generation: int) -> None: ...  # accumulation restarted for this edit
+
+    def scene_failed(self, generation: int, reason: str) -> None: ...  # one line: the scene cannot be rendered
+
+    def export_progress(self, progress: ExportProgress) -> None: ...
+
+    def export_finished(self, request_id: int, path: str) -> None: ...  # the path written
+
+    def export_failed(self, request_id: int, reason: str) -> None: ...
+
+    def export_cancelled(self, request_id: int) -> None: ...
+
+
+class RenderLoop:
+    """The viewport's progressive render, its picks, g-buffers and exports, on one renderer (its GL context).
+
+    Every method but ``take_frame`` is called on the thread that made the renderer's context current. ``handle``
+    applies what the GUI sent through ``apply_scene``, ``apply_camera``, ``apply_settings``, ``apply_display``,
+    ``apply_denoise``, ``apply_region``, ``pick``, ``start_export``, ``cancel_export`` and ``republish``.
+    """
+
+    def __init__(self, renderer, events: LoopEvents, dispatch_seconds: float = VIEWPORT_DISPATCH_SECONDS,
+                 more_messages: Callable[[], bool] = lambda: False):
+        """``renderer``: a lenslab.render.tracer.Renderer, released by ``release``. ``more_messages``: whether
+        the GUI has sent more since the last ``handle`` (a drag under way)."""
+        self.dispatch_seconds = dispatch_seconds
+        self._events = events
+        self._more_messages = more_messages
+        self._stopped = False
+        self._frame_lock = threading.Lock()
+        self._frame: Frame | None = None
+        self._frame_signalled = False
+        self._renderer = renderer
+        self._session = None
+        self._size = (0, 0)
+        self._generation = 0
+        self._phase = Phase.IDLE
+        self._paused = False
+        self._target_spp: int | None = 1024
+        self._scene_ok = False
+        self._camera_ok = True
+        self._preview_image = None
+        self._preview_linear = None  # the preview pass's linear image at the viewport's size
+        self._preview_display: tuple[tuple[float, str], np.ndarray] | None = None  # (settings, RGBA8 at full size)
+        self._display_settings: tuple[float, str] = (0.0, "filmic")
+        self._last_linear = 0.0
+        self._gbuffer_due = False
+        self._gbuffer_size: tuple[int, int] | None = None
+        self._gbuffer_time = 0.0
+        self._margin: float | None = None
+        self._region: tuple[int, int, int, int] | None = None
+        self._denoise = False
+        self._denoiser = None  # lenslab.render.denoise's, made on first use
+        self._denoised: tuple | None = None  # (generation, spp, picture, linear): the last denoised frame
+        self._denoise_ready_at = 0.0
+        # Never blank: the last picture shown at the viewport's size fills what the new render has not reached.
+        self._backdrop: np.ndarray | None = None  # RGBA8
+        self._backdrop_linear: np.ndarray | None = None
+        self._stale_since: float | None = None  # when the picture on screen stopped showing the latest edit
+        self._shown_quality = -1  # its samples per pixel; -1 for a preview
+        self._restart_time = 0.0
+        self._last_publish = 0.0
+        self._published_spp = -1
+        self._export = None
+
+    # -- the state, read-only ----------------------------------------------------------------------------------
+    @property
+    def phase(self) -> Phase:
+        return self._phase
+
+    @property
+    def paused(self) -> bool:
+        return self._paused
+
+    @property
+    def target_spp(self) -> int | None:
+        return self._target_spp
+
+    @property
+    def generation(self) -> int:
+        """The edit the loop last applied (rendered, or failed)."""
+        return self._generation
+
+    @property
+    def stopped(self) -> bool:
+        """A Stop message came: the owner ends the loop (and calls release)."""
+        return self._stopped
+
+    @property
+    def busy(self) -> bool:
+        """``step`` has work to do: an export, or a viewport render short of its target."""
+        if self._export is not None:
+            return True
+        return (not self._paused and self._session is not None and self._scene_ok and self._camera_ok
+                and self._phase in (Phase.PREVIEW, Phase.FULL))
+
+    # -- the frame hand-off (any thread) -----------------------------------------------------------------------
+    def take_frame(self) -> Frame | None:
+        with self._frame_lock:
+            frame, self._frame = self._frame, None
+            self._frame_signalled = False
+        return frame
+
+    # -- driving the loop --------------------------------------------------------------------------------------
+    def start(self) -> None:
+        """Report the device (``device_ready``); once, before the first ``handle``."""
+        self._events.device_ready(self._renderer.describe())
+
+    def step(self) -> None:
+        """One bounded dispatch of the export, or else of the viewport's render if it is short of its target."""
+        if self._export is not None:
+            self._export_step()
+        elif self.busy:
+            self._viewport_step()
+
+    def release(self) -> None:
+        """Free the export, the session and the renderer (on the thread that made them)."""
+        if self._export is not None:
+            self._export.job.release()
+            self._export = None
+        if self._session is not None:
+            self._session.release()
+            self._session = None
+        if self._renderer is not None:
+            self._renderer.release()
+            self._renderer = None
+
+    def handle(self, messages: list) -> None:
+        """Apply the messages the GUI sent since the last call, in order, coalesced. A Stop ends the handling at
+        once (``stopped``): nothing else in the list is applied."""
+        # Only the latest scene, camera and settings matter: a new scene supersedes the edits before it.
+        scene_edit: SceneEdit | None = None
+        camera_edit: CameraEdit | None = None
+        settings_edit: SettingsEdit | None = None
+        display_edit: DisplayEdit | None = None
+        region_edit: RegionEdit | None = None
+        denoise_edit: DenoiseEdit | None = None
+        holding = False  # the viewport is about to stop making frames by itself
+        for message in messages:
+            if isinstance(message, Stop):
+                self._stopped = True
+                return
+            if isinstance(message, SceneEdit):
+                scene_edit, camera_edit, settings_edit = message, None, None
+            elif isinstance(message, CameraEdit):
+                # Keep "the view moved" if any of the coalesced camera edits moved it.
+                moved = message.view_changed or (camera_edit is not None and camera_edit.view_changed)
+                camera_edit = dataclasses.replace(message, view_changed=moved)
+            elif isinstance(message, SettingsEdit):
+                settings_edit = message
+            elif isinstance(message, DisplayEdit):
+                display_edit = message
+            elif isinstance(message, RegionEdit):
+                region_edit = message
+            elif isinstance(message, DenoiseEdit):
+                denoise_edit = message
+            elif isinstance(message, Pause):
+                holding = holding or (message.paused and not self._paused)
+                self._paused = message.paused
+                if not self._paused and self._phase is Phase.DONE:
+                    self._phase = Phase.FULL  # the target may have been raised meanwhile
+            elif isinstance(message, TargetSpp):
+                self._target_spp = message.spp
+                if self._phase is Phase.DONE:
+                    self._phase = Phase.FULL
+        if scene_edit is not None:
+            self.apply_scene(scene_edit)
+        if camera_edit is not None:
+            self.apply_camera(camera_edit)
+        if settings_edit is not None:
+            self.apply_settings(settings_edit)
+        if display_edit is not None:
+            self.apply_display(display_edit)
+        if denoise_edit is not None:
+            self.apply_denoise(denoise_edit)
+        if region_edit is not None:
+            self.apply_region(region_edit)
+        for message in messages:
+            if isinstance(message, PickRequest):
+                self.pick(message)
+            elif isinstance(message, ExportStart):
+                holding = self.start_export(message) or holding
+            elif isinstance(message, ExportCancel):
+                self.cancel_export(message.request_id)
+        if holding:
+            # Paused, or the device turns to an export: the last picture stays up for a while, so it comes
+            # with its linear image, or the pixel readout would answer from an older one.
+            self.republish(with_linear=True)
+
+    # -- applying edits ------------------------------------------------------------------------------------
+    def apply_scene(self, edit: SceneEdit) -> None:
+        from lenslab.render.tracer import RenderSession
+
+        scene, size, generation = edit.scene, edit.size, edit.generation
+        try:
+            if self._session is None:
+                self._session = RenderSession(self._renderer, scene, width=size[0], height=size[1],
+                                              dispatch_seconds=self.dispatch_seconds)
+                # The viewport always gathers the denoiser's albedo and normal, so that turning it on or off
+                # shows at once, without a restart.
+                self._session.set_feature_buffers(True)
+            else:
+                self._session.set_scene(scene, width=size[0], height=size[1])
+            self._session.set_view(*size, edit.margin)
+        except Exception as exc:  # SceneError, SceneTooLarge, a camera ValueError, a mesh that fails to load
+            self._scene_ok = False
+            self._phase = Phase.ERROR
+            self._generation = generation
+            self._events.scene_failed(generation, _one_line(exc))
+            return
+        self._scene_ok = self._camera_ok = True
+        self._set_size(size, edit.margin)
+        self._restart(generation, view_changed=True)
+
+    def apply_camera(self, edit: CameraEdit) -> None:
+        if self._session is None:
+            return
+        generation = edit.generation
+        try:
+            self._session.set_camera(edit.camera)
+        except Exception as exc:
+            self._camera_ok = False
+            self._phase = Phase.ERROR
+            self._generation = generation
+            self._events.scene_failed(generation, _one_line(exc))
+            return
+        self._camera_ok = True
+        if not self._scene_ok:
+            self._generation = generation
+            return
+        self._set_size(edit.size, edit.margin)
+        self._restart(generation, view_changed=edit.view_changed or edit.size != self._gbuffer_size)
+
+    def apply_settings(self, edit: SettingsEdit) -> None:
+        if self._session is None:
+            return
+        self._session.set_settings(edit.settings)
+        if self._scene_ok and self._camera_ok:
+            self._restart(edit.generation, view_changed=False)
+
+    def _set_size(self, size: tuple[int, int], margin: float | None) -> None:
+        if size != self._size or margin != self._margin:
+            self._region = None  # its pixels were another picture's
+        self._size, self._margin = size, margin
+
+    def apply_region(self, edit: RegionEdit) -> None:
+        self._region = edit.region
+        if self._session is not None and self._scene_ok and self._camera_ok:
+            self._restart(edit.generation, view_changed=False)
+
+    def apply_denoise(self, edit: DenoiseEdit) -> None:
+        if edit.on != self._denoise:
+            self._denoise = edit.on
+            self._denoised = None
+            self.republish(with_linear=True)
+
+    def apply_display(self, edit: DisplayEdit) -> None:
+        self._display_settings = (edit.exposure, edit.tone_map)
+        # Show the picture in the new look now: a finished or paused render makes no more frames by itself.
+        self.republish(with_linear=False)
+
+    def republish(self, with_linear: bool) -> None:
+        """Publish the full-size picture as it stands again, if there is one."""
+        if self._session is not None and self._scene_ok and self._camera_ok \
+                and self._phase in (Phase.FULL, Phase.DONE) and self._published_spp >= 0:
+            self._publish_session(converged=self._phase is Phase.DONE, with_linear=with_linear)
+
+    def _resize(self, width: int, height: int, region=None) -> None:
+        # RenderSession keeps the scene on the GPU; a new size needs the camera framed again for it and a new
+        # accumulation buffer (set_view does both).
+        self._session.set_view(width, height, self._margin)
+        if region is not None:
+            self._session.set_region(region)
+
+    def _restart(self, generation: int, view_changed: bool) -> None:
+        self._generation = generation
+        self._preview_image = None
+        self._preview_display = None
+        self._last_linear = 0.0
+        self._published_spp = -1
+        self._restart_time = time.perf_counter()
+        if self._stale_since is None:
+            self._stale_since = self._restart_time
+        w, h = self._size
+        if self._region is None and w * h >= PREVIEW_MIN_PIXELS:
+            self._resize(*preview_size(w, h))
+            self._phase = Phase.PREVIEW
+        else:
+            self._resize(w, h, self._region)
+            self._phase = Phase.FULL
+        if view_changed:
+            self._gbuffer_due = True
+        self._events.restarted(generation)
+
+    # -- rendering the viewport ------------------------------------------------------------------------------
+    def _viewport_step(self) -> None:
+        session = self._session
+        if self._phase is Phase.PREVIEW:
+            session.step(self.dispatch_seconds / 2, target_spp=1)
+            if session.samples_per_pixel >= 1:
+                image = session.image()
+                if self._denoise:
+                    image = self._denoise_image(image, *session.features_image())
+                self._preview_image = image
+                w, h = self._size
+                # Enlarged once: the frames of the first full pass fill their unreached pixels from it.
+                self._preview_linear = upscale_smooth(image, w, h)
+                self._offer(self._preview_picture(), self._preview_linear, preview=True)
+                self._resize(w, h)
+                self._phase = Phase.FULL
+                self._gbuffer_if_due()  # during a drag every edit restarts here: the outline must keep up
+            return
+        if self._gbuffer_if_due():
+            return
+        target = self._target_spp
+        progress = session.step(self.dispatch_seconds, target)
+        done = target is not None and progress.samples_per_pixel >= target
+        now = time.perf_counter()
+        if done or progress.samples_per_pixel != self._published_spp or now - self._last_publish >= FRAME_INTERVAL:
+            self._publish_session(done)
+        if done:
+            self._phase = Phase.DONE
+
+    def _gbuffer_if_due(self) -> bool:
+        """Remake the depth and selection buffer if the view moved: between edits, or every GBUFFER_INTERVAL
+        while they keep coming (a drag), so that the selection's outline follows a lens change."""
+        if not self._gbuffer_due:
+            return False
+        if self._more_messages() and time.perf_counter() - self._gbuffer_time < GBUFFER_INTERVAL:
+            return False
+        self._gbuffer_due = False
+        self._compute_gbuffer()
+        return True
+
+    def _preview_picture(self) -> np.ndarray:
+        """The preview pass tone-mapped at its own quarter size, then enlarged: RGBA8 at the viewport's size."""
+        look = self._display_look()
+        if self._preview_display is None or self._preview_display[0] != look:
+            rgb = to_8bit(tone_map(self._preview_image, *look))
+            w, h = self._size
+            self._preview_display = (look, opaque(upscale_smooth(rgb, w, h)))
+        return self._preview_display[1]
+
+    def _display_look(self) -> tuple[float, str]:
+        """The viewport's exposure and tone curve, with the camera's own exposure added in the physical mode (so
+        a stop of aperture darkens the picture by a stop, as the exported file will be)."""
+        exposure, tone = self._display_settings
+        session = self._session
+        scale = session.camera.exposure_scale(session.frame.aperture.light_fraction)
+        return exposure + math.log2(scale), tone
+
+    def _publish_session(self, converged: bool, with_linear: bool = False) -> None:
+        session = self._session
+        now = time.perf_counter()
+        if self._denoise and session.samples_per_pixel >= 1:
+            picture, image = self._denoised_frame(converged)
+            self._offer(picture, image, preview=False, converged=converged, denoised=True)
+            return
+        picture = session.display(*self._display_look())
+        empty = picture[..., 3] == 0  # pixels without a sample: a first pass under way, or outside the region
+        has_empty = bool(empty.any())
+        fill, fill_linear = self._fill_pictures()
+        if has_empty and fill is not None:
+            picture[empty] = fill[empty]
+        elif has_empty:
+            picture[empty, 3] = 255  # black
+        image = None
+        if with_linear or converged or self._paused or not self.busy or now - self._last_linear >= LINEAR_INTERVAL:
+            image = session.image()  # resolved from the read-back itself, without a copy of the sums
+            if has_empty and fill_linear is not None:
+                image[empty] = fill_linear[empty]
+            self._last_linear = now
+        self._offer(picture, image, preview=False, converged=converged)
+
+    def _fill_pictures(self) -> tuple[np.ndarray | None, np.ndarray | None]:
+        """What shows where the render has no sample yet: this edit's preview, else the last picture shown."""
+        w, h = self._size
+        if self._preview_image is not None:
+            return self._preview_picture(), self._preview_linear
+        if self._backdrop is not None and self._backdrop.shape[:2] == (h, w):
+            linear = self._backdrop_linear
+            return self._backdrop, linear if linear is not None and linear.shape[:2] == (h, w) else None
+        return None, None
+
+    # -- the denoiser ------------------------------------------------------------------------------------------
+    def _denoise_image(self, image: np.ndarray, albedo: np.ndarray, normal: np.ndarray) -> np.ndarray:
+        from lenslab.render.denoise import denoise
+
+        # OIDN's "fast" quality is the one its documentation gives interactive previews: about half the time of
+        # "high" on the CPU. Exports that ask for the denoiser take "high" (render/job.py).
+        return denoise(image, albedo, normal, quality="fast")
+
+    def _denoised_frame(self, converged: bool) -> tuple[np.ndarray, np.ndarray]:
+        """The picture and linear image through the denoiser: the render region's pixels over the last picture,
+        or the whole image. The denoiser is not cheap (a CPU network): between runs the last result of this
+        edit is shown again (see DENOISE_MIN_INTERVAL)."""
+        session = self._session
+        spp = session.samples_per_pixel
+        cached = self._denoised
+        now = time.perf_counter()
+        look = self._display_look()
+        if cached is not None and cached[0] == self._generation \
+                and (cached[1] == spp or (not converged and now < self._denoise_ready_at)):
+            if cached[3] != look:  # another exposure or tone map: the same denoised image, shown anew
+                self._denoised = (*cached[:2], session.display_image(cached[4], *look), look, cached[4])
+            return self._denoised[2], self._denoised[4]
+        start = time.perf_counter()
+        image = session.image()
+        albedo, normal = session.features_image()
+        x, y, w, h = session.region_pixels
+        crop = self._denoise_image(image[y:y + h, x:x + w], albedo[y:y + h, x:x + w], normal[y:y + h, x:x + w])
+        if session.region is not None:  # outside the region: the last picture shown
+            _fill, fill_linear = self._fill_pictures()
+            if fill_linear is not None:
+                image = fill_linear.copy()
+        image[y:y + h, x:x + w] = crop
+        picture = session.display_image(image, *look)  # tone-mapped on the GPU, as the raw pictures are
+        cost = time.perf_counter() - start
+        self._denoise_ready_at = time.perf_counter() + max(DENOISE_MIN_INTERVAL, 2.0 * cost)
+        self._denoised = (self._generation, spp, picture, look, image)
+        return picture, image
+
+    # -- what the viewport shows -------------------------------------------------------------------------------
+    def _offer(self, picture: np.ndarray, image: np.ndarray | None, preview: bool, converged: bool = False,
+               denoised: bool = False) -> None:
+        """Show this picture of the latest edit, unless the one on screen is still the better (HOLD_SPP and
+        HOLD_SECONDS): the viewport never trades a clean picture for a worse one of the same view at once."""
+        quality = -1 if preview else self._session.samples_per_pixel
+        if self._stale_since is not None:
+            on_screen = self._backdrop
+            comparable = on_screen is not None and on_screen.shape[:2] == picture.shape[:2]
+            enough = quality >= min(self._shown_quality, HOLD_SPP)
+            waited = time.perf_counter() - self._stale_since >= HOLD_SECONDS
+            if comparable and not (enough or waited or converged):
+                return
+            self._stale_since = None
+        self._shown_quality = quality
+        self._backdrop = picture
+        if image is not None:
+            self._backdrop_linear = image
+        self._publish(picture, image, preview=preview, converged=converged, denoised=denoised)
+
+    def _publish(self, picture: np.ndarray, image: np.ndarray | None, preview: bool, converged: bool = False,
+                 denoised: bool = False) -> None:
+        session = self._session
+        progress = session.progress(self._target_spp)
+        spp = 0 if preview else session.samples_per_pixel
+        w, h = self._size
+        gx, gy, gw, gh = session.frame.gate_pixels
+        sx, sy = w / session.width, h / session.height  # the preview pass is smaller than the picture
+        frame = Frame(display=picture, display_settings=self._display_settings, image=image,
+                      width=picture.shape[1], height=picture.shape[0], samples_per_pixel=spp,
+                      target_spp=self._target_spp, samples_per_second=progress.samples_per_second,
+                      elapsed_seconds=time.perf_counter() - self._restart_time, generation=self._generation,
+                      preview=preview, converged=converged, gate=(gx * sx, gy * sy, gw * sx, gh * sy),
+                      region=session.region, denoised=denoised)
+        self._published_spp = spp
+        self._last_publish = time.perf_counter()
+        with self._frame_lock:
+            untaken = self._frame
+            if image is None and untaken is not None and untaken.image is not None \
+                    and untaken.image.shape[:2] == picture.shape[:2]:
+                # This frame replaces one the GUI never took: keep the linear image that one carried.
+                frame = dataclasses.replace(frame, image=untaken.image)
+            self._frame = frame
+            signal = not self._frame_signalled
+            self._frame_signalled = True
+        if signal:
+            self._events.frame_ready()
+
+    def _compute_gbuffer(self) -> None:
+        from lenslab.render.raycast import cast_rays
+
+        session = self._session
+        w, h = self._size
+        frame = session.frame  # the full-size picture's, as the g-buffer is only made between full passes
+        self._gbuffer_time = time.perf_counter()
+        origins, directions = frame.rays(frame.pixel_centres())
+        hits = cast_rays(self._renderer, session.gpu_scene, origins, directions)
+        node_index = session.hit_nodes(hits)
+        depth = np.where(hits.prim >= 0, hits.t * (directions @ frame.forward), np.inf).astype(np.float32)
+        self._gbuffer_size = (w, h)
+        self._events.gbuffer_ready(GBuffer(node_index.reshape(h, w), depth.reshape(h, w), self._generation))
+
+    def pick(self, request: PickRequest) -> None:
+        session = self._session
+        if session is None or not (self._scene_ok and self._camera_ok):
+            self._events.pick_ready(PickResult(request.request_id, self._generation, False))
+            return
+        pick = session.pick(request.u * session.width, request.v * session.height)
+        if pick is None:
+            self._events.pick_ready(PickResult(request.request_id, self._generation, False))
+            return
+        self._events.pick_ready(PickResult(request.request_id, self._generation, True, float(pick.depth),
+                                           tuple(float(c) for c in pick.point), pick.node_index))
+
+    # -- export ----------------------------------------------------------------------------------------------
+    def start_export(self, start: ExportStart) -> bool:
+        """Start the export; False if it could not start (the reason goes out by export_failed)."""
+        from lenslab.render.job import RenderJob
+        from lenslab.render.tracer import DEFAULT_DISPATCH_SECONDS
+
+        if self._export is not None:
+            self._events.export_failed(start.request_id, "another export is still running")
+            return False
+        request = start.request
+        try:
+            # An export's dispatches are the session's default, not the headless job's longer ones
+            # (job.OFFLINE_DISPATCH_SECONDS): long enough to keep the device busy, short enough for a cancel
+            # to be felt within a tenth of a second.
+            job = RenderJob(self._renderer, request.scene, spp=request.target_spp, time_limit=request.seconds,
+                            dispatch_seconds=max(self.dispatch_seconds, DEFAULT_DISPATCH_SECONDS),
+                            feature_buffers=request.denoise)
+        except Exception as exc:
+            self._events.export_failed(start.request_id, _one_line(exc))
+            return False
+        self._export = _Export(start.request_id, request, job)
+        return True
+
+    def cancel_export(self, request_id: int) -> None:
+        export = self._export
+        if export is None or export.request_id != request_id:
+            return
+        export.job.release()
+        self._export = None
+        self._events.export_cancelled(request_id)
+
+    def _export_step(self) -> None:
+        export = self._export
+        job = export.job
+        if not job.finished:
+            progress = job.step(EXPORT_PROGRESS_INTERVAL)
+            now = time.perf_counter()
+            if now - export.last_report >= EXPORT_PROGRESS_INTERVAL:
+                export.last_report = now
+                self._events.export_progress(ExportProgress(export.request_id, progress))
+            return
+        # Done: the job has a sample in every pixel; the file is written whole or not at all.
+        self._export = None
+        try:
+            path = job.write(export.request.path, exposure_stops=export.request.exposure_stops,
+                             tone_map=export.request.tone_map, denoise=export.request.denoise)
+        except Exception as exc:
+            self._events.export_failed(export.request_id, _one_line(exc))
+        else:
+            self._events.export_finished(export.request_id, str(path))
+        finally:
+            job.release()
+
+
+@dataclass
+class _Export:
+    """The export in progress (the loop's thread only)."""
+
+    request_id: int
+    request: ExportRequest
+    job: object  # lenslab.render.job.RenderJob
+    last_report: float = 0.0
+
+
+def _one_line(exc: BaseException) -> str:
+    """The studio shows an error as the command line prints it (lenslab.messages): one line, shortened."""
+    return one_line(str(exc).strip() or type(exc).__name__)
