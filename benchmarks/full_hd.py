@@ -11,7 +11,7 @@ Printed, in one run:
 * the million-triangle scene (scenes/marbles_on_sand): making the mesh and building its kd-tree, the kernel's
   first compile, and the seconds to 5 samples per pixel.
 
-The targets issue 9 set for an NVIDIA GPU are printed beside the figures: 1024 spp of the Cornell box in
+The targets for an NVIDIA GPU are printed beside the figures: 1024 spp of the Cornell box in
 under 10 s, 5 spp of the million triangles in under 1 s, 60 or more updates per second.
 
 Usage: python benchmarks/full_hd.py [--width 1920] [--height 1080] [--spp 1024] [--updates 60] [--save DIR]

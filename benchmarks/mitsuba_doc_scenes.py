@@ -1,4 +1,4 @@
-"""Mitsuba 3's own documentation and example scenes, through ``lenslab validate --files`` (issue 11's goal).
+"""Mitsuba 3's own documentation and example scenes, through ``lenslab validate --files`` and its goal.
 
 The scenes are Mitsuba's, not ours, and large: they are exported from a clone of Mitsuba's data repository into
 a folder outside this checkout, then validated there. Which scenes, from which commit, and why the others are

@@ -1,4 +1,4 @@
-"""The controls of a real camera (issue 13): sensor fit, focus from the sensor plane, aperture shapes measured on
+"""The controls of a real camera: sensor fit, focus from the sensor plane, aperture shapes measured on
 rendered point lights, physical exposure and what the image files say. Expected values are worked out here from
 the definitions (Blender's and Unity's fits, the Gaussian lens equation, ISO 12232), not taken from the code."""
 

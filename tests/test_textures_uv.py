@@ -112,11 +112,11 @@ def flip_v(uv: np.ndarray) -> np.ndarray:
 def import_texture(xml_texture: str, base_dir: Path, warn=None):
     """A texture element imported as a diffuse reflectance on an OBJ-like (mesh-frame) shape: the texture
     texture_of gives, unfitted."""
-    from lenslab.scene.io.mitsuba_xml import _Importer, _parse_xml, _Expander
+    from lenslab.scene.io.mitsuba_xml import MitsubaImporter, _parse_xml, _Expander
 
     expander = _Expander({})
     root = expander.expand(_parse_xml(f'<scene version="3.0.0">{xml_texture}</scene>'.encode(), "<t>", base_dir), 0)[0]
-    importer = _Importer(root, expander.ids, base_dir, warn or (lambda message: None))
+    importer = MitsubaImporter(root, expander.ids, base_dir, warn or (lambda message: None))
     return importer, root.children[0]
 
 

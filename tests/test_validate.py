@@ -154,7 +154,7 @@ def test_both_renderers_agree_on_a_point_lit_scene(mitsuba):
 
 
 # ---------------------------------------------------------------------------------------------------------
-# --files: any scene files against issue 11's goal
+# --files: any scene files against the --files goal (nothing dropped, image within 2%)
 # ---------------------------------------------------------------------------------------------------------
 SERIALIZED = ('/s/docs/scenes/include/matpreview.xml:9: <shape type="serialized" id="Plane">: Mitsuba .serialized '
               'meshes are not readable yet: shape skipped (convert it to PLY)')

@@ -1,6 +1,6 @@
 """What this machine and its GL device can hold, and the one error for a scene or an image that does not fit.
 
-A small file can ask for a great deal of work (issue 12): ten coplanar disks of 4,096 segments once drove the
+A small file can ask for a great deal of work: ten coplanar disks of 4,096 segments once drove the
 kd-tree build to 7.5 GB, and a 16384 x 16384 image asks for 4 GiB of accumulation buffer. The builders and
 the render session work out what they need *before* allocating it and compare it with what is here, so the
 user gets one line naming what is too big rather than a crash deep inside numpy or the GL driver.

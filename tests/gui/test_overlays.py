@@ -1,4 +1,4 @@
-"""The viewport's judging aids (issue 14, items 4 and 5), driven with pytest-qt: the sensor's gate with the guides,
+"""The viewport's judging aids, driven with pytest-qt: the sensor's gate with the guides,
 the safe frame and the passepartout; the aspect-ratio presets; focus peaking; the histogram and the clipping
 warnings; the loupe.
 

@@ -1,4 +1,4 @@
-"""Snapshots and A/B comparison (issue 14, item 6): keep a render at f/1.4 and compare it with the live one at f/4,
+"""Snapshots and A/B comparison: keep a render at f/1.4 and compare it with the live one at f/4,
 with a split wipe or side by side.
 
 The store's rules (the cap, the labels, the re-tone-mapping) are checked without a window; the rest drives the

@@ -1,6 +1,6 @@
 """The studio, driven as a user would (pytest-qt, offscreen, rendering on llvmpipe in its worker thread).
 
-What issue 4 checks: choosing f/2.8 sets the f-number and restarts accumulation; a lens preset sets the focal
+What is checked: choosing f/2.8 sets the f-number and restarts accumulation; a lens preset sets the focal
 length and clamps the aperture; clicking an object focuses at its depth within 1 %; undo restores each edit;
 export writes a valid file and cancelling writes none; closing with unsaved changes prompts; the window closes
 cleanly while rendering.

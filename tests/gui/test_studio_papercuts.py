@@ -1,4 +1,4 @@
-"""What a photographer found wrong in the studio (issue 14, item 7), each fixed and held here: History rows that
+"""What a photographer found wrong in the studio, each fixed and held here: History rows that
 name the value they restore, a translate scrub that follows the mouse on screen, every light under Lights, example
 scenes with proper names, file dialogs that remember their folder, and a display exposure that can be typed and
 reset."""

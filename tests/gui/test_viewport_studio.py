@@ -161,7 +161,7 @@ def test_the_denoised_preview_is_on_by_default_and_one_toggle(make_window, small
 
 
 def test_undoing_a_scrub_twice_renders_again_at_once(make_window, small_scene, qtbot):
-    """Issue 14's report: after scrubbing a translate and pressing Ctrl+Z twice the viewport stayed on
+    """A user's report: after scrubbing a translate and pressing Ctrl+Z twice the viewport stayed on
     "preview" at 0 samples/s for 15 to 25 s. Undo is an edit like any other: a full pass follows promptly."""
     small_scene.camera = dataclasses.replace(small_scene.camera, resolution=(320, 240))  # with a preview pass
     window = make_window(small_scene)
@@ -179,7 +179,7 @@ def test_undoing_a_scrub_twice_renders_again_at_once(make_window, small_scene, q
 
 
 def test_the_selection_outline_follows_a_lens_drag(make_window, small_scene, qtbot):
-    """Issue 14's report: the selection outline lagged a lens change by seconds. The depth and selection buffer
+    """A user's report: the selection outline lagged a lens change by seconds. The depth and selection buffer
     is now remade during a drag too (every GBUFFER_INTERVAL), not only once the edits stop."""
     from PySide6.QtCore import QTimer
 

@@ -223,7 +223,7 @@ class Comparison(QObject):
         if area.width() < width + 8 or area.height() < 40:
             return
         x = {"left": area.left(), "right": area.right() - width}.get(align, area.center().x() - width / 2)
-        self.viewport._draw_tag(p, QPointF(x, area.bottom() - 10), text, colour)
+        self.viewport.draw_tag(p, QPointF(x, area.bottom() - 10), text, colour)
 
     # -- the mouse --------------------------------------------------------------------------------------------------
     def eventFilter(self, obj, event) -> bool:
@@ -244,7 +244,7 @@ class Comparison(QObject):
         return False
 
     def _panning(self, event) -> bool:
-        return event.button() == Qt.MiddleButton or bool(getattr(self.viewport, "_space_down", False))
+        return event.button() == Qt.MiddleButton or self.viewport.space_held
 
     def _press(self, event) -> bool:
         pos = event.position()

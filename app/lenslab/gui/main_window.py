@@ -132,8 +132,10 @@ class MainWindow(QMainWindow):
         self._update_actions()
 
     # -- construction ------------------------------------------------------------------------------------------
-    def _action(self, text: str, slot=None, shortcut=None, icon: str | None = None, checkable: bool = False,
-                tip: str | None = None) -> QAction:
+    def make_action(self, text: str, slot=None, shortcut=None, icon: str | None = None, checkable: bool = False,
+                    tip: str | None = None) -> QAction:
+        """A QAction added to the window, so its shortcut works wherever the focus is; the tip, shortcut
+        appended, is its status tip and tooltip. The studio's panels make their actions with it too."""
         action = QAction(text, self)
         if shortcut is not None:
             if isinstance(shortcut, (list, tuple)):
@@ -165,7 +167,7 @@ class MainWindow(QMainWindow):
         return exposure, tone_map if tone_map in TONE_MAPS else "filmic"
 
     def _create_actions(self) -> None:
-        a = self._action
+        a = self.make_action
         self.actions: dict[str, QAction] = {}
         act = self.actions
         act["new"] = a("&New", self.new_scene, QKeySequence.New)
@@ -408,12 +410,12 @@ class MainWindow(QMainWindow):
         camera.addAction(act["focus_on_selection"])
         lens_menu = camera.addMenu("&Lens")
         self.lens_actions = []
-        free = self._action("Free (no lens limits)", lambda: self.camera_panel.choose_lens(None), "Alt+0")
+        free = self.make_action("Free (no lens limits)", lambda: self.camera_panel.choose_lens(None), "Alt+0")
         lens_menu.addAction(free)
         lens_menu.addSeparator()
         for i, lens in enumerate(self.camera_panel.lenses):
-            action = self._action(lens.name, lambda _c=False, lens=lens: self.camera_panel.choose_lens(lens),
-                                  f"Alt+{i + 1}" if i < 9 else None)
+            action = self.make_action(lens.name, lambda _c=False, lens=lens: self.camera_panel.choose_lens(lens),
+                                      f"Alt+{i + 1}" if i < 9 else None)
             lens_menu.addAction(action)
             self.lens_actions.append(action)
 

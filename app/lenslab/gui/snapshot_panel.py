@@ -243,7 +243,7 @@ class StudioSnapshots(QObject):
     # -- construction ------------------------------------------------------------------------------------------
     def _create_actions(self) -> None:
         w, store = self.window, self.store
-        a = w._action
+        a = w.make_action
         act = w.actions
         act["take_snapshot"] = a("Take &Snapshot", self.take, TAKE_SHORTCUT, "camera",
                                  tip="Keep the picture as it is, to compare with the live one (A/B)")

@@ -108,7 +108,7 @@ class Viewport(QWidget):
         self._drag_start: QPointF | None = None
         self._pan_start = QPointF(0, 0)
         self._press_pos: QPointF | None = None
-        self._space_down = False
+        self.space_held = False  # a left drag pans whatever the tool, here and in the A/B comparison
         self.hud_text = ""
         self.message = ""  # an error to show over the image
         self.status_text = ""  # e.g. "Preview" in the corner
@@ -311,7 +311,7 @@ class Viewport(QWidget):
             if self._overlay is not None and self._overlay.size() == self.qimage.size():
                 p.setOpacity(self._overlay_opacity())
                 p.drawImage(rect, self._overlay)
-                self._draw_tag(p, QPointF(rect.left() + 10, rect.bottom() - 12), self._overlay_label, theme.FOCUS)
+                self.draw_tag(p, QPointF(rect.left() + 10, rect.bottom() - 12), self._overlay_label, theme.FOCUS)
                 p.setOpacity(1.0)
             for layer in self.layers:
                 if getattr(layer, "visible", True):
@@ -355,7 +355,9 @@ class Viewport(QWidget):
         y0, y1 = sorted((min(max(a.y(), 0), h), min(max(b.y(), 0), h)))
         return QRectF(x0, y0, x1 - x0, y1 - y0)
 
-    def _draw_tag(self, p: QPainter, at: QPointF, text: str, colour: str) -> None:
+    def draw_tag(self, p: QPainter, at: QPointF, text: str, colour: str) -> None:
+        """A label on a dark rounded box whose bottom-left corner is ``at``: the HUD's and the status's, and the
+        A/B comparison's, so that all the viewport's tags look alike."""
         if not text:
             return
         metrics = p.fontMetrics()
@@ -372,14 +374,14 @@ class Viewport(QWidget):
         rect = self.image_rect() if self.qimage is not None else QRectF(self.rect())
         top = max(4.0, rect.top() - 4)
         if self.hud_text:
-            self._draw_tag(p, QPointF(max(4.0, rect.left()), top + 22 if rect.top() < 26 else top), self.hud_text,
-                           "#e6e6e6")
+            self.draw_tag(p, QPointF(max(4.0, rect.left()), top + 22 if rect.top() < 26 else top), self.hud_text,
+                          "#e6e6e6")
         if self.status_text:
             metrics = p.fontMetrics()
             x = min(self.width() - 4.0, rect.right()) - metrics.horizontalAdvance(self.status_text) - 12
-            self._draw_tag(p, QPointF(x, top + 22 if rect.top() < 26 else top), self.status_text, theme.DIM_TEXT)
+            self.draw_tag(p, QPointF(x, top + 22 if rect.top() < 26 else top), self.status_text, theme.DIM_TEXT)
         if self.tool == "focus" and self.focus_pending:
-            self._draw_tag(p, QPointF(8, self.height() - 8), "focusing…", theme.FOCUS)
+            self.draw_tag(p, QPointF(8, self.height() - 8), "focusing…", theme.FOCUS)
 
     # -- interaction --------------------------------------------------------------------------------------------
     def set_tool(self, tool: str) -> None:
@@ -427,11 +429,11 @@ class Viewport(QWidget):
             self.setCursor(Qt.SizeAllCursor)
             self.navigation_started.emit(kind, None if xy is None else (int(xy[0]), int(xy[1])))
             return
-        if event.button() == Qt.LeftButton and self.tool == "region" and not self._space_down:
+        if event.button() == Qt.LeftButton and self.tool == "region" and not self.space_held:
             start = self.widget_to_image_unclamped(pos)
             self._region_start = self._region_end = QPointF(*start)
             return
-        panning = event.button() == Qt.LeftButton and (self.tool == "pan" or self._space_down)
+        panning = event.button() == Qt.LeftButton and (self.tool == "pan" or self.space_held)
         if panning:
             if self.zoom is None:
                 self.zoom = self.fit_scale()
@@ -504,14 +506,14 @@ class Viewport(QWidget):
 
     def keyPressEvent(self, event) -> None:
         if event.key() == Qt.Key_Space and not event.isAutoRepeat():
-            self._space_down = True
+            self.space_held = True
             self.setCursor(Qt.OpenHandCursor)
             return
         super().keyPressEvent(event)
 
     def keyReleaseEvent(self, event) -> None:
         if event.key() == Qt.Key_Space and not event.isAutoRepeat():
-            self._space_down = False
+            self.space_held = False
             self.set_tool(self.tool)
             return
         super().keyReleaseEvent(event)

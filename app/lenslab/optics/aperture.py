@@ -136,9 +136,10 @@ class Aperture:
         return "round"
 
     @cached_property
-    def _blade_geometry(self) -> tuple[float, float, float]:
+    def blade_geometry(self) -> tuple[float, float, float]:
         """For rounded blades, in units of the corners' circle: (distance from the centre to the centre of each
-        edge's arc, the arc's radius, the area of the shape). Straight blades: arc radius infinite."""
+        edge's arc, the arc's radius, the area of the shape). Straight blades: arc radius infinite. The renderer
+        passes these to the shader, which samples and scales the shape from them."""
         n = self.blades
         half_chord, apothem = math.sin(math.pi / n), math.cos(math.pi / n)
         polygon_area = n * half_chord * apothem
@@ -155,7 +156,7 @@ class Aperture:
         """Radius of the corners' circle in aperture units: a bladed stop is made as large as passes the light of
         the round stop (1 for a round stop and an image)."""
         if self.kind in ("blades", "rounded_blades"):
-            return math.sqrt(math.pi / self._blade_geometry[2])
+            return math.sqrt(math.pi / self.blade_geometry[2])
         return 1.0
 
     @property
@@ -175,7 +176,7 @@ class Aperture:
     def rounded_blade_radius(self, angle) -> np.ndarray:
         """Distance from the centre to the edge of one blade's wedge (unit corners' circle) at ``angle`` radians
         from the wedge's first corner: where the ray from the centre leaves the edge's arc."""
-        centre, radius, _ = self._blade_geometry
+        centre, radius, _ = self.blade_geometry
         towards_arc = centre * np.cos(np.asarray(angle, dtype=float) - math.pi / self.blades)
         return towards_arc + np.sqrt(towards_arc * towards_arc - centre * centre + radius * radius)
 
@@ -238,7 +239,7 @@ class Aperture:
         angle = (i + (v - cdf[i]) / bin_mass) * bin_width
         edge = self.rounded_blade_radius(angle)
         # pdf of the angle in its wedge: bin_mass / bin_width; a uniform point's: R^2 / 2 over the wedge's area.
-        wedge_area = self._blade_geometry[2] / n
+        wedge_area = self.blade_geometry[2] / n
         weight = (0.5 * edge * edge / wedge_area) / (bin_mass / bin_width)
         theta = self.rotation_rad + k * wedge + angle
         radius = edge * np.sqrt(u[:, 1])

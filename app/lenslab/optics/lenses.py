@@ -154,9 +154,9 @@ class LensPreset:
         marks (an f/1.8 lens on a full-stop scale starts at 1.8).  Pass the result as ``scale`` to
         ``stops.step_stop`` to step within the lens.
         """
-        from .stops import _scale_values
+        from .stops import scale_values
 
-        scale = _scale_values(scale)
+        scale = scale_values(scale)
         rel = 1e-3  # same tolerance as stops.py: 5.6 and 5.600001 are one mark
         inside = [
             float(s) for s in scale

@@ -25,6 +25,7 @@ __all__ = [
     "STOP_SCALES",
     "StopScale",
     "stop_scale",
+    "scale_values",
     "exact_f_number",
     "marked_f_number",
     "THIRD_STOPS",
@@ -118,7 +119,7 @@ def stop_scale(scale: str | StopScale = DEFAULT_STOP_SCALE) -> StopScale:
     return STOP_SCALES[scale]
 
 
-def _scale_values(scale: Scale) -> Sequence[float]:
+def scale_values(scale: Scale) -> Sequence[float]:
     """The f-numbers a scale argument stands for: a name's or a StopScale's exact values, a sequence itself."""
     if isinstance(scale, (str, StopScale)):
         return stop_scale(scale).exact
@@ -199,7 +200,7 @@ def nearest_stop(n: float, scale: Scale = DEFAULT_STOP_SCALE) -> float:
     ``lens.available_stops(name)`` to snap within what a lens can do.
     """
     n = _checked(n)
-    return float(min(_scale_values(scale), key=lambda stop: abs(math.log(stop / n))))
+    return float(min(scale_values(scale), key=lambda stop: abs(math.log(stop / n))))
 
 
 def _index_on_scale(n: float, values: Sequence[float], scale: Scale) -> int | None:
@@ -228,7 +229,7 @@ def step_stop(n: float, steps: int, scale: Scale = DEFAULT_STOP_SCALE) -> float:
     """
     n = _checked(n)
     steps = int(steps)
-    values = _scale_values(scale)
+    values = scale_values(scale)
     if steps == 0:
         return nearest_stop(n, values)
     last = len(values) - 1

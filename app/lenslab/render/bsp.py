@@ -58,7 +58,7 @@ Spheres, and all primitives when no triangles are given, are clipped as boxes.
 Bounded work
 ------------
 Some inputs make every split copy references without end: ten coplanar disks of 4,096 thin fan triangles
-all meeting at one centre (issue 12) grew by 40% per level, 32 M references at depth 23 from 41 k triangles,
+all meeting at one centre grew by 40% per level, 32 M references at depth 23 from 41 k triangles,
 and the build died of memory. So the tree holds at most ``reference_budget(N)`` references, about
 ``REFS_PER_PRIM_LIMIT`` per primitive plus ``REFS_FLOOR`` and fewer where memory is short (checked before
 the build allocates anything large). Each level counts the references its splits would add (the binned SAH

@@ -215,7 +215,7 @@ def camera_uniforms(frame: CameraFrame) -> dict[str, object]:
     """glsl/camera.glsl's uniforms: the camera's frame for an image, as the host computes it. The aperture's tables
     go to the GPU apart (:class:`ApertureTable`)."""
     aperture = frame.aperture
-    arc_centre, arc_radius, area = aperture._blade_geometry if aperture.blades >= 3 else (0.0, 0.0, math.pi)
+    arc_centre, arc_radius, area = aperture.blade_geometry if aperture.blades >= 3 else (0.0, 0.0, math.pi)
     (gain_x, gain_y), barrel_radius = frame.barrel_opening
     rows, cols = aperture.image.shape if aperture.image is not None else (0, 0)
     return {

@@ -1,4 +1,4 @@
-"""``lenslab validate``: render Mitsuba 3 scenes with LensLab and with Mitsuba 3, and compare (issue 6).
+"""``lenslab validate``: render Mitsuba 3 scenes with LensLab and with Mitsuba 3, and compare.
 
 ``metrics`` holds the pure-numpy figures (block bias, relative MSE), ``mitsuba_env`` finds a usable Mitsuba,
 ``runner`` renders and compares, ``report`` prints the table and writes docs/validation.md, ``cli`` is the

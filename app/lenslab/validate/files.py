@@ -1,5 +1,5 @@
-"""``lenslab validate --files``: any Mitsuba 3 scene files, rendered by LensLab and by Mitsuba 3, against issue
-11's goal: the scene opens with nothing dropped, and LensLab's image is within 2% of Mitsuba's in the median
+"""``lenslab validate --files``: any Mitsuba 3 scene files, rendered by LensLab and by Mitsuba 3, against one
+goal: the scene opens with nothing dropped, and LensLab's image is within 2% of Mitsuba's in the median
 16 x 16 block and in its total light (docs/validation.md, "Mitsuba's own scenes").
 
 Per file, at a width of ``width`` pixels (the film scaled, its aspect kept: both renderers get the same size):
@@ -31,7 +31,7 @@ from lenslab.resources import user_cache_dir
 from lenslab.validate import findings, metrics
 from lenslab.validate.runner import Render, in_child_process, mitsuba_image, render_scene
 
-GOAL_MEDIAN = 0.02  # issue 11: median block error at most 2%
+GOAL_MEDIAN = 0.02  # the median block error at most 2%
 GOAL_TOTAL_LIGHT = 0.02  # and the total light within 2%
 REFERENCE_SEED, NOISE_SEED, LENSLAB_SEED = 1000, 500, 1
 CACHE_VERSION = 1  # bump when what a cached reference means changes

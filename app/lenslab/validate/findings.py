@@ -5,8 +5,8 @@ The importer and the renderer warn with one line per thing they approximate or l
 joined by ``; `` when one element has several). ``lenslab validate --files`` sorts each part into
 
 * **drops**: content that is not rendered as written: an element ignored or skipped, a light dropped, a
-  texture or BSDF replaced by a placeholder colour. A scene with one of these does not meet issue 11's goal,
-  whatever its image says;
+  texture or BSDF replaced by a placeholder colour. A scene with one of these does not meet the ``--files``
+  goal (nothing dropped), whatever its image says;
 * **approximates**: rendered differently but in substance (a filter, a clamp, a nearest rotation): the
   image's figures judge these;
 * **notes**: the image is Mitsuba's all the same (Mitsuba ignores it too, a sampler mapped onto ours).

@@ -162,7 +162,7 @@ Difference: red where LensLab is brighter than the reference, blue where darker,
 
 
 # ---------------------------------------------------------------------------------------------------------
-# --files: any scene files against issue 11's goal (validate/files.py)
+# --files: any scene files against the --files goal (nothing dropped, image within 2%: validate/files.py)
 # ---------------------------------------------------------------------------------------------------------
 FILES_HEADER = ("scene", "size", "warnings", "drops", "block med", "block p95", "noise med", "total light", "goal",
                 "why")

@@ -26,7 +26,7 @@ from lenslab.scene.textures import Texture
 from . import mitsuba_values as mv
 
 if TYPE_CHECKING:
-    from .mitsuba_xml import Props, _Importer
+    from .mitsuba_xml import Props, MitsubaImporter
 
 RGB = tuple[float, float, float]
 
@@ -39,7 +39,7 @@ class Mapped:
     note: str | None = None
 
 
-BsdfMapping = Callable[["Props", "_Importer"], Mapped]
+BsdfMapping = Callable[["Props", "MitsubaImporter"], Mapped]
 
 
 def _clip_albedo(rgb) -> RGB:
@@ -50,7 +50,7 @@ def _grey_note(kind: str, what: str) -> str:
     return f"{kind} is not renderable yet: approximated by a diffuse surface with {what}"
 
 
-def _reflectance(p: "Props", imp: "_Importer", name: str, default: float) -> tuple[RGB, Texture | None]:
+def _reflectance(p: "Props", imp: "MitsubaImporter", name: str, default: float) -> tuple[RGB, Texture | None]:
     """A reflectance that may vary over the surface: (its colour, None), or, for a texture LensLab can look
     up (nested or referred to), (Mitsuba's default colour, which the texture overrides, the texture)."""
     node = p.values.get(name)
@@ -62,12 +62,12 @@ def _reflectance(p: "Props", imp: "_Importer", name: str, default: float) -> tup
     return _clip_albedo(p.color(name, default)), None  # a colour, or a texture's mean (with a warning)
 
 
-def _map_diffuse(p: "Props", imp: "_Importer") -> Mapped:
+def _map_diffuse(p: "Props", imp: "MitsubaImporter") -> Mapped:
     albedo, texture = _reflectance(p, imp, "reflectance", 0.5)
     return Mapped(Diffuse(albedo, albedo_texture=texture))
 
 
-def _map_roughdiffuse(p: "Props", imp: "_Importer") -> Mapped:
+def _map_roughdiffuse(p: "Props", imp: "MitsubaImporter") -> Mapped:
     p.float("alpha")
     albedo, texture = _reflectance(p, imp, "reflectance", 0.5)
     return Mapped(Diffuse(albedo, albedo_texture=texture), "rough diffuse (Oren-Nayar) is rendered as Lambertian")
@@ -147,7 +147,7 @@ def _note(notes: list[str]) -> str | None:
     return "; ".join(notes) or None
 
 
-def _map_conductor(p: "Props", imp: "_Importer") -> Mapped:
+def _map_conductor(p: "Props", imp: "MitsubaImporter") -> Mapped:
     notes: list[str] = []
     rough = p.node.type == "roughconductor"
     roughness, distribution = _roughness(p, notes) if rough else (0.0, "ggx")
@@ -194,7 +194,7 @@ def _relative_ior(p: "Props", notes: list[str], lo: float) -> float:
     return ior
 
 
-def _map_plastic(p: "Props", imp: "_Importer") -> Mapped:
+def _map_plastic(p: "Props", imp: "MitsubaImporter") -> Mapped:
     notes: list[str] = []
     roughness, distribution = _roughness(p, notes) if p.node.type == "roughplastic" else (0.0, "ggx")
     albedo, texture = _reflectance(p, imp, "diffuse_reflectance", 0.5)
@@ -211,7 +211,7 @@ def _map_plastic(p: "Props", imp: "_Importer") -> Mapped:
                           coating="single_scattering"), _note(notes))
 
 
-def _map_dielectric(p: "Props", imp: "_Importer") -> Mapped:
+def _map_dielectric(p: "Props", imp: "MitsubaImporter") -> Mapped:
     notes: list[str] = []
     kind = p.node.type
     roughness, distribution = _roughness(p, notes) if kind == "roughdielectric" else (0.0, "ggx")
@@ -225,7 +225,7 @@ def _map_dielectric(p: "Props", imp: "_Importer") -> Mapped:
     return Mapped(Dielectric(ior=ior, roughness=roughness, distribution=distribution, tint=transmit), _note(notes))
 
 
-def _map_principled(p: "Props", imp: "_Importer") -> Mapped:
+def _map_principled(p: "Props", imp: "MitsubaImporter") -> Mapped:
     for key in list(p.values):
         if key != "base_color":
             p.take(key)
@@ -238,7 +238,7 @@ def _nested_bsdfs(p: "Props") -> list:
     return [n for n in p.objects if n.tag == "bsdf"] + [p.take(k) for k in list(p.values) if p.values[k].tag == "bsdf"]
 
 
-def _held(p: "Props", imp: "_Importer", notes: list[str]) -> Material:
+def _held(p: "Props", imp: "MitsubaImporter", notes: list[str]) -> Material:
     """The one BSDF a wrapper holds, mapped (Mitsuba's default diffuse when it holds none)."""
     inner = _nested_bsdfs(p)
     if not inner:
@@ -255,7 +255,7 @@ def _mapped(mapped: Mapped, notes: list[str]) -> Material:
     return mapped.material
 
 
-def _scalar_or_texture(p: "Props", imp: "_Importer", name: str, default: float,
+def _scalar_or_texture(p: "Props", imp: "MitsubaImporter", name: str, default: float,
                        notes: list[str]) -> tuple[float, Texture | None]:
     """A property Mitsuba reads with eval_1: a number, a colour (its luminance) or a texture (its luminance,
     looked up where the ray hits)."""
@@ -265,7 +265,7 @@ def _scalar_or_texture(p: "Props", imp: "_Importer", name: str, default: float,
     return _texture_or_mean(imp, p.take(name), notes)
 
 
-def _texture_or_mean(imp: "_Importer", node, notes: list[str]) -> tuple[float, Texture | None]:
+def _texture_or_mean(imp: "MitsubaImporter", node, notes: list[str]) -> tuple[float, Texture | None]:
     """As Mitsuba's eval_1 reads it: a bitmap's luminance (the renderer's texture_value), a checkerboard with
     its colours swapped (texture_of's scalar form), a plain colour's channel mean."""
     if node.tag == "texture":
@@ -276,7 +276,7 @@ def _texture_or_mean(imp: "_Importer", node, notes: list[str]) -> tuple[float, T
     return (r + g + b) / 3.0, None
 
 
-def _texture_property(p: "Props", imp: "_Importer", name: str | None) -> tuple[object, Texture | None]:
+def _texture_property(p: "Props", imp: "MitsubaImporter", name: str | None) -> tuple[object, Texture | None]:
     """The texture a bumpmap (unnamed, or any name) or normalmap (``normalmap``) holds, and its element."""
     if name is not None:
         node = p.take(name)
@@ -290,7 +290,7 @@ def _texture_property(p: "Props", imp: "_Importer", name: str | None) -> tuple[o
     return node, imp.texture_of(node) if node.tag == "texture" else None
 
 
-def _map_twosided(p: "Props", imp: "_Importer") -> Mapped:
+def _map_twosided(p: "Props", imp: "MitsubaImporter") -> Mapped:
     """Our surfaces look the same from both sides already: the front BSDF, unwrapped."""
     notes: list[str] = []
     inner = _nested_bsdfs(p)
@@ -302,14 +302,14 @@ def _map_twosided(p: "Props", imp: "_Importer") -> Mapped:
     return Mapped(material, _note(notes))
 
 
-def _map_mask(p: "Props", imp: "_Importer") -> Mapped:
+def _map_mask(p: "Props", imp: "MitsubaImporter") -> Mapped:
     notes: list[str] = []
     opacity, texture = _scalar_or_texture(p, imp, "opacity", 0.5, notes)
     material = _held(p, imp, notes)
     return Mapped(Mask(material=material, opacity=min(max(opacity, 0.0), 1.0), opacity_texture=texture), _note(notes))
 
 
-def _map_blendbsdf(p: "Props", imp: "_Importer") -> Mapped:
+def _map_blendbsdf(p: "Props", imp: "MitsubaImporter") -> Mapped:
     notes: list[str] = []
     weight, texture = _scalar_or_texture(p, imp, "weight", 0.5, notes)
     inner = _nested_bsdfs(p)
@@ -330,7 +330,7 @@ def _tilt_options(p: "Props", notes: list[str]) -> bool:
     return p.bool("use_shadowing_function", True)
 
 
-def _map_bumpmap(p: "Props", imp: "_Importer") -> Mapped:
+def _map_bumpmap(p: "Props", imp: "MitsubaImporter") -> Mapped:
     notes: list[str] = []
     scale = p.float("scale", 1.0)
     shadowing = _tilt_options(p, notes)
@@ -341,7 +341,7 @@ def _map_bumpmap(p: "Props", imp: "_Importer") -> Mapped:
     return Mapped(BumpMap(material=material, texture=texture, scale=scale, shadowing=shadowing), _note(notes))
 
 
-def _map_normalmap(p: "Props", imp: "_Importer") -> Mapped:
+def _map_normalmap(p: "Props", imp: "MitsubaImporter") -> Mapped:
     notes: list[str] = []
     node, texture = _texture_property(p, imp, "normalmap")
     shadowing = _tilt_options(p, notes)

@@ -2,7 +2,7 @@
 
 ``bitmap`` and ``checkerboard`` (``src/textures/*.cpp``) become :class:`ImageTexture` and :class:`Checkerboard`
 whose uv transform holds Mitsuba's ``to_uv`` exactly; :func:`texture_from_element` is what
-``_Importer.texture_of`` calls.
+``MitsubaImporter.texture_of`` calls.
 
 **Which (u, v) a texture expects.** Mitsuba looks an image up with its first row at v = 0 (Dr.Jit's texture:
 texel row = v H); LensLab with its first row at v = 1. Mitsuba's OBJ reader flips v as it loads
@@ -34,7 +34,7 @@ from lenslab.scene.shapes import Cylinder
 from lenslab.scene.textures import FILTERS, WRAP_MODES, Checkerboard, ImageTexture, Texture, uv_fields
 
 if TYPE_CHECKING:
-    from .mitsuba_xml import Props, XNode, _Importer
+    from .mitsuba_xml import Props, XNode, MitsubaImporter
 
 RGB = tuple[float, float, float]
 
@@ -50,7 +50,7 @@ FLIP_TEX_COORDS_DEFAULT = {"obj": True, "ply": False}
 AXIS_TOLERANCE = 1e-6
 
 
-def _props(imp: "_Importer", node: "XNode") -> "Props":
+def _props(imp: "MitsubaImporter", node: "XNode") -> "Props":
     from .mitsuba_xml import Props  # imported here: mitsuba_xml imports this module
 
     return Props(imp, node)
@@ -67,7 +67,7 @@ def to_uv(p: "Props") -> np.ndarray:
     return _homogeneous(full[np.ix_([0, 1], [0, 1, 3])])
 
 
-def _texture_fields(imp: "_Importer", node: "XNode", matrix: np.ndarray) -> dict:
+def _texture_fields(imp: "MitsubaImporter", node: "XNode", matrix: np.ndarray) -> dict:
     try:
         return uv_fields(matrix)
     except ValueError:
@@ -84,7 +84,7 @@ def _choice(p: "Props", name: str, default: str) -> str:
     return value
 
 
-def read_bitmap(imp: "_Importer", node: "XNode") -> ImageTexture:
+def read_bitmap(imp: "MitsubaImporter", node: "XNode") -> ImageTexture:
     """Mitsuba's bitmap: ``raw`` false reads 8- and 16-bit files as sRGB and float files as linear, as our
     "auto"; raw true reads every file as linear. A file that is not there is LensLab's usual magenta
     checkerboard at render time, warned here with the scene file's line (Mitsuba refuses the scene)."""
@@ -102,11 +102,11 @@ def read_bitmap(imp: "_Importer", node: "XNode") -> ImageTexture:
     path = imp.resolve_file(node, filename)
     if not os.path.isfile(path):
         imp.warn(node, f"texture file not found: {path}; LensLab shows a magenta checkerboard in its place")
-    return ImageTexture(file=imp._scene_relative(path), color_space="linear" if raw else "auto", wrap=wrap_mode,
+    return ImageTexture(file=imp.scene_relative_path(path), color_space="linear" if raw else "auto", wrap=wrap_mode,
                         filter=filter_type, **_texture_fields(imp, node, matrix))
 
 
-def _unit_colour(imp: "_Importer", p: "Props", name: str, default: float) -> RGB:
+def _unit_colour(imp: "MitsubaImporter", p: "Props", name: str, default: float) -> RGB:
     rgb = p.color(name, default)
     clipped = tuple(float(min(max(c, 0.0), 1.0)) for c in rgb)
     if clipped != tuple(rgb):
@@ -114,7 +114,7 @@ def _unit_colour(imp: "_Importer", p: "Props", name: str, default: float) -> RGB
     return clipped  # type: ignore[return-value]
 
 
-def read_checkerboard(imp: "_Importer", node: "XNode") -> Checkerboard:
+def read_checkerboard(imp: "MitsubaImporter", node: "XNode") -> Checkerboard:
     """Mitsuba's checkerboard: color0 where the fractional parts of (s, t) = to_uv(uv) are both below 1/2 or
     both above, color1 elsewhere."""
     p = _props(imp, node)
@@ -127,7 +127,7 @@ def read_checkerboard(imp: "_Importer", node: "XNode") -> Checkerboard:
 READERS = {"bitmap": read_bitmap, "checkerboard": read_checkerboard}
 
 
-def texture_from_element(imp: "_Importer", node: "XNode") -> Texture | None:
+def texture_from_element(imp: "MitsubaImporter", node: "XNode") -> Texture | None:
     """The LensLab texture for a ``<texture>`` element, or None for a kind LensLab cannot look up."""
     reader = READERS.get(node.type)
     return reader(imp, node) if reader is not None else None
@@ -144,7 +144,7 @@ def as_scalar(texture: Texture) -> Texture:
     return dataclasses.replace(texture, color_a=(grey_a,) * 3, color_b=(grey_b,) * 3)
 
 
-def mean_colour(imp: "_Importer", node: "XNode", texture: Texture | None) -> RGB | None:
+def mean_colour(imp: "MitsubaImporter", node: "XNode", texture: Texture | None) -> RGB | None:
     """Mitsuba's ``mean()`` of a texture, for a property LensLab cannot texture: the checkerboard's two
     colours' mean, a bitmap's mean linear texel; None where it cannot be had."""
     if isinstance(texture, Checkerboard):

@@ -181,10 +181,10 @@ def _camel_to_underscore(name: str) -> str:
     return re.sub(r"(?<=[a-z])([A-Z]+)", lambda m: "_" + m.group(1).lower(), name)
 
 
-# Bounds on $param substitution (issue 12). A <default> may use the parameters before it, so a file of a
-# kilobyte can double a value 28 times (p2 = "$p1$p1", p3 = "$p2$p2" ...: 134 M characters). Real scenes
-# substitute numbers and file names; an attribute of a megabyte, or 16 M characters substituted in all,
-# is a file built to exhaust memory.
+# Bounds on $param substitution, so that a small file cannot expand into an enormous one. A <default> may use
+# the parameters before it, so a file of a kilobyte can double a value 28 times (p2 = "$p1$p1",
+# p3 = "$p2$p2" ...: 134 M characters). Real scenes substitute numbers and file names; an attribute of a
+# megabyte, or 16 M characters substituted in all, is a file built to exhaust memory.
 MAX_EXPANDED_VALUE_CHARS = 1 << 20
 MAX_SUBSTITUTED_CHARS = 1 << 24
 
@@ -296,7 +296,7 @@ class Props:
     support), except those in :data:`SILENT`. Nested objects without a name are kept in order in ``objects``.
     """
 
-    def __init__(self, importer: "_Importer", node: XNode):
+    def __init__(self, importer: "MitsubaImporter", node: XNode):
         self.importer = importer
         self.node = node
         self.values: dict[str, XNode] = {}
@@ -436,7 +436,7 @@ def _xyz(node: XNode, default: float) -> np.ndarray:
         raise node.error("could not parse a number") from None
 
 
-def _transform_matrix(node: XNode, importer: "_Importer") -> np.ndarray:
+def _transform_matrix(node: XNode, importer: "MitsubaImporter") -> np.ndarray:
     """A <transform>: every operation multiplied on the left, in document order (first listed, first applied)."""
     m = np.eye(4)
     for op in node.children:
@@ -522,7 +522,10 @@ class _Camera:
     focus_distance: float
 
 
-class _Importer:
+class MitsubaImporter:
+    """Reads one parsed and expanded scene file into LensLab's scene: the state (materials, nodes, lights,
+    the camera) that the element readers here, in mitsuba_bsdfs and in mitsuba_textures share."""
+
     def __init__(self, root: XNode, ids: dict[str, XNode], root_folder: Path, warn: WarnCallback):
         self.root = root
         self.ids = ids
@@ -854,7 +857,7 @@ class _Importer:
         if self._environment_node is not None:
             self.warn(node, "LensLab has one environment: this envmap replaces the "
                       f"{self._environment_node.label()} at {self._environment_node.where()}")
-        self.environment = EnvironmentMap(file=self._scene_relative(path), strength=float(max(scale, 0.0)),
+        self.environment = EnvironmentMap(file=self.scene_relative_path(path), strength=float(max(scale, 0.0)),
                                           rotation_deg=float(rotation_deg), rows="pole_to_pole", zenith=zenith)
         self._environment_node = node
 
@@ -962,7 +965,7 @@ class _Importer:
             shape_index = p.int("shape_index", 0) if kind == "serialized" else 0  # which of the file's meshes
             if not 0 <= shape_index < 2**31:
                 raise node.error(f"shape_index must be in [0, {2**31 - 1}] (got {shape_index})")
-            shape = MeshFile(file=self._scene_relative(path), smooth=smooth, shape_index=shape_index)
+            shape = MeshFile(file=self.scene_relative_path(path), smooth=smooth, shape_index=shape_index)
         else:
             p.finish(silent=set(p.values))
             self.warn(node, f'shape "{kind}" is not supported: skipped')
@@ -1088,7 +1091,8 @@ class _Importer:
                   "the nearest uniform scale used")
         return mv.nearest_similarity(matrix)
 
-    def _scene_relative(self, path: Path) -> str:
+    def scene_relative_path(self, path: Path) -> str:
+        """``path`` relative to the scene file's folder, the way the imported scene names its files."""
         try:
             return os.path.relpath(path.resolve(), self.root_folder.resolve())
         except ValueError:  # another drive on Windows
@@ -1348,7 +1352,7 @@ def _load(root_loader, display: str, folder: Path, source_path: Path | None,
     expanded = expander.expand(root, 0)[0]
     for name in sorted(set(defines or {}) - expander.used):
         warn(f"{display}: -D {name}={defines[name]} is not used by the scene")
-    importer = _Importer(expanded, expander.ids, folder, warn)
+    importer = MitsubaImporter(expanded, expander.ids, folder, warn)
     importer.run()
     camera = importer.make_camera()
     return Scene(
