@@ -63,7 +63,7 @@ def test_a_setting_the_lens_does_not_have_is_refused(bad, message):
     assert message in str(caught.value)
 
 
-# -- every camera control (issue 13) --------------------------------------------------------------------------
+# -- every camera control ------------------------------------------------------------------------------------
 def test_every_camera_control_reaches_the_camera(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     changed = SceneOverrides(sensor="aps-c", sensor_fit="fill", focus_from="lens", focus_breathing=False,

@@ -136,7 +136,7 @@ Machine: {'; '.join(machine_description(renderer))}.
 - **relMSE**: at equal samples ({spp} spp each), `mean((x - ref)^2 / (ref^2 + 0.01))` over pixels and
   channels. The goal is LensLab's no larger than Mitsuba's.
 - **time**: wall seconds of the {spp}-spp render, loading and kernel compilation included.
-- **goal** (issue 6): no block biased by more than 2%, median block bias under 1%, LensLab's relMSE no
+- **goal**: no block biased by more than 2%, median block bias under 1%, LensLab's relMSE no
   larger than Mitsuba's.
 
 ## Results
@@ -187,7 +187,7 @@ def _legend(spp: int, reference_spp: int) -> str:
     return (f"LensLab at {spp} spp against Mitsuba 3 at {reference_spp} spp. block med / p95: the median and 95th "
             f"percentile of |16x16 block mean - reference| / reference; noise med: Mitsuba's own at {spp} spp (what "
             f"noise alone gives); total light: LensLab's sum over the reference's, less one. PASS: nothing dropped, "
-            f"block med <= {100 * GOAL_MEDIAN:g}% and |total light| <= {100 * GOAL_TOTAL_LIGHT:g}% (issue 11).")
+            f"block med <= {100 * GOAL_MEDIAN:g}% and |total light| <= {100 * GOAL_TOTAL_LIGHT:g}%.")
 
 
 def _failing(results) -> dict[str, list[str]]:
