@@ -1,0 +1,182 @@
+"""The camera panel's exposure section: compensated (the brightness holds at every aperture) or physical, with the
+ISO and the shutter speed on the dial of the chosen stop scale, and the exposure value they make."""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+from PySide6.QtWidgets import QComboBox, QGridLayout, QHBoxLayout, QLabel, QToolButton
+
+from lenslab.gui.camera_panel.aperture import STEP_WORDS
+from lenslab.gui.camera_panel.section import CameraSection
+from lenslab.gui.widgets import hint
+from lenslab.optics.exposure import ev100, format_shutter, parse_shutter
+from lenslab.optics.stops import DEFAULT_STOP_SCALE
+from lenslab.scene.camera import ThinLensCamera
+from lenslab.scene.fields import declared_range
+
+if TYPE_CHECKING:
+    from lenslab.gui.camera_panel import CameraPanel
+
+ISO_SPEEDS = (50, 64, 80, 100, 125, 160, 200, 250, 320, 400, 500, 640, 800, 1000, 1250, 1600, 2000, 2500, 3200, 4000,
+              5000, 6400, 12800, 25600, 51200, 102400)
+#: The shutter speeds a camera's dial shows, seconds, longest first, on each stop scale (30 s to 1/8000 s).
+SHUTTER_SCALES = {
+    "full": (30, 15, 8, 4, 2, 1, 1 / 2, 1 / 4, 1 / 8, 1 / 15, 1 / 30, 1 / 60, 1 / 125, 1 / 250, 1 / 500, 1 / 1000,
+             1 / 2000, 1 / 4000, 1 / 8000),
+    "half": (30, 20, 15, 10, 8, 6, 4, 3, 2, 1.5, 1, 0.7, 1 / 2, 1 / 3, 1 / 4, 1 / 6, 1 / 8, 1 / 10, 1 / 15, 1 / 20,
+             1 / 30, 1 / 45, 1 / 60, 1 / 90, 1 / 125, 1 / 180, 1 / 250, 1 / 350, 1 / 500, 1 / 750, 1 / 1000, 1 / 1500,
+             1 / 2000, 1 / 3000, 1 / 4000, 1 / 6000, 1 / 8000),
+    "third": (30, 25, 20, 15, 13, 10, 8, 6, 5, 4, 3.2, 2.5, 2, 1.6, 1.3, 1, 0.8, 0.6, 1 / 2, 0.4, 1 / 3, 1 / 4, 1 / 5,
+              1 / 6, 1 / 8, 1 / 10, 1 / 13, 1 / 15, 1 / 20, 1 / 25, 1 / 30, 1 / 40, 1 / 50, 1 / 60, 1 / 80, 1 / 100,
+              1 / 125, 1 / 160, 1 / 200, 1 / 250, 1 / 320, 1 / 400, 1 / 500, 1 / 640, 1 / 800, 1 / 1000, 1 / 1250,
+              1 / 1600, 1 / 2000, 1 / 2500, 1 / 3200, 1 / 4000, 1 / 5000, 1 / 6400, 1 / 8000),
+}
+SHUTTER_SPEEDS = SHUTTER_SCALES["full"]
+
+
+def step_shutter(seconds: float, steps: int, scale: str = DEFAULT_STOP_SCALE) -> float:
+    """Move ``steps`` marks of the shutter dial of ``scale`` from ``seconds`` (positive: a longer time, more
+    light). From a time between marks the first step lands on the next mark that way; the dial's ends hold."""
+    marks = SHUTTER_SCALES[scale][::-1]  # shortest first: a positive step is a longer time
+    same = [i for i, mark in enumerate(marks) if math.isclose(mark, seconds, rel_tol=1e-3)]
+    if same:
+        i = same[0] + steps
+    elif steps > 0:
+        longer = [i for i, mark in enumerate(marks) if mark > seconds]
+        if not longer:
+            return float(seconds)
+        i = longer[0] + steps - 1
+    elif steps < 0:
+        shorter = [i for i, mark in enumerate(marks) if mark < seconds]
+        if not shorter:
+            return float(seconds)
+        i = shorter[-1] + steps + 1
+    else:
+        return float(min(marks, key=lambda mark: abs(math.log(mark / seconds))))
+    return float(marks[min(max(i, 0), len(marks) - 1)])
+
+
+class ExposureSection(CameraSection):
+    def __init__(self, panel: CameraPanel):
+        super().__init__(panel, "exposure", "Exposure")
+        grid = QGridLayout()
+        self.exposure_mode = QComboBox()
+        self.exposure_mode.addItem("Compensated", "compensated")
+        self.exposure_mode.addItem("Physical (ISO, shutter)", "physical")
+        self.exposure_mode.setToolTip("Compensated: the brightness stays the same at every aperture, to judge "
+                                      "depth of field. Physical: each stop of aperture, shutter or ISO is a stop "
+                                      "of light (radiance in cd/m²)")
+        self.exposure_mode.currentIndexChanged.connect(
+            lambda i: self._updating or self.doc.set_camera("Exposure mode", False,
+                                                            exposure_mode=self.exposure_mode.itemData(i)))
+        self.iso = QComboBox()
+        self.iso.setEditable(True)
+        self.iso.setInsertPolicy(QComboBox.NoInsert)
+        for speed in ISO_SPEEDS:
+            self.iso.addItem(f"{speed}", float(speed))
+        self.iso.setToolTip("Sensor speed: any value")
+        self.iso.lineEdit().editingFinished.connect(self._iso_typed)
+        self.iso.activated.connect(lambda i: self._set_iso(self.iso.itemData(i)))
+        self.shutter = QComboBox()
+        self.shutter.setObjectName("shutter")
+        self.shutter.setEditable(True)
+        self.shutter.setInsertPolicy(QComboBox.NoInsert)
+        self.shutter.setToolTip("Exposure time: choose a speed of the dial or type any (1/125, 0.5, 2 s)")
+        self.shutter.lineEdit().editingFinished.connect(self._shutter_typed)
+        self.shutter.activated.connect(lambda i: self._set_shutter(self.shutter.itemData(i)))
+        self.shutter_shorter = QToolButton()
+        self.shutter_shorter.setText("−")
+        self.shutter_shorter.clicked.connect(lambda: self.step_shutter(-1))
+        self.shutter_longer = QToolButton()
+        self.shutter_longer.setText("+")
+        self.shutter_longer.clicked.connect(lambda: self.step_shutter(+1))
+        shutter_row = QHBoxLayout()
+        shutter_row.setSpacing(2)
+        shutter_row.addWidget(self.shutter_shorter)
+        shutter_row.addWidget(self.shutter, 1)
+        shutter_row.addWidget(self.shutter_longer)
+        grid.addWidget(QLabel("Mode"), 0, 0)
+        grid.addWidget(self.exposure_mode, 0, 1)
+        grid.addWidget(QLabel("ISO"), 1, 0)
+        grid.addWidget(self.iso, 1, 1)
+        grid.addWidget(QLabel("Shutter"), 2, 0)
+        grid.addLayout(shutter_row, 2, 1)
+        grid.setColumnStretch(1, 1)
+        self.add(grid)
+        self.exposure_info = hint("")
+        self.add(self.exposure_info)
+
+    # -- edits ----------------------------------------------------------------------------------------------------
+    def _set_iso(self, value) -> None:
+        low, high = declared_range(ThinLensCamera, "iso")
+        if value is None or not low <= float(value) <= high:
+            self.panel.status_message.emit(f"ISO must lie between {low:g} and {high:g}")
+            self.panel.refresh()
+            return
+        self.doc.set_camera(f"ISO {float(value):g}", False, iso=float(value))
+
+    def _iso_typed(self) -> None:
+        if self._updating:
+            return
+        text = self.iso.lineEdit().text().strip().lower().removeprefix("iso").strip()
+        try:
+            value = float(text)
+        except ValueError:
+            self.panel.status_message.emit(f"not an ISO speed: '{text}'")
+            self.panel.refresh()
+            return
+        if not math.isclose(value, self.doc.scene.camera.iso):
+            self._set_iso(value)
+
+    def _set_shutter(self, seconds, merge: bool = False) -> None:
+        if seconds is not None:
+            self.doc.set_camera(f"Shutter {format_shutter(seconds)}", merge, shutter_s=float(seconds))
+
+    def step_shutter(self, steps: int) -> None:
+        """``steps`` marks of the shutter dial on the chosen stop scale (positive: longer, more light)."""
+        current = self.doc.scene.camera.shutter_s
+        seconds = step_shutter(current, steps, self.panel.scale_name)
+        if not math.isclose(seconds, current, rel_tol=1e-9):
+            self._set_shutter(seconds, merge=True)
+        self.panel.refresh()
+
+    def _shutter_typed(self) -> None:
+        if self._updating:
+            return
+        try:
+            seconds = parse_shutter(self.shutter.lineEdit().text())
+        except ValueError as exc:
+            self.panel.status_message.emit(str(exc))
+            self.panel.refresh()
+            return
+        if not math.isclose(seconds, self.doc.scene.camera.shutter_s, rel_tol=1e-6):
+            self._set_shutter(seconds)
+
+    # -- following the document ---------------------------------------------------------------------------------
+    def refresh(self, cam: ThinLensCamera, scale_name: str) -> None:
+        """Show ``cam``'s exposure, the shutter on the dial of the stop scale ``scale_name``."""
+        with self._showing_camera():
+            physical = cam.exposure_mode == "physical"
+            self.exposure_mode.setCurrentIndex(self.exposure_mode.findData(cam.exposure_mode))
+            self.iso.setEditText(f"{cam.iso:g}")
+            dial = SHUTTER_SCALES[scale_name]
+            if [self.shutter.itemData(i) for i in range(self.shutter.count())] != [float(t) for t in dial]:
+                self.shutter.clear()
+                for seconds in dial:
+                    self.shutter.addItem(format_shutter(seconds), float(seconds))
+            self.shutter.setCurrentIndex(next((i for i, t in enumerate(dial)
+                                               if math.isclose(t, cam.shutter_s, rel_tol=1e-3)), -1))
+            self.shutter.setEditText(format_shutter(cam.shutter_s))
+            step = STEP_WORDS[scale_name]
+            self.shutter_shorter.setToolTip(f"Shorter by {step}: less light")
+            self.shutter_longer.setToolTip(f"Longer by {step}: more light")
+            self.shutter_shorter.setEnabled(physical and cam.shutter_s > dial[-1] * 1.0001)
+            self.shutter_longer.setEnabled(physical and cam.shutter_s < dial[0] * 0.9999)
+            self.iso.setEnabled(physical)
+            self.shutter.setEnabled(physical)
+            ev = ev100(cam.f_number, cam.shutter_s, cam.iso)
+            self.exposure_info.setText(
+                f"EV₁₀₀ {ev:.1f}: a reflected-light meter calls {0.125 * 2 ** ev:.3g} cd/m² mid-grey."
+                if physical else "The picture keeps its brightness whatever the aperture, shutter and ISO.")
