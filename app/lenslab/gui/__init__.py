@@ -3,7 +3,10 @@
 Modules, one job each:
 
 * :mod:`.app`          - ``run_studio``: the QApplication, theme, and the window from the command line
-* :mod:`.main_window`  - docks, menus, status bar, files, export, drag and drop
+* :mod:`.main_window`  - the window's assembly: docks, status bar, the viewport's toolbar, edits
+* :mod:`.actions`      - every action and the menus, declared as data (text, shortcut, handler, enabled-when)
+* :mod:`.file_controller` - new, open, save, recent files, mesh import, drag and drop
+* :mod:`.export_flow`  - the export dialog, progress, cancel and the result
 * :mod:`.document`     - the open scene, its undo stack, selection and lens; targets that address its parts
 * :mod:`.commands`     - every edit as a QUndoCommand
 * :mod:`.render_loop`  - the progressive render loop (preview, full passes, denoise, picks, exports), Qt-free
@@ -11,6 +14,7 @@ Modules, one job each:
 * :mod:`.viewport`     - the converging picture, display transform, selection outline, plane-of-focus overlay
 * :mod:`.scene_tree`   - the outliner (a Qt item model over the scene)
 * :mod:`.properties`   - the property editor, generic over the scene's dataclass fields
-* :mod:`.camera_panel` - lens, aperture, focal length, focus, sensor, iris and depth-of-field readout
+* :mod:`.camera_panel` - lens, aperture, focal length, focus, sensor, iris and depth-of-field readout, one
+                         widget per section
 * :mod:`.export_dialog`, :mod:`.widgets`, :mod:`.theme`, :mod:`.defaults`
 """

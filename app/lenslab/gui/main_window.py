@@ -1,24 +1,26 @@
 """The studio's main window: the viewport in the centre, the outliner and property editor on the left, the camera
 panel on the right, the render status at the bottom; menus for files, editing, the view, the camera and the
-render. The layout, the display settings and the recent files are remembered between runs (QSettings)."""
+render. The layout, the display settings and the recent files are remembered between runs (QSettings).
+
+The window assembles the studio; its actions and menus are declared in :mod:`.actions`, its files handled by
+:mod:`.file_controller` and its exports by :mod:`.export_flow`."""
 
 from __future__ import annotations
 
 import dataclasses
 import math
 import os
-import threading
 from pathlib import Path
 
 from PySide6.QtCore import QPointF, QRectF, QSettings, Qt, QTimer, Signal
-from PySide6.QtGui import QAction, QActionGroup, QKeySequence
+from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import (
     QComboBox,
     QDockWidget,
-    QFileDialog,
     QHBoxLayout,
     QLabel,
     QMainWindow,
+    QMenu,
     QMessageBox,
     QProgressBar,
     QProgressDialog,
@@ -33,14 +35,17 @@ from PySide6.QtWidgets import (
 
 from lenslab import __version__
 from lenslab.gui import theme
+from lenslab.gui.actions import build_menus, create_actions, make_action, selection_has_nodes, update_enabled
 from lenslab.gui.camera_panel import CameraPanel
 from lenslab.gui.commands import (AddLightCommand, AddMaterialCommand, AddNodeCommand, RemoveLightsCommand,
                                   RemoveMaterialCommand, RemoveNodesCommand)
 from lenslab.gui.controller import SAMPLE_LIMITS, RenderController, elapsed_text, rate_text, samples_text
 from lenslab.gui.defaults import studio_scene
 from lenslab.gui.document import Document, is_shipped, listen
+from lenslab.gui.export_dialog import ExportDialog
+from lenslab.gui.export_flow import ExportFlow
+from lenslab.gui.file_controller import FileController
 from lenslab.gui.navigation import CameraNavigator
-from lenslab.gui.export_dialog import ExportDialog, default_export_path
 from lenslab.gui.properties import PropertyEditor
 from lenslab.gui.scene_tree import SceneTreeView, node_context_menu
 from lenslab.gui.snapshot_panel import StudioSnapshots
@@ -49,19 +54,15 @@ from lenslab.gui.viewport import Viewport
 from lenslab.gui.widgets import ResetSlider, SignedNumberEdit
 from lenslab.gui.worker import VIEWPORT_DISPATCH_SECONDS
 from lenslab.color import luminance
-from lenslab.messages import one_line
 from lenslab.optics import format_camera_settings, format_distance
 from lenslab.optics.exposure import format_shutter
 from lenslab.render.film import TONE_MAPS
 from lenslab.scene import editing
-from lenslab.scene.io.loader import open_scene, resolve_scene_path, scene_title, shipped_scene_names
-from lenslab.scene.io.meshes import MESH_SUFFIXES, MeshLoadError, load_mesh
-from lenslab.scene.io.native import SCENE_SUFFIX, save_scene
-from lenslab.scene.scene import SceneError
+from lenslab.scene.io.loader import scene_title
+from lenslab.scene.io.native import save_scene
 
 DISPLAY_EXPOSURE_STOPS = 6.0  # the display exposure slider reaches this many stops either way
 
-MAX_RECENT = 10
 APP_NAME = "LensLab"
 
 
@@ -73,7 +74,6 @@ class MainWindow(QMainWindow):
     closed = Signal()
     mesh_imported = Signal(str)  # path, once its node is in the scene
     mesh_import_failed = Signal(str, str)  # path, reason
-    _mesh_loaded = Signal(object, object, str)  # from the loading thread
 
     def __init__(self, scene=None, path: Path | None = None, *, device_index: int | None = None,
                  settings: QSettings | None = None, dispatch_seconds: float = VIEWPORT_DISPATCH_SECONDS,
@@ -91,15 +91,14 @@ class MainWindow(QMainWindow):
         limit = self.settings.value("viewport/sample_limit", 1024)
         limit = None if limit in (None, "", "none", "None") else int(limit)
         self.controller = RenderController(self.doc, device_index, dispatch_seconds, quality, limit, self)
-        self.export_id: int | None = None
-        self.export_progress_dialog: QProgressDialog | None = None
-        self.last_export_path: Path | None = None
-        self._unsaved_box: QMessageBox | None = None
+        # The file writer and the export dialog are looked up here when they are used, so that a test can stand
+        # in for them (lenslab.gui.main_window.save_scene, .ExportDialog).
+        self.files = FileController(self, self.doc, self.settings, lambda scene, path: save_scene(scene, path))
+        self.files.mesh_imported.connect(self.mesh_imported)
+        self.files.mesh_import_failed.connect(self.mesh_import_failed)
+        self.export_flow = ExportFlow(self, self.controller, self.files, lambda *args: ExportDialog(*args))
         self._structure_generation = 0
-        self._closing = False
         self._hover: tuple[int, int] | None = None
-        self._pending_imports = 0
-        self._mesh_loaded.connect(self._on_mesh_loaded, Qt.QueuedConnection)
 
         self.viewport = Viewport()
         self.viewport.set_display(*self._saved_look())
@@ -113,10 +112,13 @@ class MainWindow(QMainWindow):
         self._resize_timer.setInterval(120)
         self._resize_timer.timeout.connect(self._send_viewport_size)
         self._viewport_size: tuple[int, int] | None = None
-        self._create_actions()
+        self.actions: dict[str, QAction] = create_actions(self)
         self.setCentralWidget(self._central())
         self._create_docks()
-        self._create_menus()
+        menus = build_menus(self.menuBar(), self.actions, {
+            "examples": self.files.fill_examples_menu, "recent": self.files.fill_recent_menu,
+            "panels": self._add_panel_toggles, "lenses": self._fill_lens_menu})
+        self.shipped_menu, self.recent_menu = menus["examples"], menus["recent"]
         self._create_status_bar()
         self._connect()
         self.snapshots = StudioSnapshots(self)  # its dock exists before the saved layout is restored
@@ -136,22 +138,7 @@ class MainWindow(QMainWindow):
                     tip: str | None = None) -> QAction:
         """A QAction added to the window, so its shortcut works wherever the focus is; the tip, shortcut
         appended, is its status tip and tooltip. The studio's panels make their actions with it too."""
-        action = QAction(text, self)
-        if shortcut is not None:
-            if isinstance(shortcut, (list, tuple)):
-                action.setShortcuts([QKeySequence(s) for s in shortcut])
-            else:
-                action.setShortcut(QKeySequence(shortcut))
-        if icon:
-            action.setIcon(theme.icon(icon))
-        action.setCheckable(checkable)
-        if tip:
-            action.setStatusTip(tip)
-            action.setToolTip(f"{tip} ({action.shortcut().toString()})" if action.shortcut() else tip)
-        if slot is not None:
-            action.triggered.connect(slot)
-        self.addAction(action)
-        return action
+        return make_action(self, text, slot, shortcut, icon, checkable, tip)
 
     def _saved_look(self) -> tuple[float, str]:
         """The viewport's exposure and tone map from the last session; a value edited by hand or written by
@@ -165,70 +152,6 @@ class MainWindow(QMainWindow):
         exposure = min(DISPLAY_EXPOSURE_STOPS, max(-DISPLAY_EXPOSURE_STOPS, exposure))
         tone_map = str(self.settings.value("viewport/tone_map", "filmic"))
         return exposure, tone_map if tone_map in TONE_MAPS else "filmic"
-
-    def _create_actions(self) -> None:
-        a = self.make_action
-        self.actions: dict[str, QAction] = {}
-        act = self.actions
-        act["new"] = a("&New", self.new_scene, QKeySequence.New)
-        act["open"] = a("&Open…", self.open_dialog, QKeySequence.Open)
-        act["save"] = a("&Save", self.save, QKeySequence.Save)
-        act["save_as"] = a("Save &As…", self.save_as, QKeySequence("Ctrl+Shift+S"))
-        act["import_mesh"] = a("&Import Mesh…", self.import_dialog, "Ctrl+I", tip="Add a mesh file (OBJ, PLY, glTF, STL)")
-        act["export"] = a("&Export Image…", self.export_dialog, "Ctrl+E", tip="Render to an EXR or PNG file")
-        act["quit"] = a("&Quit", self.close, QKeySequence.Quit)
-        undo = self.doc.undo_stack.createUndoAction(self, "&Undo")
-        undo.setShortcuts([QKeySequence.Undo])
-        redo = self.doc.undo_stack.createRedoAction(self, "&Redo")
-        redo.setShortcuts([QKeySequence("Ctrl+Shift+Z"), QKeySequence("Ctrl+Y")])
-        self.addAction(undo)
-        self.addAction(redo)
-        act["undo"], act["redo"] = undo, redo
-        act["add_group"] = a("Group", lambda: self.add_primitive("group"), icon="group")
-        act["add_sphere"] = a("Sphere", lambda: self.add_primitive("sphere"), icon="sphere")
-        act["add_box"] = a("Box", lambda: self.add_primitive("box"), icon="box")
-        act["add_cylinder"] = a("Cylinder", lambda: self.add_primitive("cylinder"), icon="cylinder")
-        act["add_rectangle"] = a("Rectangle", lambda: self.add_primitive("rectangle"), icon="rectangle")
-        act["add_light"] = a("Area Light", lambda: self.add_primitive("light"), icon="light")
-        act["add_point_light"] = a("Point Light", lambda: self.add_light("point"), icon="light")
-        act["add_spot_light"] = a("Spot Light", lambda: self.add_light("spot"), icon="light")
-        act["add_sun"] = a("Sun", lambda: self.add_light("sun"), icon="light")
-        act["new_material"] = a("New Material", self.new_material, icon="material")
-        act["duplicate"] = a("&Duplicate", self.duplicate_selection, "Ctrl+D")
-        act["rename"] = a("Re&name", self.rename_selection, "F2")
-        act["delete"] = a("&Delete", self.delete_selection, QKeySequence.Delete, icon="delete")
-        act["fit"] = a("&Fit in Window", self.viewport.fit, "Ctrl+0", icon="fit", tip="Fit the image in the window")
-        act["actual"] = a("&Actual Pixels", lambda: self.viewport.set_zoom(1.0), "Ctrl+1", tip="100%")
-        act["zoom_in"] = a("Zoom &In", lambda: self.viewport.zoom_step(1), [QKeySequence.ZoomIn, "Ctrl+="])
-        act["zoom_out"] = a("Zoom &Out", lambda: self.viewport.zoom_step(-1), QKeySequence.ZoomOut)
-        act["reset_layout"] = a("Reset Panel Layout", self.reset_layout)
-        act["denoise"] = a("&Denoise Preview", self.set_denoise, "D", "denoise", True,
-                           "Show the viewport through Intel Open Image Denoise (never applied to an export "
-                           "unless the export asks)")
-        act["denoise"].setChecked(self.controller.denoise)
-        act["frame_selection"] = a("&Frame Selection", self.frame_selection, ".",
-                                   tip="Point the camera at the selection, fill the frame with it and focus on it")
-        act["frame_all"] = a("Frame &All", lambda: self.frame_selection(everything=True), "Home",
-                             tip="Point the camera at the whole scene")
-        act["clear_region"] = a("&Clear Render Region", lambda: self.controller.set_region(None), "Alt+R",
-                                tip="Refine the whole picture again")
-        tools = QActionGroup(self)
-        for name, key, icon_name, tip in (("select", "Q", "select", "Select: click an object"),
-                                          ("focus", "F", "focus", "Focus: click to focus there"),
-                                          ("pan", "H", "pan", "Pan: drag the image"),
-                                          ("region", "R", "region", "Render region: drag a rectangle to refine "
-                                                                     "only that part of the picture")):
-            action = a(name.capitalize(), lambda _c=False, n=name: self.set_tool(n), key, icon_name, True, tip)
-            tools.addAction(action)
-            act["tool_" + name] = action
-        act["tool_select"].setChecked(True)
-        act["open_up"] = a("Open Up ⅓ Stop", lambda: self.camera_panel.step_aperture(-1), "[")
-        act["stop_down"] = a("Stop Down ⅓ Stop", lambda: self.camera_panel.step_aperture(+1), "]")
-        act["focus_on_selection"] = a("Focus on Selection", self.focus_on_selection, "Shift+F")
-        act["pause"] = a("&Pause Rendering", self.set_paused, "P", "pause", True, "Pause or resume the viewport render")
-        act["restart"] = a("&Restart Rendering", self.controller.restart, "Ctrl+R", "restart", tip="Start accumulating afresh")
-        act["shortcuts"] = a("Keyboard Shortcuts", self.show_shortcuts, QKeySequence.HelpContents)
-        act["about"] = a("About LensLab", self.show_about)
 
     def _central(self) -> QWidget:
         bar = QToolBar()
@@ -352,85 +275,20 @@ class MainWindow(QMainWindow):
         self.resizeDocks([self.docks["scene"], self.docks["camera"]], [360, 350], Qt.Horizontal)
         self.resizeDocks([self.docks["scene"], self.docks["properties"]], [300, 520], Qt.Vertical)
 
-    def _create_menus(self) -> None:
-        act = self.actions
-        bar = self.menuBar()
-        file_menu = bar.addMenu("&File")
-        file_menu.addAction(act["new"])
-        file_menu.addAction(act["open"])
-        self.shipped_menu = file_menu.addMenu("Open Example")
-        for name in shipped_scene_names():
-            self.shipped_menu.addAction(scene_title(name), lambda n=name: self.open_path(n))
-        self.recent_menu = file_menu.addMenu("Open &Recent")
-        self.recent_menu.aboutToShow.connect(self._fill_recent_menu)
-        file_menu.addSeparator()
-        file_menu.addAction(act["save"])
-        file_menu.addAction(act["save_as"])
-        file_menu.addSeparator()
-        file_menu.addAction(act["import_mesh"])
-        file_menu.addAction(act["export"])
-        file_menu.addSeparator()
-        file_menu.addAction(act["quit"])
-
-        edit = bar.addMenu("&Edit")
-        edit.addAction(act["undo"])
-        edit.addAction(act["redo"])
-        edit.addSeparator()
-        add = edit.addMenu("&Add")
-        for name in ("add_group", "add_sphere", "add_box", "add_cylinder", "add_rectangle", "add_light",
-                     "add_point_light", "add_spot_light", "add_sun"):
-            add.addAction(act[name])
-        add.addSeparator()
-        add.addAction(act["import_mesh"])
-        edit.addAction(act["new_material"])
-        edit.addSeparator()
-        edit.addAction(act["duplicate"])
-        edit.addAction(act["rename"])
-        edit.addAction(act["delete"])
-
-        view = bar.addMenu("&View")
-        for name in ("fit", "actual", "zoom_in", "zoom_out"):
-            view.addAction(act[name])
-        view.addSeparator()
-        view.addAction(act["denoise"])
-        view.addSeparator()
+    def _add_panel_toggles(self, menu: QMenu) -> None:
         for dock in self.docks.values():
-            view.addAction(dock.toggleViewAction())
-        view.addAction(act["reset_layout"])
+            menu.addAction(dock.toggleViewAction())
 
-        camera = bar.addMenu("&Camera")
-        for name in ("tool_select", "tool_focus", "tool_pan"):
-            camera.addAction(act[name])
-        camera.addSeparator()
-        camera.addAction(act["frame_selection"])
-        camera.addAction(act["frame_all"])
-        camera.addSeparator()
-        camera.addAction(act["open_up"])
-        camera.addAction(act["stop_down"])
-        camera.addAction(act["focus_on_selection"])
-        lens_menu = camera.addMenu("&Lens")
+    def _fill_lens_menu(self, menu: QMenu) -> None:
         self.lens_actions = []
         free = self.make_action("Free (no lens limits)", lambda: self.camera_panel.choose_lens(None), "Alt+0")
-        lens_menu.addAction(free)
-        lens_menu.addSeparator()
+        menu.addAction(free)
+        menu.addSeparator()
         for i, lens in enumerate(self.camera_panel.lenses):
             action = self.make_action(lens.name, lambda _c=False, lens=lens: self.camera_panel.choose_lens(lens),
                                       f"Alt+{i + 1}" if i < 9 else None)
-            lens_menu.addAction(action)
+            menu.addAction(action)
             self.lens_actions.append(action)
-
-        render = bar.addMenu("&Render")
-        render.addAction(act["pause"])
-        render.addAction(act["restart"])
-        render.addSeparator()
-        render.addAction(act["tool_region"])
-        render.addAction(act["clear_region"])
-        render.addSeparator()
-        render.addAction(act["export"])
-
-        help_menu = bar.addMenu("&Help")
-        help_menu.addAction(act["shortcuts"])
-        help_menu.addAction(act["about"])
 
     def _create_status_bar(self) -> None:
         status = self.statusBar()
@@ -457,10 +315,6 @@ class MainWindow(QMainWindow):
         c.gbuffer_ready.connect(self._gbuffer)
         c.device_ready.connect(self._device)
         c.render_error.connect(self._render_error)
-        c.export_progress.connect(self._export_progress)
-        c.export_finished.connect(self._export_finished)
-        c.export_failed.connect(self._export_failed)
-        c.export_cancelled.connect(self._export_cancelled)
         v = self.viewport
         v.pixel_hovered.connect(self._hovered)
         v.node_clicked.connect(self._node_clicked)
@@ -513,13 +367,8 @@ class MainWindow(QMainWindow):
             self.setWindowFilePath(str(self.doc.path))
 
     def _update_actions(self) -> None:
-        has_nodes = bool(self.doc.selected_node_paths())
-        has_any = any(t[0] in ("node", "material") for t in self.doc.selection)
-        self.actions["delete"].setEnabled(has_any)
-        self.actions["duplicate"].setEnabled(has_nodes)
-        self.actions["rename"].setEnabled(has_any)
-        self.actions["focus_on_selection"].setEnabled(has_nodes)
-        self.camera_panel.focus_selection_button.setEnabled(has_nodes)
+        update_enabled(self, self.actions)  # the actions' own predicates (actions.ACTIONS)
+        self.camera_panel.focus_selection_button.setEnabled(selection_has_nodes(self))
 
     def _name_stop_actions(self, scale: str) -> None:
         """[ and ] step the camera panel's stop scale: their menu entries say by how much."""
@@ -767,124 +616,6 @@ class MainWindow(QMainWindow):
         self.viewport.status_text = " · ".join(state)
         self.viewport.update()
 
-    # -- files ---------------------------------------------------------------------------------------------------
-    def maybe_save(self) -> bool:
-        """True when it is fine to drop the current document (saved, discarded, or unchanged)."""
-        if not self.doc.modified:
-            return True
-        box = QMessageBox(QMessageBox.Warning, "Unsaved changes",
-                          f"Save the changes to “{self.doc.display_name}” before closing it?",
-                          QMessageBox.Save | QMessageBox.Discard | QMessageBox.Cancel, self)
-        box.setInformativeText("Your changes will be lost if you don't save them.")
-        box.setDefaultButton(QMessageBox.Save)
-        box.setObjectName("unsavedChangesBox")
-        self._unsaved_box = box
-        try:
-            answer = box.exec()
-        finally:
-            self._unsaved_box = None
-        if answer == QMessageBox.Save:
-            return self.save()
-        return answer == QMessageBox.Discard
-
-    def new_scene(self) -> None:
-        if self.maybe_save():
-            self.doc.replace(studio_scene(), None)
-
-    def open_dialog(self) -> None:
-        if not self.maybe_save():
-            return
-        start = str(self.last_folder("scenes") or (self.doc.path.parent if self.doc.path else Path.home()))
-        name, _ = QFileDialog.getOpenFileName(self, "Open scene", start, f"LensLab scenes (*{SCENE_SUFFIX});;All files (*)")
-        if name:
-            self.open_path(name, ask=False)
-
-    def open_path(self, text: str | os.PathLike, ask: bool = True) -> bool:
-        if ask and not self.maybe_save():
-            return False
-        try:
-            path = resolve_scene_path(text)
-            scene = open_scene(text)
-        except (SceneError, OSError) as exc:
-            QMessageBox.critical(self, "Cannot open scene", one_line(exc))
-            return False
-        self.doc.replace(scene, path)
-        if not is_shipped(path):
-            self._add_recent(path)
-            self.remember_folder("scenes", path)
-        self.statusBar().showMessage(f"Opened {path}", 4000)
-        return True
-
-    def save(self) -> bool:
-        if self.doc.path is None:
-            return self.save_as()
-        return self._write(self.doc.path)
-
-    def save_as(self) -> bool:
-        folder = self.last_folder("scenes") or Path.home()
-        start = str(self.doc.path or (folder / f"{self.doc.display_name}{SCENE_SUFFIX}"))
-        name, _ = QFileDialog.getSaveFileName(self, "Save scene", start, f"LensLab scenes (*{SCENE_SUFFIX})")
-        if not name:
-            return False
-        path = Path(name)
-        if path.suffix.lower() != SCENE_SUFFIX:
-            path = path.with_suffix(SCENE_SUFFIX)
-        return self._write(path)
-
-    def _write(self, path: Path) -> bool:
-        path = Path(path)
-        # Relative file names (meshes, textures, the environment map) are rewritten for the new folder in the
-        # copy that is written; the open scene takes them on only once the file is there, so a failed save
-        # leaves it exactly as it was.
-        file_paths = editing.rebased_file_paths(self.doc.model, path.resolve().parent)
-        try:
-            save_scene(editing.with_file_paths(self.doc.scene, file_paths), path)
-        except OSError as exc:
-            reason = exc.strerror or str(exc)  # the writer's own messages name the file already
-            QMessageBox.critical(self, "Cannot save scene", reason if str(path) in reason else f"{path}: {reason}")
-            return False
-        self.doc.saved_as(path, file_paths)
-        self._add_recent(path)
-        self.remember_folder("scenes", path)
-        self.statusBar().showMessage(f"Saved {path}", 4000)
-        return True
-
-    def last_folder(self, kind: str) -> Path | None:
-        """The folder the last file of ``kind`` ("scenes": opened or saved; "meshes": imported; "images":
-        exported) was in, remembered between runs, if it is still there."""
-        value = self.settings.value(f"folders/{kind}")
-        folder = Path(str(value)) if value else None
-        return folder if folder is not None and folder.is_dir() else None
-
-    def remember_folder(self, kind: str, file: str | os.PathLike) -> None:
-        self.settings.setValue(f"folders/{kind}", str(Path(file).expanduser().resolve().parent))
-
-    def recent_files(self) -> list[str]:
-        value = self.settings.value("recent_files", [])
-        if isinstance(value, str):
-            value = [value]
-        return [str(v) for v in (value or [])]
-
-    def _add_recent(self, path: Path) -> None:
-        text = str(Path(path).resolve())
-        recent = [p for p in self.recent_files() if p != text]
-        self.settings.setValue("recent_files", [text] + recent[: MAX_RECENT - 1])
-
-    def _fill_recent_menu(self) -> None:
-        menu = self.recent_menu
-        menu.clear()
-        recent = self.recent_files()
-        for i, path in enumerate(recent):
-            action = menu.addAction(f"&{(i + 1) % 10}  {Path(path).parent.name}/{Path(path).name}",
-                                    lambda p=path: self.open_path(p))
-            action.setToolTip(path)
-            action.setEnabled(Path(path).exists())
-        if recent:
-            menu.addSeparator()
-            menu.addAction("Clear List", lambda: self.settings.setValue("recent_files", []))
-        else:
-            menu.addAction("No recent scenes").setEnabled(False)
-
     # -- adding, importing, deleting --------------------------------------------------------------------------------
     def add_primitive(self, kind: str) -> None:
         new = editing.new_primitive(self.doc.model, kind)
@@ -905,59 +636,6 @@ class MainWindow(QMainWindow):
         name, material = editing.new_material(self.doc.model)
         self.doc.push(AddMaterialCommand(self.doc, name, material, assign_to=self.doc.selected_node_paths()))
         self.doc.set_selection([("material", name)])
-
-    def import_dialog(self) -> None:
-        self._warm_up_mesh_library()
-        start = str(self.last_folder("meshes") or self.doc.scene.base_dir())
-        pattern = "Meshes (" + " ".join("*" + s for s in MESH_SUFFIXES) + ");;All files (*)"
-        names, _ = QFileDialog.getOpenFileNames(self, "Import mesh", start, pattern)
-        if names:
-            self.remember_folder("meshes", names[0])
-        for name in names:
-            self.import_mesh(Path(name))
-
-    def import_mesh(self, path: Path) -> None:
-        """Add a mesh file as a node. The file is read on a background thread (a large mesh, or the first use of
-        the mesh library, takes seconds); the node appears, as one undo step, when it has been read."""
-        path = Path(path).resolve()
-        self._pending_imports += 1
-        self.statusBar().showMessage(f"Reading {path.name}…")
-        self.setCursor(Qt.BusyCursor)
-
-        def load() -> None:
-            try:
-                mesh = load_mesh(path, True)
-            except MeshLoadError as exc:
-                self._mesh_loaded.emit(path, None, str(exc))
-            except Exception as exc:  # a broken file can make trimesh raise anything
-                self._mesh_loaded.emit(path, None, f"{path}: cannot read mesh ({exc})")
-            else:
-                self._mesh_loaded.emit(path, mesh, "")
-
-        threading.Thread(target=load, name=f"load {path.name}", daemon=True).start()
-
-    def _on_mesh_loaded(self, path: Path, mesh, error: str) -> None:
-        self._pending_imports -= 1
-        if self._pending_imports == 0:
-            self.unsetCursor()
-        if mesh is None:
-            self.statusBar().clearMessage()
-            self.mesh_import_failed.emit(str(path), error)
-            if not self._closing:
-                QMessageBox.critical(self, "Cannot import mesh", error)
-            return
-        node, scale = editing.mesh_node(self.doc.model, path, mesh.vertices, self.doc.path)
-        parent = editing.insertion_parent(self.doc.model, self.doc.selected_node_paths())
-        self.doc.push(AddNodeCommand(self.doc, node, parent, text=f"Import {path.name}"))
-        note = f", scaled ×{scale:g} to fit the view" if scale != 1.0 else ""
-        self.statusBar().showMessage(f"Imported {path.name}: {mesh.triangle_count:,} triangles{note}", 6000)
-        self.mesh_imported.emit(str(path))
-
-    def _warm_up_mesh_library(self) -> None:
-        """Start importing the mesh library (trimesh, scipy: seconds the first time) while the user picks a file."""
-        if not getattr(self, "_mesh_library_warming", False):
-            self._mesh_library_warming = True
-            threading.Thread(target=lambda: __import__("trimesh"), name="import trimesh", daemon=True).start()
 
     def delete_selection(self) -> None:
         nodes = self.doc.selected_node_paths()
@@ -1013,106 +691,73 @@ class MainWindow(QMainWindow):
         name = self.doc.model.node(paths[0]).name
         self.camera_panel.set_focus(distance, text=f"Focus on {name}")
 
-    # -- export -----------------------------------------------------------------------------------------------------
-    def export_dialog(self) -> None:
-        if self.export_id is not None:
-            return
-        frame = self.controller.last_frame
-        folder = self.last_folder("images")
-        last = self.last_export_path or (folder / default_export_path(self.doc).name if folder else None)
-        dialog = ExportDialog(self.doc, self.viewport.exposure, self.viewport.tone_map,
-                              frame.samples_per_second if frame else None, last, self)
-        if dialog.exec() == ExportDialog.Accepted:
-            self.start_export(dialog.request())
+    # -- files and export: the file controller and the export flow do them -----------------------------------------
+    def maybe_save(self) -> bool:
+        return self.files.maybe_save()
 
-    def start_export(self, request) -> int:
-        self.last_export_path = Path(request.path)
-        self.remember_folder("images", request.path)
-        self.export_id = self.controller.start_export(request)
-        w, h = request.scene.camera.resolution
-        dialog = QProgressDialog(f"Rendering {w}×{h} to {Path(request.path).name}…", "Cancel", 0, 1000, self)
-        dialog.setObjectName("exportProgress")
-        dialog.setWindowTitle("Export")
-        dialog.setWindowModality(Qt.WindowModal)
-        dialog.setMinimumDuration(0)
-        dialog.setAutoClose(False)
-        dialog.setAutoReset(False)
-        dialog.setValue(0)
-        dialog.canceled.connect(self.cancel_export)
-        self.export_progress_dialog = dialog
-        dialog.show()
-        return self.export_id
+    def new_scene(self) -> None:
+        self.files.new_scene()
 
-    def cancel_export(self) -> None:
-        if self.export_id is not None:
-            self.controller.cancel_export(self.export_id)
+    def open_dialog(self) -> None:
+        self.files.open_dialog()
 
-    def _export_progress(self, update) -> None:
-        dialog = self.export_progress_dialog
-        if dialog is None or update.request_id != self.export_id:
-            return
-        progress = update.progress
-        dialog.setValue(round(progress.fraction * 1000))
-        goal = f" / {progress.target_spp}" if progress.target_spp else ""
-        limit = f" of {elapsed_text(progress.time_limit)}" if progress.time_limit else ""
-        remaining = ""
-        if 0.02 < progress.fraction < 1:
-            remaining = f" · about {elapsed_text(progress.elapsed_seconds * (1 - progress.fraction) / progress.fraction)} left"
-        dialog.setLabelText(f"{progress.samples_per_pixel}{goal} spp · {elapsed_text(progress.elapsed_seconds)}{limit}"
-                            f"{remaining} · {rate_text(progress.samples_per_second)}")
+    def open_path(self, text: str | os.PathLike, ask: bool = True) -> bool:
+        return self.files.open_path(text, ask)
 
-    def _close_export_dialog(self) -> None:
-        dialog = self.export_progress_dialog
-        self.export_progress_dialog = None
-        self.export_id = None
-        if dialog is not None:
-            dialog.canceled.disconnect(self.cancel_export)
-            dialog.close()
-            dialog.deleteLater()
+    def save(self) -> bool:
+        return self.files.save()
 
-    def _export_finished(self, request_id: int, path: str) -> None:
-        if request_id != self.export_id:
-            return
-        self._close_export_dialog()
-        self.statusBar().showMessage(f"Exported {path}", 8000)
+    def save_as(self) -> bool:
+        return self.files.save_as()
 
-    def _export_failed(self, request_id: int, message: str) -> None:
-        if request_id != self.export_id:
-            return
-        self._close_export_dialog()
-        if not self._closing:
-            QMessageBox.critical(self, "Export failed", message)
+    def _write(self, path: Path) -> bool:
+        return self.files.write(path)
 
-    def _export_cancelled(self, request_id: int) -> None:
-        if request_id != self.export_id:
-            return
-        self._close_export_dialog()
-        self.statusBar().showMessage("Export cancelled: nothing was written", 5000)
+    def last_folder(self, kind: str) -> Path | None:
+        return self.files.last_folder(kind)
 
-    # -- drag and drop ---------------------------------------------------------------------------------------------
-    @staticmethod
-    def _dropped_paths(event) -> list[Path]:
-        if not event.mimeData().hasUrls():
-            return []
-        return [Path(u.toLocalFile()) for u in event.mimeData().urls() if u.isLocalFile()]
+    def remember_folder(self, kind: str, file: str | os.PathLike) -> None:
+        self.files.remember_folder(kind, file)
+
+    def recent_files(self) -> list[str]:
+        return self.files.recent_files()
+
+    def import_dialog(self) -> None:
+        self.files.import_dialog()
+
+    def import_mesh(self, path: Path) -> None:
+        self.files.import_mesh(path)
+
+    @property
+    def _unsaved_box(self) -> QMessageBox | None:
+        return self.files.unsaved_box
 
     def dragEnterEvent(self, event) -> None:
-        paths = self._dropped_paths(event)
-        if any(p.suffix.lower() in MESH_SUFFIXES for p in paths):
-            self._warm_up_mesh_library()
-        if any(p.suffix.lower() in MESH_SUFFIXES or p.suffix.lower() == SCENE_SUFFIX or p.is_dir() for p in paths):
-            event.acceptProposedAction()
+        self.files.drag_enter(event)
 
     def dropEvent(self, event) -> None:
-        paths = self._dropped_paths(event)
-        meshes = [p for p in paths if p.suffix.lower() in MESH_SUFFIXES]
-        scenes = [p for p in paths if p.suffix.lower() == SCENE_SUFFIX or p.is_dir()]
-        event.acceptProposedAction()
-        if meshes:
-            for p in meshes:
-                self.import_mesh(p)
-        elif scenes:
-            QTimer.singleShot(0, lambda: self.open_path(scenes[0]))
+        self.files.drop(event)
+
+    def export_dialog(self) -> None:
+        self.export_flow.open_dialog()
+
+    def start_export(self, request) -> int:
+        return self.export_flow.start(request)
+
+    def cancel_export(self) -> None:
+        self.export_flow.cancel()
+
+    @property
+    def export_id(self) -> int | None:
+        return self.export_flow.export_id
+
+    @property
+    def export_progress_dialog(self) -> QProgressDialog | None:
+        return self.export_flow.progress_dialog
+
+    @property
+    def last_export_path(self) -> Path | None:
+        return self.export_flow.last_path
 
     # -- help ----------------------------------------------------------------------------------------------------------
     def show_shortcuts(self) -> None:
@@ -1139,7 +784,7 @@ class MainWindow(QMainWindow):
         if not self.maybe_save():
             event.ignore()
             return
-        self._closing = True
+        self.files.closing = self.export_flow.closing = True  # a failure now is not worth a message box
         self._save_layout()
         if self.export_id is not None:
             self.cancel_export()
