@@ -401,8 +401,9 @@ def mitsuba_case(rng: random.Random) -> Case:
 # Command-line values
 # ---------------------------------------------------------------------------------------------------------
 _CLI_VALUES = ["0", "-1", "nan", "inf", "1e400", _HUGE_INT_TEXT, "", "abc", "\x1b[2J", "1/0", "f/0", "0x10"]
-_CLI_OPTIONS = ["--spp", "--width", "--f-stop", "--focal-length", "--focus-distance", "--seed", "--max-depth",
-                "--time-limit", "--exposure", "--iso", "--shutter", "--coc", "--blades", "--anamorphic", "--lens"]
+_CLI_OPTIONS = ["--spp", "--width", "--f-number", "--f-stop", "--focal-length", "--focus-distance", "--seed",
+                "--max-depth", "--time-limit", "--exposure", "--iso", "--shutter", "--circle-of-confusion", "--coc",
+                "--aperture-blades", "--blades", "--anamorphic-squeeze", "--anamorphic", "--lens"]
 
 
 def cli_case(rng: random.Random) -> Case:

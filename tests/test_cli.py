@@ -13,20 +13,15 @@ import pytest
 
 from lenslab.cli import main
 from lenslab.render.film import read_image
+from tests.helpers import run_cli
 
 SMALL = ["--spp", "2", "--width", "32", "--height", "24"]
 
 
-def run_cli(capsys, *argv):
-    status = main([str(a) for a in argv])
-    captured = capsys.readouterr()
-    return status, captured.out, captured.err
-
-
 def test_headless_exr_is_linear_float_with_camera_metadata(renderer, tmp_path, capsys):
     out = tmp_path / "shot.exr"
-    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", out, *SMALL, "--f-stop", "2.8",
-                             "--focal-length", "35", "--focus-distance", "1.5", "--seed", "7")
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", out, *SMALL, "--f-stop", "2.8",
+                          "--focal-length", "35", "--focus-distance", "1.5", "--seed", "7")
     assert status == 0, err
     pixels, meta = read_image(out)
     assert pixels.shape == (24, 32, 3) and pixels.dtype == np.float32
@@ -45,8 +40,8 @@ def test_headless_png_is_the_exr_tone_mapped_for_display(renderer, tmp_path, cap
     from lenslab.render.film import tone_map
 
     for suffix in (".exr", ".png"):
-        status, _, err = run_cli(capsys, "dof_chart", "--headless", "-o", tmp_path / f"shot{suffix}", *SMALL,
-                                 "--tone-map", "filmic", "--exposure", "1")
+        status, err = run_cli(capsys, "dof_chart", "--headless", "-o", tmp_path / f"shot{suffix}", *SMALL,
+                              "--tone-map", "filmic", "--exposure", "1")
         assert status == 0, err
     linear, _ = read_image(tmp_path / "shot.exr")
     display, _ = read_image(tmp_path / "shot.png")
@@ -59,8 +54,8 @@ def test_headless_png_is_the_exr_tone_mapped_for_display(renderer, tmp_path, cap
 
 def test_time_limit_alone_renders_what_fits(renderer, tmp_path, capsys):
     out = tmp_path / "quick.exr"
-    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", out, "--width", "16", "--height", "16",
-                             "--time-limit", "0.5")
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", out, "--width", "16", "--height", "16",
+                          "--time-limit", "0.5")
     assert status == 0, err
     _, meta = read_image(out)
     assert meta["lenslab:SamplesPerPixel"] >= 1
@@ -69,7 +64,7 @@ def test_time_limit_alone_renders_what_fits(renderer, tmp_path, capsys):
 def test_a_time_limit_shorter_than_one_pass_still_samples_every_pixel(renderer, tmp_path, capsys):
     # 65,536 pixels: more than the first dispatch takes, so the pass cannot end inside the limit.
     out = tmp_path / "short.exr"
-    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", out, "--width", "256", "--time-limit", "0.001")
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", out, "--width", "256", "--time-limit", "0.001")
     assert status == 0, err
     pixels, meta = read_image(out)
     assert pixels.shape == (256, 256, 3)
@@ -83,7 +78,8 @@ def test_a_time_limit_shorter_than_one_pass_still_samples_every_pixel(renderer, 
 @pytest.mark.parametrize(
     "argv, message",
     [
-        (["cornell_box", "--headless", "-o", "x.png", "--f-stop", "0"], r"argument --f-stop: f-number out of range \[0\.5, 128\]: .0."),
+        (["cornell_box", "--headless", "-o", "x.png", "--f-stop", "0"],
+         r"argument --f-number/--f-stop: f-number out of range \[0\.5, 128\]: .0."),  # the older flag still read
         (["cornell_box", "--headless", "-o", "x.png", "--spp", "many"], r"--spp: expected a whole number, not 'many'"),
         (["cornell_box", "--headless", "-o", "x.png", "--spp", "-1"], r"--spp: -1 is out of range \[1, 16777216\]"),
         (["cornell_box", "--headless", "-o", "x.png", "--focus-distance", "-2"], r"--focus-distance: -2 is out of range"),
@@ -101,7 +97,7 @@ def test_bad_arguments_exit_non_zero_with_one_line(tmp_path, monkeypatch, capsys
     import re
 
     monkeypatch.chdir(tmp_path)
-    status, _, err = run_cli(capsys, *argv)
+    status, err = run_cli(capsys, *argv)
     assert status != 0
     assert err.count("\n") == 1 and err.startswith("lenslab: error: ")
     assert re.search(message, err), err
@@ -110,7 +106,7 @@ def test_bad_arguments_exit_non_zero_with_one_line(tmp_path, monkeypatch, capsys
 
 def test_output_problems_name_the_file_the_user_asked_for(tmp_path, capsys):
     (tmp_path / "file.png").write_bytes(b"")
-    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "file.png" / "x.png")
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "file.png" / "x.png")
     assert status == 1 and f"'{tmp_path / 'file.png'}' is a file, not a folder" in err
     locked = tmp_path / "locked"
     locked.mkdir(mode=0o500)
@@ -118,7 +114,7 @@ def test_output_problems_name_the_file_the_user_asked_for(tmp_path, capsys):
         target = Path("/proc/x.png")
     else:
         target = locked / "x.png"
-    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", target, "--spp", "1", "--width", "8")
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", target, "--spp", "1", "--width", "8")
     assert status == 1 and err.count("\n") == 1
     assert str(target) in err and f"{target.parent}" in err and "/." not in err  # not our temporary name
 
@@ -133,21 +129,21 @@ def test_scene_errors_found_when_packing_name_the_scene_file(tmp_path, capsys):
     ):
         scene = tmp_path / name
         scene.write_text(json.dumps({"lenslab_scene": 1} | changes))
-        status, _, err = run_cli(capsys, scene, "--headless", "-o", tmp_path / "x.png")
+        status, err = run_cli(capsys, scene, "--headless", "-o", tmp_path / "x.png")
         assert status == 1 and err.startswith(f"lenslab: error: {scene}: {message}"), err
     assert not (tmp_path / "x.png").exists()
 
 
 def test_exposure_on_an_exr_is_a_warning(tmp_path, capsys):
-    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.exr", "--exposure", "1",
-                             "--spp", "1", "--width", "8")
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.exr", "--exposure", "1",
+                          "--spp", "1", "--width", "8")
     assert status == 0 and "lenslab: warning: --exposure applies to PNG only" in err
 
 
 def test_broken_scene_exits_with_file_and_key(tmp_path, capsys):
     scene = tmp_path / "broken.json"
     scene.write_text(json.dumps({"lenslab_scene": 1, "camera": {"f_number": "wide"}}))
-    status, _, err = run_cli(capsys, scene, "--headless", "-o", tmp_path / "x.png")
+    status, err = run_cli(capsys, scene, "--headless", "-o", tmp_path / "x.png")
     assert status == 1
     assert err.strip() == f'lenslab: error: {scene}: camera.f_number: expected a number, got "wide"'
     assert not (tmp_path / "x.png").exists()
@@ -167,12 +163,12 @@ def test_missing_gl_driver_is_one_line_with_the_packages_to_install(tmp_path, mo
         raise Exception(failure)
 
     monkeypatch.setattr(moderngl, "create_context", no_egl)
-    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.png")
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.png")
     assert status == 1
     assert err.count("\n") == 1
     assert f"is missing: on Debian/Ubuntu `apt-get install {package}`" in err
     assert "apt-get install libegl1 libgl1 libopengl0 libegl-mesa0 libgl1-mesa-dri" in err
-    status, _, err = run_cli(capsys, "--info")
+    status, err = run_cli(capsys, "--info")
     assert status == 1 and "apt-get install" in err
 
 
@@ -189,15 +185,16 @@ def test_interrupted_render_writes_nothing(renderer, tmp_path, monkeypatch, caps
         return real_step(self, seconds, 1)  # one pass only, however fast the device: the render is mid-way
 
     monkeypatch.setattr(RenderSession, "step", step_then_interrupt)
-    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.exr", "--spp", "1000",
-                             "--width", "16", "--height", "16")
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.exr", "--spp", "1000",
+                          "--width", "16", "--height", "16")
     assert status == 130
     assert err.strip() == "lenslab: interrupted; nothing was written"
     assert list(tmp_path.iterdir()) == []  # neither the image nor a temporary file
 
 
 def test_info_prints_the_gl_renderer_and_limits(renderer, capsys):
-    status, out, _ = run_cli(capsys, "--info")
+    run = run_cli(capsys, "--info")
+    status, out = run.status, run.out
     assert status == 0
     assert "renderer" in out and renderer.ctx.info["GL_RENDERER"] in out
     assert "max storage block" in out and "MiB" in out
@@ -223,7 +220,8 @@ def test_help_speaks_photography(capsys):
         main(["--help"])
     assert info.value.code == 0
     text = capsys.readouterr().out
-    for phrase in ("--f-stop", "f-number", "--focus-distance", "plane of focus", "--focal-length", "millimetres"):
+    for phrase in ("--f-number", "--f-stop", "f-number", "--focus-distance", "plane of focus", "--focal-length",
+                   "millimetres"):
         assert phrase in text
 
 
@@ -260,7 +258,7 @@ def test_mitsuba_scene_with_parameters_renders_headless(renderer, tmp_path, caps
     scene = tmp_path / "ball.xml"
     scene.write_text(MITSUBA_SCENE)
     out = tmp_path / "ball.exr"
-    status, _, err = run_cli(capsys, scene, "--headless", "-o", out, "-D", "spp=3", "-D", "albedo=1")
+    status, err = run_cli(capsys, scene, "--headless", "-o", out, "-D", "spp=3", "-D", "albedo=1")
     assert status == 0, err
     pixels, meta = read_image(out)
     assert pixels.shape == (16, 16, 3)
@@ -269,9 +267,9 @@ def test_mitsuba_scene_with_parameters_renders_headless(renderer, tmp_path, caps
 
 
 def test_bad_define_is_a_usage_error(tmp_path, capsys):
-    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.png", "-D", "nonsense")
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.png", "-D", "nonsense")
     assert status == 2 and "-D nonsense: expected NAME=VALUE" in err
-    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.png", "-D", "a=1")
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.png", "-D", "a=1")
     assert status == 1 and "-D parameters apply to Mitsuba XML scenes only" in err
 
 
@@ -283,20 +281,20 @@ def test_a_missing_texture_is_one_warning_and_the_render_goes_on(tmp_path, capsy
         "nodes": [{"name": "card", "shape": {"type": "rectangle"}, "material": "card",
                    "transform": {"translate": [0, 0, -3]}}],
     }))
-    status, _, err = run_cli(capsys, scene, "--headless", "-o", tmp_path / "x.png", "--spp", "1", "--width", "8")
+    status, err = run_cli(capsys, scene, "--headless", "-o", tmp_path / "x.png", "--spp", "1", "--width", "8")
     assert status == 0 and (tmp_path / "x.png").exists()
     lines = [line for line in err.splitlines() if "nosuch.png" in line]
     assert lines == [f"lenslab: warning: {tmp_path / 'nosuch.png'}: texture file not found; "
                      "showing a magenta checkerboard instead"]
 
 
-# -- the camera's own language (issue 13) -------------------------------------------------------------------
+# -- the camera's own language -----------------------------------------------------------------------------
 def test_every_camera_flag_reaches_the_rendered_camera(renderer, tmp_path, capsys):
     out = tmp_path / "shot.exr"
-    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", out, *SMALL, "--sensor", "aps-c",
-                             "--sensor-fit", "fill", "--blades", "6", "--blade-curvature", "0.5", "--anamorphic",
-                             "1.5", "--barrel-clipping", "0.3", "--coc", "0.02", "--iso", "800", "--shutter",
-                             "1/30", "--f-stop", "f/4", "--focus-from", "lens", "--no-focus-breathing")
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", out, *SMALL, "--sensor", "aps-c",
+                          "--sensor-fit", "fill", "--blades", "6", "--blade-curvature", "0.5", "--anamorphic",
+                          "1.5", "--barrel-clipping", "0.3", "--coc", "0.02", "--iso", "800", "--shutter",
+                          "1/30", "--f-stop", "f/4", "--focus-from", "lens", "--no-focus-breathing")
     assert status == 0, err
     _, meta = read_image(out)
     assert (meta["lenslab:SensorWidthMM"], meta["lenslab:SensorHeightMM"]) == pytest.approx((23.5, 15.6))
@@ -313,20 +311,20 @@ def test_every_camera_flag_reaches_the_rendered_camera(renderer, tmp_path, capsy
 
 
 def test_a_lens_mounts_and_focus_nearer_than_it_can_is_refused(renderer, tmp_path, capsys):
-    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "a.png", *SMALL,
-                             "--lens", "85mm f/1.4", "--focus-distance", "0.5")
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "a.png", *SMALL,
+                          "--lens", "85mm f/1.4", "--focus-distance", "0.5")
     assert status == 1
     assert err == ("lenslab: error: focus 50.0 cm from the sensor is nearer than the lens '85 mm f/1.4' focuses "
                    "(minimum 80.0 cm)\n")
-    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "b.exr", *SMALL,
-                             "--lens", "85mm f/1.4")
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "b.exr", *SMALL,
+                          "--lens", "85mm f/1.4")
     assert status == 0, err
     _, meta = read_image(tmp_path / "b.exr")
     assert meta["Exif:FocalLength"] == 85.0 and meta["lenslab:ApertureBlades"] == 11
     assert meta["lenslab:BladeCurvature"] == pytest.approx(0.8)  # the preset's blade roundness
     # No lens at all: nothing nearer than four focal lengths from the sensor.
-    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "c.png", *SMALL,
-                             "--focal-length", "200", "--focus-distance", "0.5")
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "c.png", *SMALL,
+                          "--focal-length", "200", "--focus-distance", "0.5")
     assert status == 1 and "nearer than a 200 mm lens can focus: at least 80.0 cm" in err and err.count("\n") == 1
 
 
@@ -348,26 +346,28 @@ def test_a_lens_mounts_and_focus_nearer_than_it_can_is_refused(renderer, tmp_pat
     ("--aperture-image", "no_such_star.png", "no such file: no_such_star.png"),
 ])
 def test_nonsense_camera_values_are_one_usage_line(capsys, flag, value, message):
-    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", "x.png", flag, value)
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", "x.png", flag, value)
     assert status == 2 and message in err and err.count("\n") == 1 and flag in err
 
 
 def test_an_unknown_sensor_or_lens_names_the_ones_there_are(capsys, tmp_path):
-    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.png", "--sensor", "super 8")
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.png", "--sensor", "super 8")
     assert status == 2 and err.count("\n") == 1
     assert "argument --sensor: no sensor preset called 'super 8' (there are: " in err and "APS-C" in err
-    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.png", "--lens", "400mm")
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.png", "--lens", "400mm")
     assert status == 2 and err.count("\n") == 1
     assert "argument --lens: no lens preset called '400mm' (there are: " in err and "85 mm f/1.4" in err
-    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.png", "--lens", "24")
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.png", "--lens", "24")
     assert status == 2 and err.count("\n") == 1
     assert "argument --lens: '24' could be any of 24 mm f/1.4, 24-70 mm f/2.8: name one whole" in err
 
 
 def test_the_presets_are_listed(capsys):
-    status, out, _ = run_cli(capsys, "--list-lenses")
+    run = run_cli(capsys, "--list-lenses")
+    status, out = run.status, run.out
     assert status == 0 and "85 mm f/1.4" in out and "f/1.4 to f/16" in out and "80.0 cm" in out
-    status, out, _ = run_cli(capsys, "--list-sensors")
+    run = run_cli(capsys, "--list-sensors")
+    status, out = run.status, run.out
     assert status == 0 and "APS-C" in out and "23.5 x 15.6 mm" in out and "1.53x" in out and "29 µm" in out
 
 
@@ -423,15 +423,15 @@ def test_an_iso_or_a_shutter_switches_to_a_physical_exposure(argv, mode):
 
 
 def test_settings_a_lens_does_not_have_are_one_usage_line(capsys):
-    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", "x.png", "--lens", "85mm f/1.4",
-                             "--f-stop", "1.2")
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", "x.png", "--lens", "85mm f/1.4",
+                          "--f-stop", "1.2")
     assert status == 2 and err.count("\n") == 1
     assert err.startswith("lenslab: error: f/1.2 is not on the lens '85 mm f/1.4' (f/1.4 to f/16)")
 
 
 def test_a_focus_from_the_lens_nearer_than_the_lens_focuses_is_refused(capsys, tmp_path):
-    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "a.png", *SMALL,
-                             "--lens", "135 mm f/2", "--focus-from", "lens", "--focus-distance", "0.7")
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "a.png", *SMALL,
+                          "--lens", "135 mm f/2", "--focus-from", "lens", "--focus-distance", "0.7")
     assert status == 1 and err.count("\n") == 1
     assert "focus 70.0 cm from the lens (" in err and "nearer than the lens '135 mm f/2' focuses (minimum 90.0 cm" in err
     assert not (tmp_path / "a.png").exists()
@@ -440,14 +440,16 @@ def test_a_focus_from_the_lens_nearer_than_the_lens_focuses_is_refused(capsys, t
 def test_the_listed_presets_are_the_shipped_ones(capsys):
     from lenslab.optics import load_lens_presets, load_sensor_presets
 
-    status, out, err = run_cli(capsys, "--list-lenses")
+    run = run_cli(capsys, "--list-lenses")
+    status, out, err = run.status, run.out, run.err
     lines = out.splitlines()
     assert status == 0 and not err and lines[0].split() == ["lens", "focal", "length", "stops", "blades", "closest",
                                                             "focus"]
     assert [line.startswith(lens.name + " ") for line, lens in zip(lines[1:], load_lens_presets())] == \
         [True] * len(load_lens_presets()) and len(lines) == 1 + len(load_lens_presets())
     assert "70-200 mm" in out and "f/2.8 to f/22" in out
-    status, out, err = run_cli(capsys, "--list-sensors")
+    run = run_cli(capsys, "--list-sensors")
+    status, out, err = run.status, run.out, run.err
     lines = out.splitlines()
     assert status == 0 and not err and len(lines) == 1 + len(load_sensor_presets())
     assert all(line.startswith(sensor.name + " ") for line, sensor in zip(lines[1:], load_sensor_presets()))
@@ -455,19 +457,19 @@ def test_the_listed_presets_are_the_shipped_ones(capsys):
 
 
 def test_info_with_an_output_says_it_renders_nothing(capsys, tmp_path):
-    status, _, err = run_cli(capsys, "cornell_box", "--info", "--headless", "-o", tmp_path / "c.png")
+    status, err = run_cli(capsys, "cornell_box", "--info", "--headless", "-o", tmp_path / "c.png")
     assert status == 2 and "--info prints the device and exits without rendering" in err
     assert not (tmp_path / "c.png").exists()
 
 
 def test_png_only_options_on_an_exr_are_each_named(renderer, capsys, tmp_path):
-    status, _, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "c.exr", "--spp", "1", "--width",
-                             "8", "--height", "8", "--tone-map", "filmic", "--exposure", "1")
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "c.exr", "--spp", "1", "--width",
+                          "8", "--height", "8", "--tone-map", "filmic", "--exposure", "1")
     assert status == 0
     assert "--tone-map applies to PNG only" in err and "--exposure applies to PNG only" in err
 
 
 def test_a_folder_without_a_scene_is_called_a_folder(capsys, tmp_path):
     (tmp_path / "notes.txt").write_text("hello")
-    status, _, err = run_cli(capsys, tmp_path, "--headless", "-o", tmp_path / "c.png")
+    status, err = run_cli(capsys, tmp_path, "--headless", "-o", tmp_path / "c.png")
     assert status == 1 and f"{tmp_path}: a folder with no scene.json in it" in err

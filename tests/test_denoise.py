@@ -10,6 +10,7 @@ import pytest
 
 from lenslab.cli import main
 from lenslab.render.film import read_image
+from tests.helpers import render_to_spp
 
 pytest.importorskip("pyoidn")
 
@@ -50,7 +51,7 @@ def test_albedo_and_normal_of_the_cornell_walls(renderer):
 
     scene = pinhole(open_scene("cornell_box"))
     s = session(renderer, scene, feature_buffers=True)
-    s.step(30.0, 4)
+    render_to_spp(s, 4)
     albedo, normal = s.features_image()
     names = picked_nodes(s)
     expected = {"left wall": ((0.63, 0.065, 0.05), (1.0, 0.0, 0.0)),
@@ -76,20 +77,20 @@ def test_beauty_is_the_same_with_and_without_feature_buffers(renderer):
 
     scene = open_scene("cornell_caustic")
     plain = session(renderer, scene, (40, 40))
-    plain.step(60.0, 3)
+    render_to_spp(plain, 3)
     guided = session(renderer, scene, (40, 40), feature_buffers=True)
-    guided.step(60.0, 3)
+    render_to_spp(guided, 3)
     assert np.array_equal(plain.accumulation(), guided.accumulation())
     albedo, normal = guided.features_image()
     assert albedo.max() > 0 and np.abs(normal).max() > 0
 
     guided.set_feature_buffers(False)  # back to the kernel without them: the same image again
-    guided.step(60.0, 3)
+    render_to_spp(guided, 3)
     assert np.array_equal(plain.accumulation(), guided.accumulation())
     with pytest.raises(RuntimeError, match="no feature buffers"):
         guided.features_image()
     plain.set_feature_buffers(True)
-    plain.step(60.0, 3)
+    render_to_spp(plain, 3)
     assert np.array_equal(plain.features_image()[0], albedo)
     plain.release()
     guided.release()
@@ -114,7 +115,7 @@ def test_guides_follow_a_delta_surface_and_the_sky_has_no_normal(renderer):
                   nodes=[Node("wall", Transform(translate=(0.0, 0.0, -2.0)), Rectangle((1.0, 1.0)), "red"),
                          Node("pane", Transform(translate=(0.0, 0.0, -1.0)), Rectangle((0.2, 0.2)), "pane")])
     s = session(renderer, scene, (24, 16), feature_buffers=True)
-    s.step(60.0, 256)
+    render_to_spp(s, 256)
     albedo, normal = s.features_image()
     names = picked_nodes(s)
     r = 0.04 + 0.96 ** 2 * 0.04 / (1 - 0.04 ** 2)  # the pane's reflectance head-on, inter-reflections included
@@ -140,9 +141,9 @@ def test_the_denoised_image_is_closer_to_the_converged_one(renderer):
 
     scene = open_scene("cornell_box")
     reference = session(renderer, scene, (64, 64))
-    reference.step(120.0, 512)
+    render_to_spp(reference, 512)
     noisy = session(renderer, scene, (64, 64), feature_buffers=True)
-    noisy.step(30.0, 4)
+    render_to_spp(noisy, 4)
     image = noisy.image()
     albedo, normal = noisy.features_image()
     raw_error = rel_mse(image, reference.image())

@@ -8,6 +8,7 @@ import pytest
 from lenslab.render.film import TONE_MAPS, resolve, to_8bit, tone_map
 from lenslab.render.tracer import TONE_MAP_CODES, RenderSession
 from lenslab.scene.io.loader import open_scene
+from tests.helpers import render_to_spp
 
 pytestmark = pytest.mark.gl
 
@@ -17,7 +18,7 @@ def half_rendered(renderer):
     """The Cornell box with 3 samples per pixel and the fourth pass stopped part way: bright light, dark
     corners, and pixels with no sample yet once reset."""
     session = RenderSession(renderer, open_scene("cornell_box"), width=40, height=30)
-    session.step(60.0, target_spp=3)
+    render_to_spp(session, 3)
     yield session
     session.release()
 

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from lenslab.render.tracer import RenderSession
+from tests.helpers import render_to_spp
 from tests.scenes import furnace_scene
 
 
@@ -19,9 +20,7 @@ def block_means(image, size=4):
 
 def render(renderer, scene, spp, **session_args):
     session = RenderSession(renderer, scene, **session_args)
-    while not session.done(spp):
-        session.step(10.0, spp)
-    accumulation = session.accumulation()
+    accumulation = render_to_spp(session, spp).accumulation()
     session.release()
     return accumulation
 

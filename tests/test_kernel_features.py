@@ -13,6 +13,7 @@ from lenslab.render.features import FLAT_MAX_PRIMITIVES, GENERAL, renders_flat, 
 from lenslab.render.tracer import RenderSession
 from lenslab.scene.io.loader import open_scene
 from lenslab.scene.materials import Conductor, Dielectric, Diffuse, Emissive
+from tests.helpers import render_to_spp
 
 SHIPPED = ("cornell_box", "dof_chart", "product_shot", "cornell_caustic")
 
@@ -43,9 +44,7 @@ def test_the_product_shot_keeps_its_environment_map_and_every_material_it_uses()
 
 def render(renderer, scene, spp, specialise):
     session = RenderSession(renderer, scene, width=48, height=32, specialise=specialise)
-    while not session.done(spp):
-        session.step(10.0, spp)
-    image = session.image()
+    image = render_to_spp(session, spp).image()
     session.release()
     return image
 

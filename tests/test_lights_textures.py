@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from tests.helpers import render_to_spp
 from tests.scenes import FIXED_SENSOR
 
 from lenslab.render.film import write_image
@@ -37,7 +38,7 @@ def looking_down_at_floor(**scene_args) -> Scene:
 
 def render(renderer, scene, spp, **session_args):
     session = RenderSession(renderer, scene, **session_args)
-    session.step(120.0, target_spp=spp)
+    render_to_spp(session, spp)
     image, warnings = session.image(), session.warnings
     session.release()
     return image, warnings

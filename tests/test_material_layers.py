@@ -21,6 +21,7 @@ from lenslab.scene.scene import ConstantEnvironment, Node, RenderSettings, Scene
 from lenslab.scene.shapes import Rectangle, Sphere
 from lenslab.scene.textures import Checkerboard, ImageTexture
 from lenslab.scene.transform import Transform
+from tests.helpers import render_to_spp
 from tests.scenes import FIXED_SENSOR
 
 SUN = 3.0  # irradiance on a surface facing the sun
@@ -28,9 +29,7 @@ SUN = 3.0  # irradiance on a surface facing the sun
 
 def render(renderer, scene, spp, specialise=True):
     session = RenderSession(renderer, scene, specialise=specialise)
-    while not session.done(spp):
-        session.step(60.0, spp)
-    accumulation = session.accumulation()
+    accumulation = render_to_spp(session, spp).accumulation()
     session.release()
     return accumulation[..., :3] / accumulation[..., 3:4]
 

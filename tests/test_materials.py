@@ -18,6 +18,7 @@ from lenslab.scene.scene import ConstantEnvironment, Node, RenderSettings, Scene
 from lenslab.scene.shapes import Box, Rectangle, Sphere
 from lenslab.scene.transform import Transform
 from tests.bsdf_probe import BsdfProbe
+from tests.helpers import render_to_spp
 
 PERFECT_MIRROR = dict(metal="custom", eta=(0.0, 0.0, 0.0), k=(50.0, 50.0, 50.0))  # reflectance exactly 1
 
@@ -141,8 +142,7 @@ def furnace(material, max_depth=64):
 
 def render_mean(renderer, scene, spp):
     session = RenderSession(renderer, scene)
-    session.step(60.0, target_spp=spp)
-    image = session.image()
+    image = render_to_spp(session, spp).image()
     session.release()
     return image
 

@@ -501,6 +501,7 @@ def test_a_scene_flattens_with_the_files_materials(tmp_path):
 @pytest.mark.gl
 def test_a_textured_gltf_renders_its_texture(renderer, tmp_path):
     from lenslab.render.tracer import RenderSession
+    from tests.helpers import render_to_spp
 
     # 8 x 8 image in four colour blocks: red top-left, green top-right, blue bottom-left, white bottom-right.
     image = np.zeros((8, 8, 3), np.uint8)
@@ -521,8 +522,7 @@ def test_a_textured_gltf_renders_its_texture(renderer, tmp_path):
     )
     session = RenderSession(renderer, scene, width=16, height=16)
     try:
-        session.step(10, target_spp=1)
-        picture = session.image()
+        picture = render_to_spp(session, 1).image()
     finally:
         session.release()
     quadrant = {"top-left": picture[2:6, 2:6], "top-right": picture[2:6, 10:14],

@@ -681,13 +681,13 @@ def test_open_scene_reads_xml_files():
 @pytest.mark.gl
 def test_imported_cornell_box_renders(renderer):
     from lenslab.render.tracer import RenderSession
+    from tests.helpers import render_to_spp
 
     warnings: list[str] = []
     scene = load_mitsuba_scene(DATA / "cbox.xml", defines={"spp": "1"}, warn=warnings.append)
     assert scene.render.spp == 1 and warnings == []
     session = RenderSession(renderer, scene, width=32, height=32)
-    session.step(5, target_spp=1)
-    image = session.image()
+    image = render_to_spp(session, 1).image()
     try:
         assert image.shape == (32, 32, 3) and np.isfinite(image).all()
         assert image.mean() > 0.05

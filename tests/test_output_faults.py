@@ -1,4 +1,4 @@
-"""Nothing written is ever half a file: outputs under every fault (issue 12).
+"""Nothing written is ever half a file: outputs under every fault.
 
 A full disk (a file-size limit, which fails writes as a full disk does and needs no privilege; and a real full
 tmpfs where the tests may mount one), a read-only folder, SIGTERM, SIGINT and SIGKILL during the write, a stop
@@ -26,19 +26,13 @@ import numpy as np
 import pytest
 
 from lenslab.atomic import STALE_AFTER_SECONDS, TEMPORARY_NAME, WriteFailed, atomic_path, remove_stale_temporaries
-from lenslab.cli import main
 from lenslab.render.film import ExportError, read_image, write_image
+from tests.helpers import run_cli
 from tests.test_batch_farm import FOUR_SLOW_SHOTS
 
 POSIX_ONLY = pytest.mark.skipif(os.name != "posix", reason="POSIX signals, file-size limits and mounts")
 SUBPROCESS_SECONDS = 180
 SMALL = ["--spp", "1", "--width", "16", "--height", "16"]
-
-
-def run_cli(capsys, *argv):
-    status = main([str(a) for a in argv])
-    captured = capsys.readouterr()
-    return status, captured.err
 
 
 def noise(width=64, height=48, seed=0) -> np.ndarray:
@@ -495,7 +489,7 @@ def test_a_time_limit_up_before_the_first_pass_says_so_at_once(renderer, tmp_pat
 
     # Many dispatches to one pass, and a report after each: the pass outlasts the first report, as a large
     # image's does at the default slices.
-    monkeypatch.setattr(lenslab.cli, "HEADLESS_DISPATCH_SECONDS", 1e-4)
+    monkeypatch.setattr(lenslab.render.job, "OFFLINE_DISPATCH_SECONDS", 1e-4)
     monkeypatch.setattr(lenslab.render.job, "REPORT_SECONDS", 1e-4)
     status, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.png", "--width", "256", "--height",
                           "256", "--time-limit", "0.001")

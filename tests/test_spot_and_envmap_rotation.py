@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.helpers import render_to_spp
 from tests.scenes import FIXED_SENSOR
 
 from lenslab.render import buffers
@@ -47,7 +48,7 @@ def random_rotations(count: int, seed: int = 0) -> list[np.ndarray]:
 def render(renderer, scene, spp, **session_args):
     session = RenderSession(renderer, scene, **session_args)
     try:
-        session.step(300.0, target_spp=spp)
+        render_to_spp(session, spp)
         return session.image(), session.warnings
     finally:
         session.release()

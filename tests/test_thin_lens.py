@@ -14,6 +14,7 @@ import pytest
 
 from lenslab.optics import blur_diameter_mm
 from lenslab.render.tracer import RenderSession
+from tests.helpers import render_to_spp
 from tests.scenes import axis_camera, point_light_scene
 
 WIDTH = 160
@@ -22,9 +23,7 @@ SENSOR = (24.0, 24.0)  # a square sensor for a square image: pixels are square a
 
 def render(renderer, scene, spp, width=WIDTH, height=WIDTH):
     session = RenderSession(renderer, scene, width=width, height=height, dispatch_seconds=0.5)
-    while not session.done(spp):
-        session.step(10.0, spp)
-    image = session.image().mean(axis=2)
+    image = render_to_spp(session, spp).image().mean(axis=2)
     session.release()
     return image
 

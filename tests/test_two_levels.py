@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 import trimesh
 
+from tests.helpers import render_to_spp
 from tests.scenes import FIXED_SENSOR
 from lenslab.render import instancing
 from lenslab.render.buffers import GpuScene, pack_scene
@@ -109,9 +110,7 @@ def render(renderer, scene, instance_min_triangles, monkeypatch, spp=4):
     monkeypatch.setattr(tracer, "INSTANCE_MIN_TRIANGLES", instance_min_triangles)
     session = RenderSession(renderer, scene)
     try:
-        while not session.done(spp):
-            session.step(1.0, target_spp=spp)
-        return session.image()[..., :3], session
+        return render_to_spp(session, spp).image()[..., :3], session
     finally:
         session.release()
 
@@ -229,9 +228,7 @@ def test_an_edited_session_renders_what_a_new_one_does(renderer, bumpy_ball, mon
     edited = dataclasses.replace(edited, materials={**edited.materials, "clay": Diffuse(albedo=(0.2, 0.6, 0.3))})
 
     def image(session):
-        while not session.done(2):
-            session.step(1.0, target_spp=2)
-        return session.image()
+        return render_to_spp(session, 2).image()
 
     session = RenderSession(renderer, scene)
     try:

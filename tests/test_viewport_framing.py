@@ -119,6 +119,7 @@ def cornell(renderer):
 
 def _render(renderer, scene, spp, *, size=None, resize_from=None, region=None, margin=None):
     from lenslab.render.tracer import RenderSession
+    from tests.helpers import render_to_spp
 
     w, h = size or scene.camera.resolution
     first = resize_from or (w, h)
@@ -127,9 +128,7 @@ def _render(renderer, scene, spp, *, size=None, resize_from=None, region=None, m
         session.set_view(w, h, margin)
         if region is not None:
             session.set_region(region)
-        while session.samples_per_pixel < spp:
-            session.step(1.0, spp)
-        return session.accumulation()
+        return render_to_spp(session, spp).accumulation()
     finally:
         session.release()
 

@@ -55,6 +55,13 @@ class JobProgress:
         return min(1.0, max(fractions))
 
 
+def _check_terms(spp: int | None, time_limit: float | None) -> None:
+    if spp is not None and spp < 1:
+        raise ValueError(f"a render needs at least 1 sample per pixel, not {spp}")
+    if time_limit is not None and not time_limit > 0:
+        raise ValueError(f"a time limit must be positive, not {time_limit}")
+
+
 class RenderJob:
     """Render ``scene`` to ``spp`` samples per pixel, or for ``time_limit`` seconds, or both (whichever comes
     first). With neither, the scene's own sample count. The image is the scene camera's resolution.
@@ -65,15 +72,27 @@ class RenderJob:
     def __init__(self, renderer: Renderer, scene: Scene, *, spp: int | None = None, time_limit: float | None = None,
                  dispatch_seconds: float = DEFAULT_DISPATCH_SECONDS, first_sample: int = 0,
                  feature_buffers: bool = False):
-        if spp is not None and spp < 1:
-            raise ValueError(f"a render needs at least 1 sample per pixel, not {spp}")
-        if time_limit is not None and not time_limit > 0:
-            raise ValueError(f"a time limit must be positive, not {time_limit}")
-        self.scene = scene
-        self.target_spp = spp if spp is not None else (None if time_limit else scene.render.spp)
+        _check_terms(spp, time_limit)  # before the session: refused without building anything
+        session = RenderSession(renderer, scene, dispatch_seconds=dispatch_seconds, first_sample=first_sample,
+                                feature_buffers=feature_buffers)
+        self._take(session, spp, time_limit)
+
+    @classmethod
+    def of_session(cls, session: RenderSession, *, spp: int | None = None,
+                   time_limit: float | None = None) -> RenderJob:
+        """A job that renders a session made elsewhere (another size, kernel, view or render region than a job
+        makes from the scene, or one already edited), on the same terms: ``spp``, ``time_limit``, or the scene's
+        own sample count. The session stays its maker's to release."""
+        job = cls.__new__(cls)
+        job._take(session, spp, time_limit)
+        return job
+
+    def _take(self, session: RenderSession, spp: int | None, time_limit: float | None) -> None:
+        _check_terms(spp, time_limit)
+        self.scene = session.scene
+        self.target_spp = spp if spp is not None else (None if time_limit else session.scene.render.spp)
         self.time_limit = time_limit
-        self.session = RenderSession(renderer, scene, dispatch_seconds=dispatch_seconds, first_sample=first_sample,
-                                     feature_buffers=feature_buffers)
+        self.session = session
         self.overran_time_limit = 0.0  # seconds past the time limit spent finishing the first full pass
         self._start = time.perf_counter()  # the time limit counts sampling, not building and compiling
 
