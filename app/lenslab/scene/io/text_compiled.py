@@ -60,23 +60,6 @@ def _beyond_exact(data, start, end):
     return digits > 18 or mantissa > _EXACT_MANTISSA
 
 
-@njit(cache=True)
-def _read_exponent(data, i, n):
-    """The exponent after an ``e``: (value, index after it, ok)."""
-    negative = False
-    if i < n and (data[i] == 45 or data[i] == 43):
-        negative = data[i] == 45
-        i += 1
-    exponent = 0
-    seen = False
-    while i < n and 48 <= data[i] <= 57:
-        seen = True
-        if exponent < 100000:
-            exponent = exponent * 10 + (data[i] - 48)
-        i += 1
-    return (-exponent if negative else exponent), i, seen
-
-
 @njit(cache=True, inline="always")
 def _read_float(data, i, n, powers):
     """The decimal number at ``data[i:]``: (value, index after it, EXACT, INEXACT or NOT_A_NUMBER)."""
@@ -102,7 +85,7 @@ def _read_float(data, i, n, powers):
     # Perhaps more digits than a double holds exactly: counted where it is rare.
     beyond_exact = i - start > 15 and _beyond_exact(data, start, i)
     if i < n and (data[i] == 101 or data[i] == 69):  # e E
-        exponent, i, ok = _read_exponent(data, i + 1, n)
+        exponent, i, ok = _read_int(data, i + 1, n)
         if not ok:
             return 0.0, i, NOT_A_NUMBER
         scale += exponent
