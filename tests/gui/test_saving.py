@@ -89,7 +89,7 @@ def test_a_failed_save_leaves_the_open_scene_exactly_as_it_was(studio, tmp_path,
         def full_disk(scene, path):
             raise OSError(errno.ENOSPC, "No space left on device")
 
-        monkeypatch.setattr("lenslab.gui.main_window.save_scene", full_disk)
+        monkeypatch.setattr(studio.files, "write_scene", full_disk)  # the file controller's scene writer
     assert not studio._write(target)
     assert len(shown) == 1 and shown[0].count(str(target)) == 1  # the file named once, with the reason
     assert not target.exists()

@@ -315,7 +315,7 @@ def test_file_dialogs_start_in_the_folder_used_last_even_after_a_restart(qtbot, 
             return ExportRequest(scene=scene, path=images / "shot.png", target_spp=1, seconds=None,
                                  exposure_stops=0.0, tone_map="filmic")
 
-    monkeypatch.setattr(main_window, "ExportDialog", Dialog)
+    monkeypatch.setattr(window.export_flow, "make_dialog", Dialog)  # the export flow's dialog
 
     window.open_dialog()
     window.save_as()
@@ -333,6 +333,7 @@ def test_file_dialogs_start_in_the_folder_used_last_even_after_a_restart(qtbot, 
     again.import_dialog()
     assert asked["import"] == str(meshes)
     Dialog.started_at.clear()
+    monkeypatch.setattr(again.export_flow, "make_dialog", Dialog)
     monkeypatch.setattr(Dialog, "exec", lambda self: QDialog.Rejected)
     again.export_dialog()
     assert Dialog.started_at[0].parent == images

@@ -3,10 +3,14 @@
 Modules, one job each:
 
 * :mod:`.app`          - ``run_studio``: the QApplication, theme, and the window from the command line
-* :mod:`.main_window`  - the window's assembly: docks, status bar, the viewport's toolbar, edits
+* :mod:`.main_window`  - the window's assembly: the viewport, docks, menus and status bar, wired together
 * :mod:`.actions`      - every action and the menus, declared as data (text, shortcut, handler, enabled-when)
 * :mod:`.file_controller` - new, open, save, recent files, mesh import, drag and drop
 * :mod:`.export_flow`  - the export dialog, progress, cancel and the result
+* :mod:`.edit_controller` - the edits of the Edit menu: add, duplicate, delete, rename
+* :mod:`.viewport_toolbar` - the viewport's toolbar: tools, zoom, display exposure and tone map, resolution, limit
+* :mod:`.viewport_tools` - the pointer over the picture: readout, click to select, click to focus, render region
+* :mod:`.render_status` - frames into the viewport, the status bar's progress, device, corner tag, pause, errors
 * :mod:`.document`     - the open scene, its undo stack, selection and lens; targets that address its parts
 * :mod:`.commands`     - every edit as a QUndoCommand
 * :mod:`.render_loop`  - the progressive render loop (preview, full passes, denoise, picks, exports), Qt-free

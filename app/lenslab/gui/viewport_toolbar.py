@@ -1,0 +1,154 @@
+"""The viewport's toolbar: the tools, fit and the zoom, the display exposure (a slider, a field and a reset, one
+setting), the tone map, the viewport's resolution, the denoiser, the sample limit, pause and restart. The
+display settings change what the picture looks like, never what is rendered."""
+
+from __future__ import annotations
+
+import math
+
+from PySide6.QtCore import QObject, QSettings, Qt
+from PySide6.QtGui import QAction
+from PySide6.QtWidgets import QComboBox, QLabel, QSizePolicy, QToolBar, QToolButton, QWidget
+
+from lenslab.gui.controller import SAMPLE_LIMITS, RenderController
+from lenslab.gui.viewport import Viewport
+from lenslab.gui.widgets import ResetSlider, SignedNumberEdit
+from lenslab.render.film import TONE_MAPS
+
+DISPLAY_EXPOSURE_STOPS = 6.0  # the display exposure slider reaches this many stops either way
+
+
+def saved_look(settings: QSettings) -> tuple[float, str]:
+    """The viewport's exposure and tone map from the last session; a value edited by hand or written by
+    another version falls back to the default rather than stopping the studio."""
+    try:
+        exposure = float(settings.value("viewport/exposure", 0.0))
+    except (TypeError, ValueError):
+        exposure = 0.0
+    if not math.isfinite(exposure):
+        exposure = 0.0
+    exposure = min(DISPLAY_EXPOSURE_STOPS, max(-DISPLAY_EXPOSURE_STOPS, exposure))
+    tone_map = str(settings.value("viewport/tone_map", "filmic"))
+    return exposure, tone_map if tone_map in TONE_MAPS else "filmic"
+
+
+class ViewportToolbar(QObject):
+    """The toolbar above the viewport (``bar``, named "viewportBar") and what its own widgets do: the display
+    exposure and tone map go to the viewport (and the controller), the resolution and sample limit to the
+    controller. The window's actions (tools, fit, denoise, pause, restart) are placed on it as they are."""
+
+    def __init__(self, actions: dict[str, QAction], viewport: Viewport, controller: RenderController,
+                 parent: QObject | None = None):
+        super().__init__(parent)
+        self.viewport = viewport
+        self.controller = controller
+        bar = self.bar = QToolBar()
+        bar.setObjectName("viewportBar")
+        bar.setMovable(False)
+        for name in ("tool_select", "tool_focus", "tool_pan", "tool_region"):
+            bar.addAction(actions[name])
+        bar.addSeparator()
+        bar.addAction(actions["fit"])
+        self.zoom_label = QLabel("Fit")
+        self.zoom_label.setObjectName("readout")
+        self.zoom_label.setMinimumWidth(44)
+        bar.addWidget(self.zoom_label)
+        bar.addSeparator()
+        exposure_label = QLabel(" EV ")
+        exposure_label.setToolTip("Display exposure")
+        bar.addWidget(exposure_label)
+        # The slider, a field to type a value into (1.5 is +1.5 EV; the arrows step a tenth) and a reset to 0,
+        # all three the same setting (display only).
+        self.exposure_slider = ResetSlider(Qt.Horizontal, default=0)
+        self.exposure_slider.setRange(round(-10 * DISPLAY_EXPOSURE_STOPS), round(10 * DISPLAY_EXPOSURE_STOPS))
+        self.exposure_slider.setFixedWidth(110)
+        self.exposure_slider.setValue(round(self.viewport.exposure * 10))
+        self.exposure_slider.setToolTip("Display exposure in stops (display only: the render is not restarted); "
+                                        "double-click: back to 0")
+        self.exposure_spin = SignedNumberEdit(-DISPLAY_EXPOSURE_STOPS, DISPLAY_EXPOSURE_STOPS, 1, 0.1, " EV")
+        self.exposure_spin.setObjectName("displayExposure")
+        self.exposure_spin.setFixedWidth(70)
+        self.exposure_spin.setToolTip("Display exposure in stops: type a value (1.5 is +1.5 EV); the arrow keys "
+                                      "and the wheel step a tenth")
+        self.exposure_reset = QToolButton()
+        self.exposure_reset.setObjectName("exposureReset")
+        self.exposure_reset.setText("\u21ba")  # ↺
+        self.exposure_reset.setStyleSheet("QToolButton { border: 1px solid #45464b; padding: 0px 5px; }"
+                                          "QToolButton:disabled { color: #5c5e62; border-color: #38393c; }")
+        self.exposure_reset.setToolTip("Display exposure back to 0 EV (or double-click the slider)")
+        bar.addWidget(self.exposure_slider)
+        bar.addWidget(self.exposure_spin)
+        bar.addWidget(self.exposure_reset)
+        self.tone_combo = QComboBox()
+        self.tone_combo.setObjectName("toneMap")
+        for name in TONE_MAPS:
+            self.tone_combo.addItem(name.capitalize(), name)
+        self.tone_combo.setCurrentIndex(max(0, self.tone_combo.findData(self.viewport.tone_map)))
+        self.tone_combo.setToolTip("Tone map: how radiance above 1 is brought into the displayable range "
+                                   "(filmic by default)")
+        bar.addWidget(self.tone_combo)
+        spacer = QWidget()
+        spacer.setSizePolicy(QSizePolicy.Expanding, QSizePolicy.Preferred)
+        bar.addWidget(spacer)
+        self.quality_combo = QComboBox()
+        for name, label in (("auto", "Auto res"), ("full", "Full res"), ("half", "½ res"), ("quarter", "¼ res"),
+                            ("export", "Export res")):
+            self.quality_combo.addItem(label, name)
+        self.quality_combo.setCurrentIndex(max(0, self.quality_combo.findData(self.controller.quality)))
+        self.quality_combo.setToolTip("The viewport's resolution: a fraction of its own size in pixels (Auto: all "
+                                      "of them on a GPU, at most 800 on the long side on the CPU), or the "
+                                      "export's own pixels")
+        bar.addWidget(self.quality_combo)
+        bar.addAction(actions["denoise"])
+        self.limit_combo = QComboBox()
+        for spp in SAMPLE_LIMITS:
+            self.limit_combo.addItem(f"{spp} spp" if spp else "∞ spp", spp)
+        self.limit_combo.setCurrentIndex(max(0, self.limit_combo.findData(self.controller.target_spp)))
+        self.limit_combo.setToolTip("The viewport stops refining at this many samples per pixel")
+        bar.addWidget(self.limit_combo)
+        bar.addAction(actions["pause"])
+        bar.addAction(actions["restart"])
+        self._update_exposure_label()
+        v = viewport
+        v.zoom_changed.connect(lambda s: self.zoom_label.setText("Fit" if v.zoom is None else f"{s * 100:.0f}%"))
+        self.exposure_slider.valueChanged.connect(lambda tenths: self.set_display_exposure(tenths / 10))
+        self.exposure_spin.valueChanged.connect(self.set_display_exposure)
+        self.exposure_reset.clicked.connect(lambda: self.set_display_exposure(0.0))
+        self.tone_combo.currentIndexChanged.connect(self._tone_changed)
+        self.quality_combo.currentIndexChanged.connect(self._quality_changed)
+        self.limit_combo.currentIndexChanged.connect(self._limit_changed)
+
+    def frame_shown(self, _frame=None) -> None:
+        """A new picture in the viewport: the zoom says "Fit" while the picture fits the window."""
+        if self.viewport.zoom is None:
+            self.zoom_label.setText("Fit")
+
+    def set_display_exposure(self, stops: float) -> None:
+        """The viewport's display exposure, from the slider, the field or the reset: each shows it after."""
+        stops = min(DISPLAY_EXPOSURE_STOPS, max(-DISPLAY_EXPOSURE_STOPS, round(float(stops), 1)))
+        if stops != self.viewport.exposure:
+            self.viewport.set_display(exposure=stops)
+            self.controller.set_display(self.viewport.exposure, self.viewport.tone_map)
+        self._update_exposure_label()
+
+    def _update_exposure_label(self) -> None:
+        """The slider and the field show the viewport's exposure (without telling anyone again)."""
+        for widget, value in ((self.exposure_slider, round(self.viewport.exposure * 10)),
+                              (self.exposure_spin, self.viewport.exposure)):
+            widget.blockSignals(True)
+            widget.setValue(value)
+            widget.blockSignals(False)
+        self.exposure_reset.setEnabled(self.viewport.exposure != 0)
+
+    def _tone_changed(self, _index: int) -> None:
+        self.viewport.set_display(operator=self.tone_combo.currentData())
+        self.controller.set_display(self.viewport.exposure, self.viewport.tone_map)
+
+    def _quality_changed(self, _index: int) -> None:
+        self.controller.set_quality(self.quality_combo.currentData())
+
+    def _limit_changed(self, _index: int) -> None:
+        self.controller.set_target_spp(self.limit_combo.currentData())
+
+
+__all__ = ["ViewportToolbar", "DISPLAY_EXPOSURE_STOPS", "saved_look"]
