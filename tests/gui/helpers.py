@@ -20,7 +20,7 @@ def wait_for_frame(qtbot, window, min_spp: int = 1, generation: int | None = Non
 def wait_for_gbuffer(qtbot, window, timeout: int = 20000):
     def ready():
         g = window.viewport.gbuffer
-        assert g is not None and g.generation >= window._structure_generation
+        assert g is not None and g.generation >= window.tools.structure_generation
 
     qtbot.waitUntil(ready, timeout=timeout)
     return window.viewport.gbuffer

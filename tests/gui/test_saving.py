@@ -90,7 +90,7 @@ def test_a_failed_save_leaves_the_open_scene_exactly_as_it_was(studio, tmp_path,
             raise OSError(errno.ENOSPC, "No space left on device")
 
         monkeypatch.setattr(studio.files, "write_scene", full_disk)  # the file controller's scene writer
-    assert not studio._write(target)
+    assert not studio.files.write(target)
     assert len(shown) == 1 and shown[0].count(str(target)) == 1  # the file named once, with the reason
     assert not target.exists()
     assert_untouched(studio, *before, heard)
@@ -108,7 +108,7 @@ def test_saving_into_another_folder_renames_mesh_paths_and_the_studio_hears_of_i
     doc.model.events.changed.connect(heard.append)
     (tmp_path / "shots" / "b").mkdir()
     target = tmp_path / "shots" / "b" / "scene.json"
-    assert studio._write(target)
+    assert studio.files.write(target)
     renamed = str(Path("..") / "a" / "meshes" / "tetra.obj")
     # The file names the same mesh from its own folder; so does the open scene, which said so.
     saved = load_scene(target)

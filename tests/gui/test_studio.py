@@ -367,7 +367,7 @@ def answer_next_prompt(window, button):
     seen = []
 
     def answer():
-        box = window._unsaved_box or QApplication.activeModalWidget()
+        box = window.files.unsaved_box or QApplication.activeModalWidget()
         if box is None:
             QTimer.singleShot(20, answer)
             return

@@ -285,10 +285,6 @@ class MainWindow(QMainWindow):
         self._update_actions()
 
     # -- the viewport's tools and display: the toolbar and the tools do them ------------------------------------
-    @property
-    def _structure_generation(self) -> int:
-        return self.tools.structure_generation
-
     def set_tool(self, tool: str) -> None:
         self.tools.set_tool(tool)
 
@@ -356,18 +352,11 @@ class MainWindow(QMainWindow):
     def save_as(self) -> bool:
         return self.files.save_as()
 
-    def _write(self, path: Path) -> bool:
-        return self.files.write(path)
-
     def import_dialog(self) -> None:
         self.files.import_dialog()
 
     def import_mesh(self, path: Path) -> None:
         self.files.import_mesh(path)
-
-    @property
-    def _unsaved_box(self) -> QMessageBox | None:
-        return self.files.unsaved_box
 
     def dragEnterEvent(self, event) -> None:
         self.files.drag_enter(event)
