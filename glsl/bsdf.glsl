@@ -5,8 +5,11 @@
 // materials are two-sided without the user having to say so, and dielectrics know from front_face
 // whether the ray is entering or leaving.
 //
-// A material is MATERIAL_ROWS vec4 rows (render/buffers.py's pack_material); its type, one of the MATERIAL_*
-// codes, is in row 0, w. Both come from render/gpu_layout.py as #defines.
+// A material is MATERIAL_ROWS vec4 rows (scene/materials/, packed through render/buffers.py's pack_material);
+// its type, one of the MATERIAL_* codes, is in row 0, w. Both come from render/gpu_layout.py as #defines.
+// Each kind's own code is in its include, glsl/material_<kind>.glsl; "material_kinds.glsl" is generated from
+// the registry (scene/materials/registry.py's glsl_dispatch): it includes them all and defines material_eval
+// and material_sample, which bsdf_eval_untilted and bsdf_sample_untilted below call for the Bsdf's kind.
 
 vec4 material_row(int m, int row) { return materials[MATERIAL_ROWS * m + row]; }
 int material_type(int m) { return int(material_row(m, 0).w); }
@@ -14,17 +17,6 @@ int material_type(int m) { return int(material_row(m, 0).w); }
 int inner_material(int m) { return int(material_row(m, 2).x); }
 // Whether a hit on m scatters light: everything but a light without a surface.
 bool material_scatters(int m) { return material_type(m) != MATERIAL_EMISSIVE || inner_material(m) >= 0; }
-
-// Radiance a surface emits towards wo.
-vec3 emitted_radiance(int m, bool front_face) {
-    vec4 e = material_row(m, 1);
-    return (front_face || e.w > 0.5) ? e.xyz : vec3(0.0);
-}
-
-// Beer-Lambert absorption coefficient (per metre) inside a dielectric; zero elsewhere.
-vec3 material_absorption(int m) {
-    return HAS_MATERIAL(MATERIAL_DIELECTRIC) && material_type(m) == MATERIAL_DIELECTRIC ? material_row(m, 5).xyz : vec3(0.0);
-}
 
 // A material's parameters at one surface point, textures resolved.
 struct Bsdf {
@@ -43,65 +35,37 @@ struct Bsdf {
     float terminator;  // their shadowing term's alpha^2 (shadow_terminator); 0: none
 };
 
-// -- Materials that hold materials (scene/materials.py) --------------------------------------------------
+// -- Materials that hold materials (scene/materials/) ----------------------------------------------------
 // A hit on one walks down to the material that scatters: a light's surface, one of a blend's two (picked
 // with the blend's odds, which keeps the estimate unbiased, as pbrt-v4's MixMaterial), the material under a
 // mask (whose cut-out traversal already applied: mask.glsl) or under a bump or normal map, which tilt the
 // shading normal on the way. Compiled only for scenes that have such materials (HAS_NESTED_MATERIALS).
 
-// A number in [0, 1) from the hit itself, so that choosing within a blend takes no dimension of the sampler.
-float hit_hash(SurfaceHit s, int level) {
-    return hash_unit(s.p, s.wo.xy, floatBitsToUint(s.wo.z) + uint(level));
-}
-
 // A texture's scalar value, as Mitsuba's eval_1 reads a colour texture: its luminance.
 float texture_value(int t, vec2 uv) { return luminance(texture_rgb(t, uv)); }
-
-// d value / d(u, v) by differences over a step small against a texel: within a texel that is the bilinear
-// filter's exact slope. The step grows with |uv| so that float spacing never swamps it. Three lookups in a
-// loop rather than unrolled calls: each inlined lookup is a large piece of a kernel llvmpipe must compile.
-// A checkerboard's value, and a nearest-filtered image's, is flat but for its edges, whose slope is
-// infinite: zero, as Mitsuba's eval_1_grad.
-vec2 texture_value_gradient(int t, vec2 uv) {
-    vec4 r0 = materials[texture_base + TEXTURE_ROWS * t], r3 = materials[texture_base + TEXTURE_ROWS * t + 3];
-    if (int(r0.x) == TEXTURE_CHECKER || int(r3.z) == TEXTURE_FILTER_NEAREST) return vec2(0.0);
-    float h = max(6.1e-5, 1.2e-4 * max(abs(uv.x), abs(uv.y)));
-    vec3 values;
-    for (int i = 0; i < 3; i++) values[i] = texture_value(t, uv + h * vec2(i == 1, i == 2));
-    return (values.yz - values.x) / h;
-}
-
-// Mitsuba's bumpmap: the surface moves by the height h(u, v) along the normal, so its tangents gain the
-// height's slopes: dp/du' = dp/du projected onto the tangent plane + n dh/du (likewise v), n' = dp/du' x dp/dv',
-// on the side of the geometric normal. All in the front face's orientation.
-vec3 bumped_normal(SurfaceHit s, vec3 n, vec3 ng, int texture, float scale) {
-    vec3 dpdu, dpdv;
-    surface_tangents(s, n, dpdu, dpdv);
-    vec2 slope = scale * texture_value_gradient(texture, s.uv);
-    vec3 du = dpdu + n * (slope.x - dot(n, dpdu));
-    vec3 dv = dpdv + n * (slope.y - dot(n, dpdv));
-    vec3 bumped = cross(du, dv);
-    if (dot(bumped, bumped) <= 0.0) return n;
-    bumped = normalize(bumped);
-    return dot(bumped, ng) < 0.0 ? -bumped : bumped;
-}
-
-// Mitsuba's normalmap: the texture's (2 rgb - 1) in the shading frame whose tangent follows dp/du.
-vec3 mapped_normal(SurfaceHit s, vec3 n, int texture) {
-    vec3 dpdu, dpdv;
-    surface_tangents(s, n, dpdu, dpdv);
-    vec3 t = dpdu - n * dot(n, dpdu);
-    t = dot(t, t) > 0.0 ? normalize(t) : frame_around(n)[0];
-    vec3 c = 2.0 * texture_rgb(texture, s.uv) - 1.0;
-    vec3 mapped = c.x * t + c.y * cross(n, t) + c.z * n;
-    return dot(mapped, mapped) > 0.0 ? normalize(mapped) : n;
-}
 
 // A tilted normal the viewer sees from behind (along wo, below its tangent plane) would shade nothing:
 // mirror its tilt across the untilted normal n instead, as Mitsuba's flip_invalid_normals (on by default).
 vec3 facing_viewer(vec3 tilted, vec3 n, vec3 wo) {
     return dot(wo, tilted) > 0.0 ? tilted : 2.0 * dot(tilted, n) * n - tilted;
 }
+
+// b is of material type `code`: false at compile time for types the scene lacks (features.glsl).
+bool is_type(Bsdf b, int code) { return HAS_MATERIAL(code) && b.type == code; }
+
+vec3 to_local(Bsdf b, vec3 w) { return w * b.frame; }  // = transpose(frame) * w
+vec3 to_world(Bsdf b, vec3 w) { return b.frame * w; }
+
+// What a kind's sample function (material_sample) did: failed (bsdf_sample_untilted returns false), finished
+// (wi_world, weight and pdf are final: returns true), or chose wi, transmit and pdf, for the checks every kind
+// shares.
+const int BSDF_SAMPLE_FAILED = 0;
+const int BSDF_SAMPLE_DONE = 1;
+const int BSDF_SAMPLE_CONTINUE = 2;
+
+vec3 bsdf_eval_untilted(SurfaceHit s, Bsdf b, vec3 wi_world, out float pdf);  // plastic's sampling weighs by it
+
+#include "material_kinds.glsl"
 
 // The material that scatters at s, its shading normal (s.ns, tilted by bump and normal maps) and the alpha^2
 // of their shadowing term (0: none).
@@ -163,9 +127,6 @@ float shadow_terminator(Bsdf b, vec3 wi) {
     return 2.0 / (1.0 + sqrt(1.0 + b.terminator * max(0.0, 1.0 - c2) / c2));
 }
 
-// b is of material type `code`: false at compile time for types the scene lacks (features.glsl).
-bool is_type(Bsdf b, int code) { return HAS_MATERIAL(code) && b.type == code; }
-
 Bsdf bsdf_at(SurfaceHit s) {
     Bsdf b;
     vec3 ns;
@@ -198,59 +159,6 @@ bool bsdf_is_delta(Bsdf b) {
            ((is_type(b, MATERIAL_CONDUCTOR) || is_type(b, MATERIAL_DIELECTRIC)) && b.alpha == 0.0);
 }
 
-vec3 to_local(Bsdf b, vec3 w) { return w * b.frame; }  // = transpose(frame) * w
-vec3 to_world(Bsdf b, vec3 w) { return b.frame * w; }
-
-// -- plastic ------------------------------------------------------------------------------------------
-// Share of light the coating lets through at this angle: 1 - Fresnel when smooth, the rough interface's
-// tabulated directional transmittance otherwise (render/fresnel.rough_transmittance_table, as Mitsuba's
-// roughplastic: the microfacets shadow part of what refracts, so it is less than 1 - reflectance).
-float plastic_transmittance(Bsdf b, float cos_theta) {
-    if (b.alpha == 0.0) return 1.0 - fresnel_dielectric(cos_theta, b.eta);
-    float x = clamp(cos_theta, 0.0, 1.0) * float(ROUGH_TABLE_SIZE - 1);
-    int i = min(int(x), ROUGH_TABLE_SIZE - 2);
-    uint at = uint(b.transmittance_table + i);
-    return mix(uintBitsToFloat(image_data[at]), uintBitsToFloat(image_data[at + 1u]), x - float(i));
-}
-
-// The probability of choosing the coating's reflection when sampling (Mitsuba's heuristic).
-float plastic_specular_probability(Bsdf b, float cos_o) {
-    float f = 1.0 - plastic_transmittance(b, cos_o);
-    float d = (b.color.x + b.color.y + b.color.z) / 3.0;
-    float spec_weight = 1.0 / (1.0 + d);
-    float p_spec = f * spec_weight;
-    float p_diff = (1.0 - f) * (1.0 - spec_weight);
-    return p_spec / max(p_spec + p_diff, 1e-12);
-}
-
-vec3 plastic_diffuse(Bsdf b, float cos_o, float cos_i) {
-    float t = plastic_transmittance(b, cos_i) * plastic_transmittance(b, cos_o);
-    return b.color / (1.0 - b.internal_reflectance) * (t / (b.eta * b.eta)) * INV_PI * cos_i;
-}
-
-// -- rough dielectric (Walter et al. 2007, as pbrt-v4's DielectricBxDF) -----------------------------------
-vec3 rough_dielectric_eval(Bsdf b, vec3 wo, vec3 wi, out float pdf) {
-    pdf = 0.0;
-    bool reflect = wi.z > 0.0;
-    vec3 m = reflect ? normalize(wo + wi) : normalize(wi * b.eta + wo);
-    if (m.z < 0.0) m = -m;
-    if (dot(m, wi) * wi.z < 0.0 || dot(m, wo) * wo.z < 0.0) return vec3(0.0);  // back-facing microfacet
-    float f = fresnel_dielectric(dot(wo, m), b.eta);
-    float vis_pdf = microfacet_pdf(wo, m, b.alpha, b.beckmann);
-    float d = microfacet_d(m, b.alpha, b.beckmann), g = microfacet_g(wo, wi, b.alpha, b.beckmann);
-    if (reflect) {
-        pdf = vis_pdf / (4.0 * abs(dot(wo, m))) * f;
-        return b.tint * (d * g * f / (4.0 * wo.z));
-    }
-    float denom = dot(wi, m) + dot(wo, m) / b.eta;
-    denom *= denom;
-    if (denom == 0.0) return vec3(0.0);
-    float dm_dwi = abs(dot(wi, m)) / denom;
-    pdf = vis_pdf * dm_dwi * (1.0 - f);
-    float ft = (1.0 - f) * d * g * abs(dot(wi, m) * dot(wo, m) / (wo.z * denom));
-    return b.tint * (ft / (b.eta * b.eta));  // radiance is compressed entering denser media: 1/eta^2
-}
-
 // f(wo, wi) |cos theta_i| and the density with which bsdf_sample would choose wi (solid angle).
 // b is bsdf_at(s), resolved once per hit and shared by evaluation and sampling.
 vec3 bsdf_eval_untilted(SurfaceHit s, Bsdf b, vec3 wi_world, out float pdf) {
@@ -259,33 +167,7 @@ vec3 bsdf_eval_untilted(SurfaceHit s, Bsdf b, vec3 wi_world, out float pdf) {
     vec3 wo = to_local(b, s.wo), wi = to_local(b, wi_world);
     if (wo.z <= 0.0) return vec3(0.0);
     bool same_side = dot(wi_world, s.ng) > 0.0;  // the geometric normal decides, so shading normals never leak
-    if (is_type(b, MATERIAL_DIELECTRIC)) {
-        if (same_side != (wi.z > 0.0)) return vec3(0.0);
-        return rough_dielectric_eval(b, wo, wi, pdf);
-    }
-    if (!same_side || wi.z <= 0.0) return vec3(0.0);
-    if (is_type(b, MATERIAL_DIFFUSE)) {
-        pdf = wi.z * INV_PI;
-        return b.color * INV_PI * wi.z;
-    }
-    vec3 m = normalize(wo + wi);
-    if (is_type(b, MATERIAL_CONDUCTOR)) {
-        pdf = microfacet_pdf(wo, m, b.alpha, b.beckmann) / (4.0 * dot(wo, m));
-        vec3 f = fresnel_conductor(dot(wo, m), b.eta3, b.k);
-        return b.tint * f * (microfacet_d(m, b.alpha, b.beckmann) * microfacet_g(wo, wi, b.alpha, b.beckmann) / (4.0 * wo.z));
-    }
-    if (is_type(b, MATERIAL_PLASTIC)) {
-        float p_spec = plastic_specular_probability(b, wo.z);
-        vec3 value = plastic_diffuse(b, wo.z, wi.z);
-        pdf = (1.0 - p_spec) * wi.z * INV_PI;
-        if (b.alpha > 0.0) {
-            float f = fresnel_dielectric(dot(wo, m), b.eta);
-            value += vec3(f * microfacet_d(m, b.alpha, b.beckmann) * microfacet_g(wo, wi, b.alpha, b.beckmann) / (4.0 * wo.z));
-            pdf += p_spec * microfacet_pdf(wo, m, b.alpha, b.beckmann) / (4.0 * dot(wo, m));
-        }
-        return value;
-    }
-    return vec3(0.0);
+    return material_eval(b, wo, wi, same_side, pdf);
 }
 
 // Sample wi given three uniform numbers; weight = f |cos| / pdf. delta: a Dirac lobe was chosen
@@ -299,84 +181,8 @@ bool bsdf_sample_untilted(SurfaceHit s, Bsdf b, vec3 u, out vec3 wi_world, out v
     if (wo.z <= 0.0 || b.type == MATERIAL_EMISSIVE) return false;
     vec3 wi;
     bool transmit = false;
-
-    if (is_type(b, MATERIAL_DIFFUSE)) {
-        wi = sample_cosine_hemisphere(u.xy);
-        pdf = wi.z * INV_PI;
-        weight = b.color;
-    } else if (is_type(b, MATERIAL_CONDUCTOR)) {
-        vec3 m = b.alpha == 0.0 ? vec3(0.0, 0.0, 1.0) : microfacet_sample(wo, b.alpha, b.beckmann, u.xy);
-        wi = 2.0 * dot(wo, m) * m - wo;
-        if (wi.z <= 0.0) return false;
-        vec3 f = b.tint * fresnel_conductor(dot(wo, m), b.eta3, b.k);
-        if (b.alpha == 0.0) {
-            delta = true;
-            pdf = 1.0;
-            weight = f;
-        } else {
-            pdf = microfacet_pdf(wo, m, b.alpha, b.beckmann) / (4.0 * dot(wo, m));
-            weight = f * microfacet_reflection_weight(wo, wi, m, b.alpha, b.beckmann);
-        }
-    } else if (is_type(b, MATERIAL_PLASTIC)) {
-        float p_spec = plastic_specular_probability(b, wo.z);
-        if (u.z < p_spec) {
-            vec3 m = b.alpha == 0.0 ? vec3(0.0, 0.0, 1.0) : microfacet_sample(wo, b.alpha, b.beckmann, u.xy);
-            wi = 2.0 * dot(wo, m) * m - wo;
-            if (wi.z <= 0.0) return false;
-            if (b.alpha == 0.0) {
-                delta = true;
-                pdf = p_spec;
-                weight = vec3(fresnel_dielectric(wo.z, b.eta) / p_spec);
-            }
-        } else {
-            wi = sample_cosine_hemisphere(u.xy);
-        }
-        if (!delta) {  // both lobes can produce this direction: weigh by the full density
-            wi_world = to_world(b, wi);
-            if (dot(wi_world, s.ng) <= 0.0) return false;
-            vec3 f = bsdf_eval_untilted(s, b, wi_world, pdf);
-            if (pdf <= 0.0) return false;
-            weight = f / pdf;
-            return true;
-        }
-    } else if (is_type(b, MATERIAL_THIN_DIELECTRIC)) {
-        float r = fresnel_dielectric(wo.z, b.eta);
-        if (r < 1.0) r += (1.0 - r) * (1.0 - r) * r / (1.0 - r * r);  // inter-reflections inside the pane
-        delta = true;
-        weight = b.tint;
-        if (u.z < r) {
-            wi = vec3(-wo.xy, wo.z);
-            pdf = r;
-        } else {
-            wi = -wo;
-            pdf = 1.0 - r;
-            transmit = true;
-        }
-    } else if (is_type(b, MATERIAL_DIELECTRIC)) {
-        vec3 m = b.alpha == 0.0 ? vec3(0.0, 0.0, 1.0) : microfacet_sample(wo, b.alpha, b.beckmann, u.xy);
-        float f = fresnel_dielectric(dot(wo, m), b.eta);
-        if (u.z < f) {
-            wi = 2.0 * dot(wo, m) * m - wo;
-            if (wi.z <= 0.0) return false;
-        } else {
-            if (!refract_dir(wo, m, b.eta, wi) || wi.z >= 0.0) return false;
-            transmit = true;
-        }
-        if (b.alpha == 0.0) {
-            delta = true;
-            pdf = transmit ? 1.0 - f : f;
-            weight = transmit ? b.tint / (b.eta * b.eta) : b.tint;
-        } else {
-            wi_world = to_world(b, wi);
-            if ((dot(wi_world, s.ng) > 0.0) == transmit) return false;
-            vec3 value = rough_dielectric_eval(b, wo, wi, pdf);
-            if (pdf <= 0.0) return false;
-            weight = value / pdf;
-            return true;
-        }
-    } else {
-        return false;
-    }
+    int sampled = material_sample(s, b, u, wo, wi, transmit, wi_world, weight, pdf, delta);
+    if (sampled != BSDF_SAMPLE_CONTINUE) return sampled == BSDF_SAMPLE_DONE;
     wi_world = to_world(b, wi);
     // The sampled side must agree with the geometric normal: reflection stays, transmission crosses.
     if ((dot(wi_world, s.ng) > 0.0) == transmit) return false;

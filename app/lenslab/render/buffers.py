@@ -18,36 +18,28 @@ import numpy as np
 from lenslab.color import luminance
 from lenslab.render import kdtree_cache
 from lenslab.render.bsp import KdTree
-from lenslab.render.fresnel import (internal_diffuse_reflectance, rough_internal_reflectance, rough_reflectance_table,
-                                    rough_transmittance_table)
+from lenslab.render import fresnel
 from lenslab.render.environment import EnvironmentDistribution, environment_power, infinite_light_power
 from lenslab.render.gl import make_current
 from lenslab.limits import SceneTooLarge, format_bytes  # SceneTooLarge: raised here, imported from here
 from lenslab.render.gpu_layout import (ENV_CONSTANT, ENV_MAP, GEOMETRY_BINDING, GEOMETRY_ROWS,
                                        IMAGE_DATA_BINDING, KD_NODES_BINDING, LIGHT_AREA, LIGHT_CHOICE_BINDING,
                                        LIGHT_ENVIRONMENT, LIGHT_PLACES, LIGHT_POINT, LIGHT_ROWS, LIGHT_SUN,
-                                       LIGHTS_BINDING, MATERIAL_BLEND, MATERIAL_BUMP_MAP, MATERIAL_CONDUCTOR,
-                                       MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_EMISSIVE, MATERIAL_MASK,
-                                       MATERIAL_NESTING, MATERIAL_NORMAL_MAP, MATERIAL_PLASTIC, MATERIAL_ROWS,
-                                       MATERIAL_THIN_DIELECTRIC, MATERIALS_BINDING, MICROFACET_BECKMANN,
-                                       MICROFACET_GGX, PRIM_REFS_BINDING, SHADING_BINDING, SHADING_ROWS,
-                                       INSTANCES_BINDING)
+                                       LIGHTS_BINDING, MATERIAL_NESTING, MATERIAL_ROWS, MATERIALS_BINDING,
+                                       PRIM_REFS_BINDING, SHADING_BINDING, SHADING_ROWS, INSTANCES_BINDING)
 from lenslab.render.instancing import GroupCache, PackedGroup, join_layers, triangle_rows
 from lenslab.render.textures import TextureTable, read_texture_image
 from lenslab.scene.flatten import FlatScene
-from lenslab.scene.materials import (Blend, BumpMap, Conductor, Diffuse, Dielectric, Emissive, Mask, Material,
-                                     NormalMap, Plastic, ThinDielectric, WRAPPER_TYPES, inner_materials)
+from lenslab.scene.materials import Emissive, Material, inner_materials
+from lenslab.scene.materials.base import MICROFACET_CODES  # noqa: F401 (imported from here)
+from lenslab.scene.materials.registry import HOLDING_CODES, KINDS, WRAPPER_CODES, pack_record
 from lenslab.render.gpu_layout import LIGHT_SPOT, SPOT_PARAMS
 from lenslab.scene.lights import Light, PointLight, SpotLight, SunLight
 from lenslab.scene.scene import ConstantEnvironment, Environment, EnvironmentMap, SceneError
 from lenslab.scene.textures import Checkerboard, InlineImageTexture
 
-# Each material class's type code in its GPU record.
-MATERIAL_CODES = {Diffuse: MATERIAL_DIFFUSE, Emissive: MATERIAL_EMISSIVE, Conductor: MATERIAL_CONDUCTOR,
-                  Plastic: MATERIAL_PLASTIC, Dielectric: MATERIAL_DIELECTRIC, ThinDielectric: MATERIAL_THIN_DIELECTRIC,
-                  Blend: MATERIAL_BLEND, Mask: MATERIAL_MASK, BumpMap: MATERIAL_BUMP_MAP,
-                  NormalMap: MATERIAL_NORMAL_MAP}
-MICROFACET_CODES = {"ggx": MICROFACET_GGX, "beckmann": MICROFACET_BECKMANN}
+# Each material class's type code in its GPU record (its place in scene/materials/registry.py).
+MATERIAL_CODES = {kind.cls: kind.code for kind in KINDS}
 
 # Where each of the packed scene's arrays is bound.
 BINDINGS = {"kd_nodes": KD_NODES_BINDING, "prim_refs": PRIM_REFS_BINDING, "geometry": GEOMETRY_BINDING,
@@ -57,68 +49,23 @@ UNIFORM_BINDINGS = {"light_choice": LIGHT_CHOICE_BINDING}  # uniform blocks (gls
 MISSING_SKY = (0.2, 0.0, 0.2)  # what a scene whose environment map cannot be read is lit by
 
 
+class _PackContext:
+    """What a material kind's packing function may ask for (scene/materials/base.py's PackContext): the
+    texture table's records and float tables, and the Fresnel tables of render/fresnel.py."""
+
+    fresnel = fresnel
+
+    def __init__(self, textures: TextureTable):
+        self.index_of = textures.index_of
+        self.add_floats = textures.add_floats
+
+
 def pack_material(material: Material, textures: TextureTable, inner: Sequence[int] = ()) -> np.ndarray:
-    """MATERIAL_ROWS (eight) vec4 rows, read by glsl/bsdf.glsl's bsdf_at():
-    0 (albedo, type), 1 (emission, two-sided), 2 (eta rgb | ior, internal reflectance, reflectance table, alpha),
-    3 (k rgb, albedo texture), 4 (specular tint, roughness texture), 5 (absorption per metre, distribution),
-    6-7 spare. A material that holds others (``inner``: the indices of their records, see
-    :class:`MaterialTable`) keeps its parameter and texture in row 0 and those indices in row 2."""
-    record = np.zeros((MATERIAL_ROWS, 4), np.float32)
-    code = MATERIAL_CODES.get(type(material))
-    if code is None:
-        raise TypeError(f"no GPU packing for material type {type(material).__name__}")
-    record[0, 3] = code
-    record[3, 3] = record[4, 3] = -1.0  # no textures
-    record[4, :3] = 1.0
-    if code in HOLDING_CODES:
-        record[2, :2] = -1.0  # holds no material
-    for slot, index in enumerate(inner):
-        record[2, slot] = index
-    if isinstance(material, WRAPPER_TYPES):
-        value, texture = {Blend: ("weight", "weight_texture"), Mask: ("opacity", "opacity_texture"),
-                          BumpMap: ("scale", "texture"), NormalMap: (None, "texture")}[type(material)]
-        record[0, 0] = getattr(material, value) if value else 0.0
-        record[0, 1] = textures.index_of(getattr(material, texture))
-        record[0, 2] = float(getattr(material, "shadowing", False))  # bump and normal maps' shadowing term
-        return record
-    roughness = getattr(material, "roughness", 0.0)
-    record[2, 3] = roughness**2  # microfacet alpha from perceptual roughness
-    record[5, 3] = MICROFACET_CODES[getattr(material, "distribution", "ggx")]
-    if isinstance(material, (Diffuse, Plastic)):
-        record[0, :3] = material.albedo
-        record[3, 3] = textures.index_of(material.albedo_texture)
-    if isinstance(material, (Conductor, Plastic)):
-        record[4, 3] = textures.index_of(material.roughness_texture)
-    if isinstance(material, Emissive):
-        record[1, :3] = material.radiance
-        record[1, 3] = 1.0 if material.two_sided else 0.0
-    elif isinstance(material, Conductor):
-        eta, k = material.complex_ior()
-        record[2, :3], record[3, :3], record[4, :3] = eta, k, material.tint
-    elif isinstance(material, Plastic):
-        alpha = float(record[2, 3])
-        record[2, 0] = material.ior
-        if alpha > 0:
-            # A rough coating lets through a different share than Fresnel alone says: tabulate it, so the
-            # diffuse base gets exactly what the coating lets through (Plastic.coating says which share).
-            distribution = material.distribution
-            record[2, 1] = rough_internal_reflectance(material.ior, alpha, distribution)
-            if material.coating == "single_scattering":
-                through = rough_transmittance_table(material.ior, alpha, distribution)
-            else:
-                through = 1.0 - rough_reflectance_table(material.ior, alpha, distribution)
-            table = textures.add_floats(through.astype(np.float32))
-            record[2, 2] = np.int32(table).view(np.float32)
-        else:
-            record[2, 1] = internal_diffuse_reflectance(material.ior)
-    elif isinstance(material, Dielectric):
-        record[2, 0] = material.ior
-        record[4, :3] = material.tint
-        record[5, :3] = material.absorption_coefficient()
-    elif isinstance(material, ThinDielectric):
-        record[2, 0] = material.ior
-        record[4, :3] = material.tint
-    return record
+    """MATERIAL_ROWS (eight) vec4 rows, read by glsl/bsdf.glsl's bsdf_at(): the rows every kind shares, then
+    the kind's own (scene/materials/registry.py's pack_record; scene/materials/base.py lists the rows). A
+    material that holds others (``inner``: the indices of their records, see :class:`MaterialTable`) keeps its
+    parameter and texture in row 0 and those indices in row 2."""
+    return pack_record(material, _PackContext(textures), inner)
 
 
 class MaterialTable:
@@ -164,8 +111,8 @@ def held_materials(records: np.ndarray, used: Sequence[int]) -> set[int]:
     return seen
 
 
-WRAPPER_CODES = tuple(MATERIAL_CODES[cls] for cls in WRAPPER_TYPES)  # parameter and texture in row 0
-HOLDING_CODES = (MATERIAL_EMISSIVE, *WRAPPER_CODES)  # the records whose row 2 names records they hold
+# WRAPPER_CODES (parameter and texture in row 0) and HOLDING_CODES (row 2 names records they hold) come from
+# the registry, imported above: render/features.py imports them from here.
 
 
 def _emitted_power(flat: FlatScene) -> np.ndarray:

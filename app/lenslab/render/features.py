@@ -17,12 +17,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from lenslab.render.bsp import INTERSECTION_COST, KdTree
-from lenslab.render.buffers import HOLDING_CODES, MATERIAL_CODES, WRAPPER_CODES, PackedScene, held_materials
+from lenslab.render.buffers import HOLDING_CODES, WRAPPER_CODES, PackedScene, held_materials
 from lenslab.render.gpu_layout import (ENV_MAP, GEOMETRY_ROWS, LIGHT_AREA, LIGHT_ENVIRONMENT, LIGHT_POINT, LIGHT_ROWS,
                                        LIGHT_SPOT, LIGHT_SUN, MATERIAL_ROWS,
                                        MICROFACET_BECKMANN)
+from lenslab.scene.materials.registry import KINDS
 
-ALL_MATERIAL_TYPES = frozenset(MATERIAL_CODES.values())
+# Every registered material kind's type code (scene/materials/registry.py); each kind's feature bit in the
+# MATERIAL_TYPES mask is 1 << code (MaterialKind.feature_bit, glsl/features.glsl's HAS_MATERIAL).
+ALL_MATERIAL_TYPES = frozenset(kind.code for kind in KINDS)
 
 # Small scenes. Lanes of a SIMD group that walk a kd-tree each read their own nodes and wait for the lane
 # with the longest walk; a loop over every primitive reads each one once for all lanes and never diverges.
@@ -51,7 +54,7 @@ class KernelFeatures:
     # (a few lights), or by power (many). The general kernel has both and asks the uniform lights_at_point.
     lights_at_point: bool = True
     lights_by_power: bool = True
-    material_types: frozenset[int] = ALL_MATERIAL_TYPES  # render/buffers.py's MATERIAL_CODES
+    material_types: frozenset[int] = ALL_MATERIAL_TYPES  # type codes: scene/materials/registry.py's KINDS
     # Materials that hold materials (a light with a surface, blends, masks, bump and normal maps): the
     # resolve loop of glsl/bsdf.glsl.
     nested_materials: bool = True
@@ -76,7 +79,7 @@ class KernelFeatures:
             "HAS_LIGHTS_BY_POWER": int(self.lights_by_power),
             "HAS_NESTED_MATERIALS": int(self.nested_materials),
             "HAS_BECKMANN": int(self.beckmann),
-            "MATERIAL_TYPES": sum(1 << code for code in self.material_types),
+            "MATERIAL_TYPES": sum(KINDS[code].feature_bit for code in self.material_types),
         }
 
 

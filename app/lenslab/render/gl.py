@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
-from lenslab.render.gpu_layout import glsl_defines
+from lenslab.render.gpu_layout import glsl_defines, glsl_generated_includes
 from lenslab.resources import glsl_dir
 
 REQUIRED_GL = 430  # compute shaders and shader storage buffers
@@ -130,7 +130,8 @@ def _read(path: Path) -> str:
 
 def load_shader_source(name: str, defines: dict[str, object] | None = None, directory: Path | None = None) -> str:
     """Read ``glsl/<name>``, expand ``#include "file"`` (each file once) and put ``#define``s after #version:
-    the buffer layout every shader shares (gpu_layout.glsl_defines), then the caller's ``defines``."""
+    the buffer layout every shader shares (gpu_layout.glsl_defines), then the caller's ``defines``. An include
+    named in gpu_layout.glsl_generated_includes (the material kinds' dispatch) is that generated text, not a file."""
     layout = glsl_defines()
     clash = sorted(layout.keys() & (defines or {}).keys())
     if clash:
@@ -139,11 +140,14 @@ def load_shader_source(name: str, defines: dict[str, object] | None = None, dire
     defines = {**layout, **(defines or {})}
     directory = directory or glsl_dir()
     seen: set[str] = set()
+    generated = glsl_generated_includes()
 
     def expand(file_name: str) -> str:
         if file_name in seen:
             return ""
         seen.add(file_name)
+        if file_name in generated:
+            return _INCLUDE.sub(lambda m: expand(m.group(1)), generated[file_name])
         path = directory / file_name
         if not path.is_file():
             raise FileNotFoundError(f"shader {path} not found")

@@ -16,26 +16,17 @@ from lenslab import color as _color
 from lenslab.optics.aperture import APERTURE_KINDS, ROUNDED_BLADE_BINS as _ROUNDED_BLADE_BINS
 from lenslab.render import film as _film
 
-# -- Materials: MATERIAL_ROWS vec4 rows per material (buffers.pack_material, glsl/bsdf.glsl), its type
-# code in row 0, w.
-MATERIAL_DIFFUSE = 0
-MATERIAL_EMISSIVE = 1
-MATERIAL_CONDUCTOR = 2
-MATERIAL_PLASTIC = 3
-MATERIAL_DIELECTRIC = 4
-MATERIAL_THIN_DIELECTRIC = 5
-# Materials that hold materials (scene/materials.py): row 0 (parameter, its texture, -, type), row 2 the
-# indices of the records they hold. An Emissive's surface index is its row 2, x (-1: black).
-MATERIAL_BLEND = 6
-MATERIAL_MASK = 7
-MATERIAL_BUMP_MAP = 8
-MATERIAL_NORMAL_MAP = 9
-MATERIAL_ROWS = 8
-# How deep materials may hold one another: glsl/bsdf.glsl's resolve loop runs at most this many steps.
-MATERIAL_NESTING = 8
-# A microfacet material's distribution (row 5, w).
-MICROFACET_GGX = 0
-MICROFACET_BECKMANN = 1
+# -- Materials: MATERIAL_ROWS vec4 rows per material (scene/materials/base.py describes them; packed through
+# buffers.pack_material, read by glsl/bsdf.glsl), its type code in row 0, w. The numbers belong to the material
+# kinds (lenslab.scene.materials): each kind's MATERIAL_<KIND> code is its place in the registry
+# (scene/materials/registry.py), re-exported here under the same names, as the rest of the layout.
+# MATERIAL_NESTING: how deep materials may hold one another (glsl/bsdf.glsl's resolve loop runs at most this
+# many steps). A microfacet material's distribution is row 5, w: MICROFACET_*.
+from lenslab.scene.materials.base import (MATERIAL_NESTING, MATERIAL_ROWS,  # noqa: E402
+                                          MICROFACET_BECKMANN, MICROFACET_GGX)
+from lenslab.scene.materials.registry import GLSL_DISPATCH_INCLUDE, MATERIAL_CODES, glsl_dispatch  # noqa: E402
+
+globals().update(MATERIAL_CODES)  # MATERIAL_DIFFUSE = 0, MATERIAL_EMISSIVE = 1, ... (registration order)
 
 # Entries of a rough plastic coating's reflectance table (render/fresnel.py), over cos theta in [0, 1].
 ROUGH_TABLE_SIZE = 64
@@ -139,6 +130,15 @@ def glsl_defines() -> dict[str, int | str]:
     itself; a float is its text as GLSL reads it (:func:`glsl_float`)."""
     return {name: glsl_float(value) if type(value) is float else value for name, value in globals().items()
             if name.isupper() and not name.startswith("_") and type(value) in (int, float)}
+
+
+def glsl_generated_includes() -> dict[str, str]:
+    """GLSL made from Python rather than read from glsl/, by the name shaders #include it under: the material
+    kinds' includes and dispatch (scene/materials/registry.py's glsl_dispatch), included by glsl/bsdf.glsl."""
+    return {GLSL_DISPATCH_INCLUDE: _MATERIAL_DISPATCH}
+
+
+_MATERIAL_DISPATCH = glsl_dispatch()
 
 
 def glsl_float(value: float) -> str:

@@ -1,0 +1,30 @@
+"""Diffuse: Lambertian reflection. GLSL: glsl/material_diffuse.glsl."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import ClassVar
+
+import numpy as np
+
+from lenslab.scene.materials.base import RGB, Material, PackContext
+from lenslab.scene.materials.spec import MaterialKind
+from lenslab.scene.textures import Texture
+
+
+@dataclass
+class Diffuse(Material):
+    """Lambertian reflection: radiance scattered equally in every direction of the hemisphere."""
+
+    type_name: ClassVar[str] = "diffuse"
+    albedo: RGB = field(default=(0.8, 0.8, 0.8), metadata={"range": (0.0, 1.0), "doc": "reflectance per channel"})
+    albedo_texture: Texture | None = field(default=None, metadata={"doc": "overrides albedo where given"})
+
+
+def pack(material: Diffuse, record: np.ndarray, ctx: PackContext) -> None:
+    """Row 0 the albedo, row 3, w its texture."""
+    record[0, :3] = material.albedo
+    record[3, 3] = ctx.index_of(material.albedo_texture)
+
+
+KIND = MaterialKind(Diffuse, "MATERIAL_DIFFUSE", pack, "material_diffuse.glsl", glsl_prefix="diffuse")

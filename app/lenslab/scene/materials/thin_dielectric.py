@@ -1,0 +1,31 @@
+"""ThinDielectric: a pane of glass too thin to model. GLSL: glsl/material_thin_dielectric.glsl."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import ClassVar
+
+import numpy as np
+
+from lenslab.scene.materials.base import RGB, Material, PackContext
+from lenslab.scene.materials.spec import MaterialKind
+
+
+@dataclass
+class ThinDielectric(Material):
+    """A pane of glass too thin to model: reflects, and lets light through without bending it."""
+
+    type_name: ClassVar[str] = "thin_dielectric"
+    ior: float = field(default=1.5, metadata={"range": (1.0001, 4.0)})
+    tint: RGB = field(default=(1.0, 1.0, 1.0), metadata={"range": (0.0, 1.0)})
+
+
+def pack(material: ThinDielectric, record: np.ndarray, ctx: PackContext) -> None:
+    """Row 2, x the index of refraction, row 4 the tint."""
+    record[2, 0] = material.ior
+    record[4, :3] = material.tint
+
+
+# Only a Dirac lobe: evaluation is never asked of it (glsl/bsdf.glsl's bsdf_is_delta), so it has no _eval.
+KIND = MaterialKind(ThinDielectric, "MATERIAL_THIN_DIELECTRIC", pack, "material_thin_dielectric.glsl",
+                    glsl_prefix="thin_dielectric", glsl_eval=False)
