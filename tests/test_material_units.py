@@ -5,6 +5,7 @@ dispatch are made. No GL here: these check the registry against what it feeds.""
 
 from __future__ import annotations
 
+import importlib
 import re
 
 import numpy as np
@@ -14,6 +15,8 @@ from lenslab.render import buffers, features, gpu_layout
 from lenslab.render.gl import load_shader_source
 from lenslab.resources import glsl_dir
 from lenslab.scene import materials
+from lenslab.scene.io import mitsuba_bsdfs
+from lenslab.scene.io.mitsuba_xml import load_mitsuba_string
 from lenslab.scene.materials import registry
 from lenslab.scene.textures import Checkerboard
 
@@ -133,3 +136,66 @@ def test_inner_materials_come_from_the_kinds():
     assert materials.inner_materials(materials.Emissive(surface=second)) == [second]
     blend = materials.Blend(first, second)
     assert list(materials.walk_materials(materials.Mask(material=blend)))[1:] == [blend, first, second]
+
+
+# -- Mitsuba ---------------------------------------------------------------------------------------------------
+# Every Mitsuba BSDF plugin name and the class it mapped onto when mitsuba_bsdfs.BSDF_MAPPINGS was one table
+# (twosided: None, it is unwrapped to the BSDF it holds). The reference the kinds' own mappings keep to.
+MITSUBA_REFERENCE: dict[str, type | None] = {
+    "diffuse": materials.Diffuse,
+    "roughdiffuse": materials.Diffuse,
+    "conductor": materials.Conductor,
+    "roughconductor": materials.Conductor,
+    "plastic": materials.Plastic,
+    "roughplastic": materials.Plastic,
+    "dielectric": materials.Dielectric,
+    "roughdielectric": materials.Dielectric,
+    "thindielectric": materials.ThinDielectric,
+    "principled": materials.Diffuse,
+    "principledthin": materials.Diffuse,
+    "twosided": None,
+    "mask": materials.Mask,
+    "bumpmap": materials.BumpMap,
+    "normalmap": materials.NormalMap,
+    "blendbsdf": materials.Blend,
+}
+# What a plugin needs inside to load (the wrappers' BSDFs, the maps' textures).
+_MITSUBA_INSIDE = {
+    "twosided": '<bsdf type="roughplastic"/>',
+    "mask": '<bsdf type="diffuse"/>',
+    "bumpmap": '<texture type="checkerboard"/><bsdf type="diffuse"/>',
+    "normalmap": '<texture type="checkerboard" name="normalmap"/><bsdf type="diffuse"/>',
+    "blendbsdf": '<bsdf type="diffuse"/><bsdf type="conductor"/>',
+}
+
+
+def test_the_mitsuba_table_has_every_plugin_it_had():
+    assert set(mitsuba_bsdfs.BSDF_MAPPINGS) == set(MITSUBA_REFERENCE)
+
+
+@pytest.mark.parametrize("plugin", list(MITSUBA_REFERENCE))
+def test_every_mitsuba_plugin_maps_onto_the_kind_it_did(plugin):
+    expected = MITSUBA_REFERENCE[plugin]
+    kinds = [kind for kind in KINDS if plugin in kind.mitsuba_plugins]
+    if kinds:  # mapped by its kind's module
+        assert [kind.cls for kind in kinds] == [expected]
+        assert mitsuba_bsdfs.BSDF_MAPPINGS[plugin] is kinds[0].from_mitsuba
+    else:  # onto no one kind: kept in mitsuba_bsdfs
+        assert plugin in mitsuba_bsdfs.UNWRAPPED_OR_APPROXIMATED
+        assert mitsuba_bsdfs.BSDF_MAPPINGS[plugin].__module__ == mitsuba_bsdfs.__name__
+    # ... and an imported scene gets that class (a twosided: the class of the BSDF it holds)
+    xml = (f'<scene version="3.0.0"><bsdf type="{plugin}" id="m">{_MITSUBA_INSIDE.get(plugin, "")}</bsdf>'
+           '<shape type="sphere"><ref id="m"/></shape></scene>')
+    scene = load_mitsuba_string(xml, warn=lambda message: None)
+    assert type(scene.materials[scene.nodes[0].material]) is (expected or materials.Plastic)
+
+
+@pytest.mark.parametrize("kind", KINDS, ids=IDS)
+def test_every_kind_holds_its_own_mitsuba_mappings(kind):
+    module = importlib.import_module(kind.cls.__module__)
+    if kind.from_mitsuba is None:  # no Mitsuba BSDF maps onto it (an emitter is not a BSDF)
+        assert kind.mitsuba_plugins == () and not hasattr(module, "from_mitsuba")
+        return
+    assert kind.from_mitsuba is module.from_mitsuba
+    assert kind.mitsuba_plugins == tuple(p for p, cls in MITSUBA_REFERENCE.items() if cls is kind.cls
+                                         and p not in mitsuba_bsdfs.UNWRAPPED_OR_APPROXIMATED)

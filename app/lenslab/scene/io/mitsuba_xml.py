@@ -7,8 +7,8 @@ Two passes, as in Mitsuba's own parser (``src/core/parser.cpp``):
    splice ``<include>`` files in (relative to the including file), and register every ``id``.
 2. **Convert** the expanded tree: integrator, sensor/film/sampler, shapes with their BSDFs and area lights,
    the constant emitter. Each plugin is a small function; BSDFs go through ``mitsuba_bsdfs.BSDF_MAPPINGS``,
-   one entry per Mitsuba plugin name; textures, the cylinder and each shape's uvs through
-   ``mitsuba_textures`` (``texture_of``, ``material_on_shape``).
+   one entry per Mitsuba plugin name, made from the material kinds' own ``from_mitsuba``; textures, the
+   cylinder and each shape's uvs through ``mitsuba_textures`` (``texture_of``, ``material_on_shape``).
 
 Whatever LensLab cannot render yet gives one warning naming the element and its line, and the rest of the
 scene still loads. A file that is not well-formed XML, or that Mitsuba itself would reject (an undefined
@@ -524,7 +524,8 @@ class _Camera:
 
 class MitsubaImporter:
     """Reads one parsed and expanded scene file into LensLab's scene: the state (materials, nodes, lights,
-    the camera) that the element readers here, in mitsuba_bsdfs and in mitsuba_textures share."""
+    the camera) that the element readers here, in the BSDF mappings (mitsuba_bsdfs, the material kinds'
+    ``from_mitsuba``, mitsuba_props) and in mitsuba_textures share."""
 
     def __init__(self, root: XNode, ids: dict[str, XNode], root_folder: Path, warn: WarnCallback):
         self.root = root

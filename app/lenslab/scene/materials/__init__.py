@@ -1,10 +1,11 @@
 """Materials: how a surface scatters or emits light.
 
 Each material kind is one module here, holding its dataclass (registered under the ``type`` name that the
-scene file uses), the function that packs it into its GPU record, and its kind entry (``KIND``) naming its
-type code and its GLSL file (glsl/material_<name>.glsl). :mod:`.registry` lists the kinds in one place; the
-renderer's type codes, packing, kernel features and shader dispatch are all made from it
-(docs/architecture.md, "Adding a material kind").
+scene file uses), the function that packs it into its GPU record, its Mitsuba mapping (``from_mitsuba``, for
+the Mitsuba BSDF plugins that map onto it) and its kind entry (``KIND``) naming its type code, its GLSL file
+(glsl/material_<name>.glsl) and its Mitsuba plugins. :mod:`.registry` lists the kinds in one place; the
+renderer's type codes, packing, kernel features and shader dispatch, and the Mitsuba importer's BSDF table,
+are all made from it (docs/architecture.md, "Adding a material kind").
 
 Roughness is the artist's "perceptual" roughness r in [0, 1]; the microfacet width is alpha = r^2 (as in
 Disney's and glTF's conventions). Zero means a perfectly smooth surface (a mirror-like delta lobe). The

@@ -4,15 +4,19 @@ glsl/bsdf.glsl's resolve_material)."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
+from lenslab.scene.io import mitsuba_props as mp
 from lenslab.scene.materials.base import Material, PackContext
 from lenslab.scene.materials.conductor import Conductor
 from lenslab.scene.materials.diffuse import Diffuse
 from lenslab.scene.materials.spec import MaterialKind
 from lenslab.scene.textures import Texture
+
+if TYPE_CHECKING:
+    from lenslab.scene.io.mitsuba_xml import MitsubaImporter, Props
 
 
 @dataclass
@@ -38,4 +42,22 @@ def holds(material: Blend) -> list[Material]:
     return [material.first, material.second]
 
 
-KIND = MaterialKind(Blend, "MATERIAL_BLEND", pack, "material_blend.glsl", holds=holds, wrapper=True)
+def from_mitsuba(p: "Props", imp: "MitsubaImporter") -> mp.Mapped:
+    """Mitsuba's blendbsdf: its two BSDFs, mixed by its weight (a number, a colour or a texture)."""
+    from lenslab.scene.materials.mask import Mask
+    from lenslab.scene.materials.registry import walk_materials  # the registry imports this module
+
+    notes: list[str] = []
+    weight, texture = mp.scalar_or_texture(p, imp, "weight", 0.5, notes)
+    inner = mp.nested_bsdfs(p)
+    if len(inner) != 2:
+        raise p.node.error(f"blendbsdf needs two BSDFs, not {len(inner)}")
+    first, second = (mp.noted_material(imp.map_bsdf(node), notes) for node in inner)
+    if any(isinstance(held, Mask) for part in (first, second) for held in walk_materials(part)):
+        notes.append("a mask inside a blend does not cut the surface in LensLab: it is solid there")
+    return mp.Mapped(Blend(first=first, second=second, weight=min(max(weight, 0.0), 1.0), weight_texture=texture),
+                     mp.joined_notes(notes))
+
+
+KIND = MaterialKind(Blend, "MATERIAL_BLEND", pack, "material_blend.glsl", holds=holds, wrapper=True,
+                    mitsuba_plugins=("blendbsdf",), from_mitsuba=from_mitsuba)

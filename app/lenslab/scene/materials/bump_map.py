@@ -4,14 +4,18 @@ glsl/material_bump_map.glsl (the tilt is applied in glsl/bsdf.glsl's resolve_mat
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
+from lenslab.scene.io import mitsuba_props as mp
 from lenslab.scene.materials.base import Material, PackContext
 from lenslab.scene.materials.diffuse import Diffuse
 from lenslab.scene.materials.spec import MaterialKind
 from lenslab.scene.textures import Texture
+
+if TYPE_CHECKING:
+    from lenslab.scene.io.mitsuba_xml import MitsubaImporter, Props
 
 
 @dataclass
@@ -38,4 +42,19 @@ def holds(material: BumpMap) -> list[Material]:
     return [material.material]
 
 
-KIND = MaterialKind(BumpMap, "MATERIAL_BUMP_MAP", pack, "material_bump_map.glsl", holds=holds, wrapper=True)
+def from_mitsuba(p: "Props", imp: "MitsubaImporter") -> mp.Mapped:
+    """Mitsuba's bumpmap: the BSDF it holds, under its height texture (flat, with a note, when LensLab cannot
+    look the texture up)."""
+    notes: list[str] = []
+    scale = p.float("scale", 1.0)
+    shadowing = mp.tilt_options(p, notes)
+    node, texture = mp.texture_property(p, imp, None)
+    material = mp.held(p, imp, notes)
+    if texture is None:
+        notes.append(f"its texture at line {node.line} cannot be looked up: the bump map is flat")
+    return mp.Mapped(BumpMap(material=material, texture=texture, scale=scale, shadowing=shadowing),
+                     mp.joined_notes(notes))
+
+
+KIND = MaterialKind(BumpMap, "MATERIAL_BUMP_MAP", pack, "material_bump_map.glsl", holds=holds, wrapper=True,
+                    mitsuba_plugins=("bumpmap",), from_mitsuba=from_mitsuba)

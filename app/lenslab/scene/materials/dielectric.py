@@ -4,12 +4,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
+from lenslab.scene.io import mitsuba_props as mp
 from lenslab.scene.materials.base import DISTRIBUTION_FIELD, RGB, Material, PackContext
 from lenslab.scene.materials.spec import MaterialKind
+
+if TYPE_CHECKING:
+    from lenslab.scene.io.mitsuba_xml import MitsubaImporter, Props
 
 
 @dataclass
@@ -40,4 +44,16 @@ def pack(material: Dielectric, record: np.ndarray, ctx: PackContext) -> None:
     record[5, :3] = material.absorption_coefficient()
 
 
-KIND = MaterialKind(Dielectric, "MATERIAL_DIELECTRIC", pack, "material_dielectric.glsl", glsl_prefix="dielectric")
+def from_mitsuba(p: "Props", imp: "MitsubaImporter") -> mp.Mapped:
+    """Mitsuba's dielectric and roughdielectric (its thindielectric is a ThinDielectric)."""
+    notes: list[str] = []
+    kind = p.node.type
+    roughness, distribution = mp.roughness(p, notes) if kind == "roughdielectric" else (0.0, "ggx")
+    transmit = mp.transmittance_tint(p, notes)
+    ior = mp.relative_ior(p, notes, 1.0001)
+    return mp.Mapped(Dielectric(ior=ior, roughness=roughness, distribution=distribution, tint=transmit),
+                     mp.joined_notes(notes))
+
+
+KIND = MaterialKind(Dielectric, "MATERIAL_DIELECTRIC", pack, "material_dielectric.glsl", glsl_prefix="dielectric",
+                    mitsuba_plugins=("dielectric", "roughdielectric"), from_mitsuba=from_mitsuba)

@@ -3,13 +3,17 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
+from lenslab.scene.io import mitsuba_props as mp
 from lenslab.scene.materials.base import RGB, Material, PackContext
 from lenslab.scene.materials.spec import MaterialKind
 from lenslab.scene.textures import Texture
+
+if TYPE_CHECKING:
+    from lenslab.scene.io.mitsuba_xml import MitsubaImporter, Props
 
 
 @dataclass
@@ -27,4 +31,16 @@ def pack(material: Diffuse, record: np.ndarray, ctx: PackContext) -> None:
     record[3, 3] = ctx.index_of(material.albedo_texture)
 
 
-KIND = MaterialKind(Diffuse, "MATERIAL_DIFFUSE", pack, "material_diffuse.glsl", glsl_prefix="diffuse")
+def from_mitsuba(p: "Props", imp: "MitsubaImporter") -> mp.Mapped:
+    """Mitsuba's diffuse, and its roughdiffuse (Oren-Nayar), rendered as Lambertian with a note."""
+    if p.node.type == "roughdiffuse":
+        p.float("alpha")
+        albedo, texture = mp.reflectance(p, imp, "reflectance", 0.5)
+        return mp.Mapped(Diffuse(albedo, albedo_texture=texture),
+                         "rough diffuse (Oren-Nayar) is rendered as Lambertian")
+    albedo, texture = mp.reflectance(p, imp, "reflectance", 0.5)
+    return mp.Mapped(Diffuse(albedo, albedo_texture=texture))
+
+
+KIND = MaterialKind(Diffuse, "MATERIAL_DIFFUSE", pack, "material_diffuse.glsl", glsl_prefix="diffuse",
+                    mitsuba_plugins=("diffuse", "roughdiffuse"), from_mitsuba=from_mitsuba)

@@ -3,14 +3,18 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
+from lenslab.scene.io import mitsuba_props as mp
 from lenslab.scene.materials.base import Material, PackContext
 from lenslab.scene.materials.diffuse import Diffuse
 from lenslab.scene.materials.spec import MaterialKind
 from lenslab.scene.textures import Texture
+
+if TYPE_CHECKING:
+    from lenslab.scene.io.mitsuba_xml import MitsubaImporter, Props
 
 
 @dataclass
@@ -36,4 +40,14 @@ def holds(material: Mask) -> list[Material]:
     return [material.material]
 
 
-KIND = MaterialKind(Mask, "MATERIAL_MASK", pack, "material_mask.glsl", holds=holds, wrapper=True)
+def from_mitsuba(p: "Props", imp: "MitsubaImporter") -> mp.Mapped:
+    """Mitsuba's mask: the BSDF it holds, cut by its opacity (a number, a colour or a texture)."""
+    notes: list[str] = []
+    opacity, texture = mp.scalar_or_texture(p, imp, "opacity", 0.5, notes)
+    material = mp.held(p, imp, notes)
+    return mp.Mapped(Mask(material=material, opacity=min(max(opacity, 0.0), 1.0), opacity_texture=texture),
+                     mp.joined_notes(notes))
+
+
+KIND = MaterialKind(Mask, "MATERIAL_MASK", pack, "material_mask.glsl", holds=holds, wrapper=True,
+                    mitsuba_plugins=("mask",), from_mitsuba=from_mitsuba)

@@ -4,14 +4,18 @@ glsl/material_normal_map.glsl (the tilt is applied in glsl/bsdf.glsl's resolve_m
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
+from lenslab.scene.io import mitsuba_props as mp
 from lenslab.scene.materials.base import Material, PackContext
 from lenslab.scene.materials.diffuse import Diffuse
 from lenslab.scene.materials.spec import MaterialKind
 from lenslab.scene.textures import Texture
+
+if TYPE_CHECKING:
+    from lenslab.scene.io.mitsuba_xml import MitsubaImporter, Props
 
 
 @dataclass
@@ -37,4 +41,17 @@ def holds(material: NormalMap) -> list[Material]:
     return [material.material]
 
 
-KIND = MaterialKind(NormalMap, "MATERIAL_NORMAL_MAP", pack, "material_normal_map.glsl", holds=holds, wrapper=True)
+def from_mitsuba(p: "Props", imp: "MitsubaImporter") -> mp.Mapped:
+    """Mitsuba's normalmap: the BSDF it holds, under its ``normalmap`` texture (flat, with a note, when LensLab
+    cannot look the texture up)."""
+    notes: list[str] = []
+    node, texture = mp.texture_property(p, imp, "normalmap")
+    shadowing = mp.tilt_options(p, notes)
+    material = mp.held(p, imp, notes)
+    if texture is None:
+        notes.append(f"its texture at line {node.line} cannot be looked up: the normal map is flat")
+    return mp.Mapped(NormalMap(material=material, texture=texture, shadowing=shadowing), mp.joined_notes(notes))
+
+
+KIND = MaterialKind(NormalMap, "MATERIAL_NORMAL_MAP", pack, "material_normal_map.glsl", holds=holds, wrapper=True,
+                    mitsuba_plugins=("normalmap",), from_mitsuba=from_mitsuba)

@@ -3,13 +3,17 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
+from lenslab.scene.io import mitsuba_props as mp
 from lenslab.scene.materials.base import DISTRIBUTION_FIELD, COATINGS, RGB, Material, PackContext
 from lenslab.scene.materials.spec import MaterialKind
 from lenslab.scene.textures import Texture
+
+if TYPE_CHECKING:
+    from lenslab.scene.io.mitsuba_xml import MitsubaImporter, Props
 
 
 @dataclass
@@ -54,4 +58,23 @@ def pack(material: Plastic, record: np.ndarray, ctx: PackContext) -> None:
         record[2, 1] = fresnel.internal_diffuse_reflectance(material.ior)
 
 
-KIND = MaterialKind(Plastic, "MATERIAL_PLASTIC", pack, "material_plastic.glsl", glsl_prefix="plastic")
+def from_mitsuba(p: "Props", imp: "MitsubaImporter") -> mp.Mapped:
+    """Mitsuba's plastic and roughplastic (its coating passes on what refracts unshadowed)."""
+    notes: list[str] = []
+    roughness, distribution = mp.roughness(p, notes) if p.node.type == "roughplastic" else (0.0, "ggx")
+    albedo, texture = mp.reflectance(p, imp, "diffuse_reflectance", 0.5)
+    ior = mp.ior_value(p, "int_ior", 1.49) / mp.ior_value(p, "ext_ior", 1.000277)
+    if not 1.0 <= ior <= 4.0:
+        notes.append(f"relative index of refraction {ior:.4g} is outside LensLab's 1-4: clamped")
+        ior = min(max(ior, 1.0), 4.0)
+    if p.color("specular_reflectance", 1.0) != (1.0, 1.0, 1.0):
+        notes.append("specular_reflectance is not supported: the coat reflects as clear plastic")
+    if p.bool("nonlinear", False):
+        notes.append("nonlinear colour shift is not supported")
+    # Mitsuba's roughplastic passes to its base only what refracts unshadowed (its eval_transmittance).
+    return mp.Mapped(Plastic(albedo=albedo, albedo_texture=texture, ior=ior, roughness=roughness,
+                             distribution=distribution, coating="single_scattering"), mp.joined_notes(notes))
+
+
+KIND = MaterialKind(Plastic, "MATERIAL_PLASTIC", pack, "material_plastic.glsl", glsl_prefix="plastic",
+                    mitsuba_plugins=("plastic", "roughplastic"), from_mitsuba=from_mitsuba)

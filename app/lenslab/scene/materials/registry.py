@@ -5,9 +5,11 @@ Everything else is made from :data:`KINDS`: the scene format's ``type`` names (:
 (:data:`MATERIAL_CODES`), packing (:func:`pack_record`, called by render/buffers.py), the kernel's feature
 bits (:attr:`MaterialKind.feature_bit`, render/features.py), and the GLSL that includes each kind's shader
 file and dispatches evaluation and sampling to it (:func:`glsl_dispatch`, the include "material_kinds.glsl"
-that render/gl.py makes for glsl/bsdf.glsl).
+that render/gl.py makes for glsl/bsdf.glsl), and the Mitsuba BSDF plugins that map onto each kind
+(:attr:`MaterialKind.mitsuba_plugins` and ``from_mitsuba``: scene/io/mitsuba_bsdfs.py's BSDF_MAPPINGS).
 
-Adding a kind: write its module (dataclass, ``pack``, ``KIND``), its glsl/material_<name>.glsl, and register
+Adding a kind: write its module (dataclass, ``pack``, ``KIND``, its Mitsuba mapping if a Mitsuba plugin maps
+onto it), its glsl/material_<name>.glsl, and register
 it at the end of :data:`KINDS` (docs/architecture.md, "Adding a material kind").
 """
 

@@ -4,11 +4,14 @@ about it besides its dataclass's own fields."""
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
 from lenslab.scene.materials.base import Material, PackContext
+
+if TYPE_CHECKING:
+    from lenslab.scene.io.mitsuba_props import BsdfMapping
 
 Packer = Callable[[Material, np.ndarray, PackContext], None]
 
@@ -23,7 +26,14 @@ class MaterialKind:
 
     ``holds`` names the materials a material of this kind holds (a blend's two, a light's surface); a
     ``wrapper`` keeps its parameter and texture in row 0 and is resolved away before shading
-    (glsl/bsdf.glsl's resolve_material). ``code`` is its place in the registry, given at registration."""
+    (glsl/bsdf.glsl's resolve_material).
+
+    ``mitsuba_plugins`` names the Mitsuba BSDF plugins that map onto this kind, and ``from_mitsuba`` (the
+    kind's module's ``from_mitsuba(p, imp)``, a ``mitsuba_props.BsdfMapping``) maps one of them: it reads the
+    plugin's properties (``p``; ``p.node.type`` is the plugin's name) and returns a ``mitsuba_props.Mapped``.
+    scene/io/mitsuba_bsdfs.py's ``BSDF_MAPPINGS`` is made from them.
+
+    ``code`` is its place in the registry, given at registration."""
 
     cls: type[Material]
     constant: str
@@ -34,6 +44,8 @@ class MaterialKind:
     glsl_sample: bool = True
     holds: Callable[[Material], list[Material]] | None = None
     wrapper: bool = False
+    mitsuba_plugins: tuple[str, ...] = ()
+    from_mitsuba: BsdfMapping | None = None
     code: int = -1
 
     @property

@@ -3,12 +3,16 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
+from lenslab.scene.io import mitsuba_props as mp
 from lenslab.scene.materials.base import RGB, Material, PackContext
 from lenslab.scene.materials.spec import MaterialKind
+
+if TYPE_CHECKING:
+    from lenslab.scene.io.mitsuba_xml import MitsubaImporter, Props
 
 
 @dataclass
@@ -26,6 +30,14 @@ def pack(material: ThinDielectric, record: np.ndarray, ctx: PackContext) -> None
     record[4, :3] = material.tint
 
 
+def from_mitsuba(p: "Props", imp: "MitsubaImporter") -> mp.Mapped:
+    """Mitsuba's thindielectric."""
+    notes: list[str] = []
+    transmit = mp.transmittance_tint(p, notes)
+    return mp.Mapped(ThinDielectric(ior=mp.relative_ior(p, notes, 1.0001), tint=transmit), mp.joined_notes(notes))
+
+
 # Only a Dirac lobe: evaluation is never asked of it (glsl/bsdf.glsl's bsdf_is_delta), so it has no _eval.
 KIND = MaterialKind(ThinDielectric, "MATERIAL_THIN_DIELECTRIC", pack, "material_thin_dielectric.glsl",
-                    glsl_prefix="thin_dielectric", glsl_eval=False)
+                    glsl_prefix="thin_dielectric", glsl_eval=False, mitsuba_plugins=("thindielectric",),
+                    from_mitsuba=from_mitsuba)
