@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import argparse
 
-from lenslab.scene.options import OPTIONS, Option
+from lenslab.scene.options import OPTIONS, Option, format_bound
 
 EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
@@ -26,10 +26,6 @@ class CommandParser(argparse.ArgumentParser):
         raise CliError(f"{message} (see {self.prog} --help)", EXIT_USAGE)
 
 
-def _bound(value: float) -> str:
-    return str(int(value)) if float(value).is_integer() else f"{value:g}"
-
-
 def number_argument(kind, low: float, high: float):
     """An argparse type: an int or float in [low, high], refused in one line naming the value."""
     def parse(text: str):
@@ -39,7 +35,7 @@ def number_argument(kind, low: float, high: float):
             raise argparse.ArgumentTypeError(f"expected {'a whole number' if kind is int else 'a number'}, "
                                              f"not '{text}'") from None
         if not low <= value <= high or value != value:
-            raise argparse.ArgumentTypeError(f"{text} is out of range [{_bound(low)}, {_bound(high)}]")
+            raise argparse.ArgumentTypeError(f"{text} is out of range [{format_bound(low)}, {format_bound(high)}]")
         return value
 
     return parse

@@ -109,14 +109,15 @@ class Option:
             value = float(value)
         low, high = self.range
         if not low <= value <= high:  # also refuses NaN
-            raise ValueError(f"{self.name} {value:g} is out of range [{_bound(low)}, {_bound(high)}]")
+            raise ValueError(f"{self.name} {value:g} is out of range [{format_bound(low)}, {format_bound(high)}]")
         reason = self.refuse(value) if self.refuse is not None else ""
         if reason:
             raise ValueError(f"{self.name} {value:g}: {reason}")
         return value
 
 
-def _bound(value: float) -> str:
+def format_bound(value: float) -> str:
+    """A range's end as a message shows it: 1, not 1.0; 0.25 as it is."""
     return str(int(value)) if float(value).is_integer() else f"{value:g}"
 
 
