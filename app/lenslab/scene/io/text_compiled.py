@@ -165,6 +165,17 @@ def _statement(data, i, n):
     return _UNKNOWN
 
 
+@njit(cache=True, inline="always")
+def _next_statement(data, i, n):
+    """The first byte of the next statement from ``data[i:]`` on, past blanks, empty lines and comments; n at
+    the end."""
+    while True:
+        i = _skip_blanks(data, i, n)
+        if i >= n or (data[i] != _NEWLINE and data[i] != 35):  # '#'
+            return i
+        i = i + 1 if data[i] == _NEWLINE else _skip_line(data, i, n)
+
+
 @njit(cache=True)
 def _continued(data, end, n):
     """Whether the line ending before ``end`` (the byte after its newline) ends in a backslash."""
@@ -183,17 +194,11 @@ def obj_counts(data):
     n = data.shape[0]
     nv = nvt = nvn = ntri = nmtl = 0
     i = 0
-    while i < n:
-        i = _skip_blanks(data, i, n)
+    while True:
+        i = _next_statement(data, i, n)
         if i >= n:
             break
         line = i
-        if data[i] == _NEWLINE:
-            i += 1
-            continue
-        if data[i] == 35:  # '#'
-            i = _skip_line(data, i, n)
-            continue
         statement = _statement(data, i, n)
         if statement == _POSITION:
             nv += 1
@@ -252,17 +257,11 @@ def obj_parse(data, nv, nvt, nvn, ntri, nmtl, powers):
     kv = kvt = kvn = kt = km = 0
     current = -1
     i = 0
-    while i < n:
-        i = _skip_blanks(data, i, n)
+    while True:
+        i = _next_statement(data, i, n)
         if i >= n:
             break
         line = i
-        if data[i] == _NEWLINE:
-            i += 1
-            continue
-        if data[i] == 35:
-            i = _skip_line(data, i, n)
-            continue
         statement = _statement(data, i, n)
         if statement == _POSITION or statement == _UV or statement == _NORMAL:
             kind = 0 if statement == _POSITION else (1 if statement == _UV else 2)
