@@ -38,5 +38,5 @@ def render_to_spp(session: RenderSession, spp: int) -> RenderSession:
     (``RenderJob.of_session``: a session the test made itself, with another size, kernel, view or region than a
     job makes from the scene, or one it has edited); the session, for its image. How the work is split into
     dispatches does not change the image (tests/test_integrator.py checks that)."""
-    RenderJob.of_session(session, spp=spp).run()
+    RenderJob.of_session(session, spp=spp).render()  # the caller reads back what it needs
     return session

@@ -129,12 +129,16 @@ class RenderJob:
                 self.session.step(max(0.0, seconds), self.target_spp)
         return self.progress()
 
-    def run(self, on_progress=None) -> np.ndarray:
-        """Render until finished, calling ``on_progress(JobProgress)`` after each slice; the linear image."""
+    def render(self, on_progress=None) -> None:
+        """Render until finished, calling ``on_progress(JobProgress)`` after each slice."""
         while not self.finished:
             progress = self.step(REPORT_SECONDS)
             if on_progress is not None:
                 on_progress(progress)
+
+    def run(self, on_progress=None) -> np.ndarray:
+        """Render until finished (:meth:`render`); the linear image."""
+        self.render(on_progress)
         return self.image()
 
     def progress(self) -> JobProgress:
