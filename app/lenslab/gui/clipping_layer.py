@@ -30,7 +30,7 @@ class ClippingLayer(MaskLayer):
         if not self.visible:
             return
         image = self.viewport.qimage
-        if image is None:
+        if image is None or not self.viewport.worth_judging:
             self.highlights = self.shadows = self._overlay = None
         else:
             self.highlights, self.shadows = (only_in_gate(m, self.viewport)

@@ -48,6 +48,7 @@ class RenderController(QObject):
     frame_ready = Signal(object)  # Frame
     gbuffer_ready = Signal(object)
     restarted = Signal(int)
+    working = Signal(object)  # WorkNote of the latest edit, while its picture is not shown yet
     device_ready = Signal(dict)
     render_error = Signal(str)  # "" when an edit made the scene renderable again
     export_progress = Signal(object)
@@ -63,6 +64,8 @@ class RenderController(QObject):
         self.target_spp = target_spp
         self.paused = False
         self.generation = 0
+        self.scene_generation = 0  # the generation of the last whole scene sent (not a camera or settings edit)
+        self.work_note = None  # the latest WorkNote
         self.device: dict | None = None
         self.device_error: str | None = None
         self.error = ""
@@ -85,6 +88,7 @@ class RenderController(QObject):
         w.gbuffer_ready.connect(self._gbuffer)
         w.pick_ready.connect(self._pick_answered)
         w.restarted.connect(self._restarted)
+        w.working.connect(self._working)
         w.scene_failed.connect(self._scene_failed)
         w.export_progress.connect(self.export_progress)
         w.export_finished.connect(self.export_finished)
@@ -118,7 +122,8 @@ class RenderController(QObject):
         if size != self._size:
             self.region = None  # the worker drops a region whose picture changed size, as here
         self._size = size
-        self.worker.set_scene(copy_scene(self.doc.scene), *self._size, self._next_generation(), self.margin)
+        self.scene_generation = self._next_generation()
+        self.worker.set_scene(copy_scene(self.doc.scene), *self._size, self.scene_generation, self.margin)
 
     def set_widget_size(self, width: int, height: int) -> None:
         """The viewport widget's size in device pixels: the picture follows it (except at "export" quality)."""
@@ -212,6 +217,18 @@ class RenderController(QObject):
             self.render_error.emit("")
         self.restarted.emit(generation)
 
+    def _working(self, note) -> None:
+        self.work_note = note
+        self.working.emit(note)
+
+    @property
+    def picture_is_current(self) -> bool:
+        """The picture on screen shows the latest edit (at full resolution), or the edit cannot render."""
+        frame = self.last_frame
+        if self.error and self._error_generation >= self.generation:
+            return True
+        return frame is not None and frame.generation >= self.generation and not frame.preview
+
     def _scene_failed(self, generation: int, message: str) -> None:
         self._error_generation = generation
         self.error = f"Cannot render: {message}"
@@ -252,7 +269,7 @@ class RenderController(QObject):
 
 def samples_text(frame: Frame) -> str:
     if frame.preview:
-        return "preview"
+        return "preview ¼ res"
     target = f" / {frame.target_spp}" if frame.target_spp else ""
     return f"{frame.samples_per_pixel}{target} spp"
 

@@ -66,7 +66,7 @@ class FocusPeakingLayer(MaskLayer):
             return
         v = self.viewport
         limits = self.limits()
-        if v.qimage is None or v.gbuffer is None or limits is None:
+        if v.qimage is None or v.gbuffer is None or limits is None or not v.worth_judging:
             self.mask = None
         else:
             near, far, *coc_px = limits

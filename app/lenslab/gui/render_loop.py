@@ -12,7 +12,10 @@ first pass fills in over the preview tile by tile. The picture on screen is neve
 after an edit the previous picture stays up until the new render has as many samples (up to HOLD_SPP), or for
 at most HOLD_SECONDS, so a drag still shows the newest state several times a second. Pixels not rendered yet
 (a first pass under way, or outside a render region) show the last picture. With the denoiser on, the pictures
-are Intel Open Image Denoise's, from the beauty and the first-hit albedo and normal the tracer accumulates. Each
+are Intel Open Image Denoise's, from the beauty and the first-hit albedo and normal the tracer accumulates, and
+raw samples are never shown: the denoised preview (marked as one) stands until the first full pass is done and
+denoised in its turn. While the picture does not show the latest edit yet, ``working`` says what the loop is
+doing and how far along (a scene's load step by step, a kernel compiling, the preview, the first pass). Each
 frame's picture is tone-mapped to 8 bits on the GPU with the viewport's exposure and tone curve
 (``RenderSession.display``), so neither thread does per-pixel work on the CPU; the linear image, for the
 viewport's pixel readout, comes along a few times a second. Once per change of view it casts one ray per pixel
@@ -62,6 +65,10 @@ HOLD_SECONDS = 0.15
 DENOISE_MIN_INTERVAL = 0.25
 GBUFFER_INTERVAL = 0.3  # during a drag, the selection's outline and the depth buffer follow this often
 EXPORT_PROGRESS_INTERVAL = 0.1
+WORK_NOTE_INTERVAL = 0.1  # seconds between notes on the first pass's progress
+# A raw picture is worth judging by eye (focus peaking, the histogram, the clipping warnings) from this many
+# samples per pixel; a denoised one at full resolution from its first pass. Below it their marks follow the noise.
+JUDGE_MIN_SPP = 16
 
 
 @dataclass(frozen=True)
@@ -81,6 +88,25 @@ class Frame:
     gate: tuple[float, float, float, float] | None = None  # the export's frame in the picture: x, y, w, h pixels
     region: tuple[int, int, int, int] | None = None  # the render region being refined, pixels
     denoised: bool = False  # the picture (and linear image) are the denoiser's
+    camera: object = None  # the ThinLensCamera the picture was rendered with: what its tags describe
+
+    @property
+    def worth_judging(self) -> bool:
+        """Clean enough for focus peaking, the histogram and the clipping warnings to mean something."""
+        if self.preview:
+            return False
+        return self.converged or self.samples_per_pixel >= (1 if self.denoised else JUDGE_MIN_SPP)
+
+
+@dataclass(frozen=True)
+class WorkNote:
+    """What the loop is doing for an edit whose picture is not on screen yet."""
+
+    generation: int
+    stage: str  # e.g. "building the kd-tree", "compiling trace.comp", "preview", "first pass"
+    step: int = 0  # for a scene's load: this stage's number (1-based) of ``steps``
+    steps: int = 0
+    fraction: float | None = None  # how far the stage is, 0 to 1, where it is known
 
 
 @dataclass(frozen=True)
@@ -242,6 +268,8 @@ class LoopEvents(Protocol):
 
     def restarted(self, generation: int) -> None: ...  # accumulation restarted for this edit
 
+    def working(self, note: WorkNote) -> None: ...  # what the loop does before the edit's picture is shown
+
     def scene_failed(self, generation: int, reason: str) -> None: ...  # one line: the scene cannot be rendered
 
     def export_progress(self, progress: ExportProgress) -> None: ...
@@ -273,6 +301,10 @@ class RenderLoop:
         self._frame: Frame | None = None
         self._frame_signalled = False
         self._renderer = renderer
+        if renderer is not None:
+            renderer.on_compile = self._compiling
+        self._work_generation = 0  # the edit being applied, for the notes on its progress
+        self._last_note = 0.0
         self._session = None
         self._size = (0, 0)
         self._generation = 0
@@ -434,10 +466,11 @@ class RenderLoop:
         from lenslab.render.tracer import RenderSession
 
         scene, size, generation = edit.scene, edit.size, edit.generation
+        self._work_generation = generation
         try:
             if self._session is None:
                 self._session = RenderSession(self._renderer, scene, width=size[0], height=size[1],
-                                              dispatch_seconds=self.dispatch_seconds)
+                                              dispatch_seconds=self.dispatch_seconds, on_stage=self._loading)
                 # The viewport always gathers the denoiser's albedo and normal, so that turning it on or off
                 # shows at once, without a restart.
                 self._session.set_feature_buffers(True)
@@ -458,6 +491,7 @@ class RenderLoop:
         if self._session is None:
             return
         generation = edit.generation
+        self._work_generation = generation
         try:
             self._session.set_camera(edit.camera)
         except Exception as exc:
@@ -476,6 +510,7 @@ class RenderLoop:
     def apply_settings(self, edit: SettingsEdit) -> None:
         if self._session is None:
             return
+        self._work_generation = edit.generation
         self._session.set_settings(edit.settings)
         if self._scene_ok and self._camera_ok:
             self._restart(edit.generation, view_changed=False)
@@ -534,10 +569,26 @@ class RenderLoop:
             self._gbuffer_due = True
         self._events.restarted(generation)
 
+    # -- saying what the loop is doing -----------------------------------------------------------------------
+    def _note(self, stage: str, step: int = 0, steps: int = 0, fraction: float | None = None) -> None:
+        self._last_note = time.perf_counter()
+        self._events.working(WorkNote(self._work_generation, stage, step, steps, fraction))
+
+    def _loading(self, stage: str) -> None:
+        """RenderSession.set_scene's steps, as each begins."""
+        from lenslab.render.tracer import SCENE_STAGES
+
+        self._note(stage, SCENE_STAGES.index(stage) + 1, len(SCENE_STAGES))
+
+    def _compiling(self, shader: str) -> None:
+        self._note(f"compiling {shader}")
+
     # -- rendering the viewport ------------------------------------------------------------------------------
     def _viewport_step(self) -> None:
         session = self._session
         if self._phase is Phase.PREVIEW:
+            if time.perf_counter() - self._last_note >= WORK_NOTE_INTERVAL:
+                self._note("preview")
             session.step(self.dispatch_seconds / 2, target_spp=1)
             if session.samples_per_pixel >= 1:
                 image = session.image()
@@ -547,7 +598,7 @@ class RenderLoop:
                 w, h = self._size
                 # Enlarged once: the frames of the first full pass fill their unreached pixels from it.
                 self._preview_linear = upscale_smooth(image, w, h)
-                self._offer(self._preview_picture(), self._preview_linear, preview=True)
+                self._offer(self._preview_picture(), self._preview_linear, preview=True, denoised=self._denoise)
                 self._resize(w, h)
                 self._phase = Phase.FULL
                 self._gbuffer_if_due()  # during a drag every edit restarts here: the outline must keep up
@@ -558,6 +609,8 @@ class RenderLoop:
         progress = session.step(self.dispatch_seconds, target)
         done = target is not None and progress.samples_per_pixel >= target
         now = time.perf_counter()
+        if progress.samples_per_pixel == 0 and now - self._last_note >= WORK_NOTE_INTERVAL:
+            self._note("first pass", fraction=session.pass_fraction)
         if done or progress.samples_per_pixel != self._published_spp or now - self._last_publish >= FRAME_INTERVAL:
             self._publish_session(done)
         if done:
@@ -594,7 +647,11 @@ class RenderLoop:
     def _publish_session(self, converged: bool, with_linear: bool = False) -> None:
         session = self._session
         now = time.perf_counter()
-        if self._denoise and session.samples_per_pixel >= 1:
+        if self._denoise:
+            if session.samples_per_pixel < 1:
+                # Raw samples are never shown with the denoiser on: the denoised preview (or the last picture)
+                # stands until the first pass is whole and can be denoised.
+                return
             picture, image = self._denoised_frame(converged)
             self._offer(picture, image, preview=False, converged=converged, denoised=True)
             return
@@ -695,7 +752,7 @@ class RenderLoop:
                       target_spp=self._target_spp, samples_per_second=progress.samples_per_second,
                       elapsed_seconds=time.perf_counter() - self._restart_time, generation=self._generation,
                       preview=preview, converged=converged, gate=(gx * sx, gy * sy, gw * sx, gh * sy),
-                      region=session.region, denoised=denoised)
+                      region=session.region, denoised=denoised, camera=session.camera)
         self._published_spp = spp
         self._last_publish = time.perf_counter()
         with self._frame_lock:

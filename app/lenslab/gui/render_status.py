@@ -1,6 +1,7 @@
 """The render as the window shows it: each frame into the viewport (its picture, the export's gate, the render
 region), the depth buffer, the status bar's sample count, progress, rate, elapsed time and device, the
-viewport's corner tag (paused, done, denoised), and the render's errors."""
+viewport's corner tags (paused, done, denoised; the camera the picture was rendered with), the work banner
+while the picture is not the latest edit's, and the render's errors."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ from PySide6.QtWidgets import QLabel, QMainWindow, QProgressBar
 from lenslab.gui import theme
 from lenslab.gui.controller import RenderController, elapsed_text, rate_text, samples_text
 from lenslab.gui.viewport import Viewport
+from lenslab.gui.work_banner import WorkBanner
 
 
 class RenderStatus(QObject):
@@ -34,12 +36,14 @@ class RenderStatus(QObject):
         self.device_label.setObjectName("deviceLabel")
         for widget in (self.spp_label, self.progress_bar, self.rate_label, self.elapsed_label, self.device_label):
             status.addPermanentWidget(widget)
+        self.work_banner = WorkBanner(viewport, controller, self)
 
     def show_frame(self, frame) -> None:
         export_pixels = self.controller.quality == "export"
         self.viewport.fit_margin = 24 if export_pixels else 0
         self.viewport.gate_rect = QRectF(*frame.gate) if frame.gate is not None and not export_pixels else None
         self.viewport.region_rect = QRectF(*frame.region) if frame.region is not None else None
+        self.viewport.worth_judging = frame.worth_judging
         self.viewport.set_frame(frame.display, frame.display_settings, frame.image)
         self.spp_label.setText(samples_text(frame))
         if frame.target_spp:
@@ -48,6 +52,7 @@ class RenderStatus(QObject):
         self.rate_label.setText(rate_text(frame.samples_per_second) if frame.samples_per_second else "")
         self.elapsed_label.setText(elapsed_text(frame.elapsed_seconds))
         self.update_corner_state(frame)
+        self.window.update_camera_tag()
 
     def set_paused(self, paused: bool) -> None:
         """Pause or resume the viewport's render: the pause action and the corner tag say which."""

@@ -49,6 +49,7 @@ from lenslab.gui.render_loop import (  # noqa: F401
     SettingsEdit,
     Stop,
     TargetSpp,
+    WorkNote,
     opaque,
     preview_size,
     upscale_smooth,
@@ -65,6 +66,7 @@ class RenderWorker(QThread):
     gbuffer_ready = Signal(object)  # GBuffer
     pick_ready = Signal(object)  # PickResult
     restarted = Signal(int)  # generation: accumulation restarted for this edit
+    working = Signal(object)  # WorkNote: what is under way before the edit's picture is shown
     scene_failed = Signal(int, str)  # generation, one-line reason: the scene cannot be rendered
     export_progress = Signal(object)  # ExportProgress
     export_finished = Signal(int, str)  # request id, path written
@@ -187,6 +189,9 @@ class _SignalEvents:
 
     def restarted(self, generation: int) -> None:
         self._worker.restarted.emit(generation)
+
+    def working(self, note: WorkNote) -> None:
+        self._worker.working.emit(note)
 
     def scene_failed(self, generation: int, reason: str) -> None:
         self._worker.scene_failed.emit(generation, reason)

@@ -17,6 +17,7 @@ import functools
 import math
 import time
 from dataclasses import dataclass
+from typing import Callable
 
 import moderngl
 import numpy as np
@@ -95,6 +96,8 @@ class Renderer:
         self.largest_buffer_bytes = largest_storage_buffer(self.ctx.info["GL_RENDERER"], self.limits)
         self._programs: dict[tuple, object] = {}
         self._declared: dict[int, tuple[str, frozenset[str]]] = {}  # id(program): (shader, uniforms declared)
+        # Told the shader's name before a kernel is compiled (seconds on llvmpipe): the studio says so on screen.
+        self.on_compile: Callable[[str], None] | None = None
 
     @in_context
     def program(self, shader: str, **defines):
@@ -102,6 +105,8 @@ class Renderer:
         gl.load_shader_source gives every shader (compiled once, then cached)."""
         key = (shader, tuple(sorted(defines.items())))
         if key not in self._programs:
+            if self.on_compile is not None:
+                self.on_compile(shader)
             source = gl.load_shader_source(shader, defines)
             program = self.ctx.compute_shader(source)
             self._programs[key] = program
@@ -326,13 +331,17 @@ class Progress:
     samples_per_second: float
 
 
+#: The steps of RenderSession.set_scene, in order, as on_stage is told them.
+SCENE_STAGES = ("reading and placing", "building the kd-tree", "packing", "uploading", "preparing the kernel")
+
+
 class RenderSession:
     """One scene on the GPU, one image accumulating. Not thread-safe: use it from the context's thread."""
 
     def __init__(self, renderer: Renderer, scene: Scene, *, width: int | None = None, height: int | None = None,
                  settings: RenderSettings | None = None, dispatch_seconds: float = DEFAULT_DISPATCH_SECONDS,
                  environment_importance: bool = True, specialise: bool = True, first_sample: int = 0,
-                 feature_buffers: bool = False):
+                 feature_buffers: bool = False, on_stage: Callable[[str], None] | None = None):
         if not 0 <= first_sample < SAMPLE_INDEX_LIMIT:
             raise ValueError(f"first sample index {first_sample} is out of range [0, {SAMPLE_INDEX_LIMIT})")
         self.renderer = renderer
@@ -357,6 +366,8 @@ class RenderSession:
         # viewport does, showing the export's frame and some of the scene around it (camera.view_frame).
         self.view_margin: float | None = None
         self.region: tuple[int, int, int, int] | None = None  # (x, y, width, height): render only these pixels
+        # Told each step of set_scene as it begins (one of SCENE_STAGES): the studio shows how far a load is.
+        self.on_stage = on_stage
         self.set_scene(scene, width=width, height=height, settings=settings)
 
     # -- scene and camera ---------------------------------------------------------------------------------
@@ -372,6 +383,7 @@ class RenderSession:
         made, largest = made_triangles(scene)
         self._check_triangle_count(made, f"the shapes made in code (node '{largest}' the most) make")
         start = time.perf_counter()
+        self._stage("reading and placing")
         # Large meshes stay in their own space with trees of their own, kept from one edit to the next
         # (render/instancing.py): an edit that leaves a mesh as it was never rebuilds its tree.
         reading = _TimedMeshReads()
@@ -384,15 +396,18 @@ class RenderSession:
         self.flat_scene = flat_scene
         if (width, height) != (getattr(self, "width", None), getattr(self, "height", None)):
             self.region = None  # its pixels were another image's
+        self._stage("building the kd-tree")
         world_tree = kdtree_cache.kdtree(flat_scene.prim_bounds(), triangles=flat_scene.triangles)
         packed_groups = self._groups.packed_groups(flat_scene)
         trees = time.perf_counter()
+        self._stage("packing")
         packed = pack_scene(self.flat_scene, scene.environment, kdtree=world_tree, base_dir=scene.base_dir(),
                             lights=scene.lights, environment_importance=self.environment_importance,
                             packed_groups=packed_groups, group_cache=self._groups)
         packing = time.perf_counter()
         # What the render survives but the user should hear about: unmapped mesh materials, missing textures.
         self.warnings = [*self.flat_scene.warnings, *packed.warnings]
+        self._stage("uploading")
         gpu_scene = GpuScene(self.ctx, packed, self.renderer.limits.max_storage_block_bytes, previous=self._gpu_scene)
         if self._gpu_scene is not None:
             self._gpu_scene.release()
@@ -400,6 +415,7 @@ class RenderSession:
         uploaded = time.perf_counter()
         self.width, self.height = width, height
         self.features = scene_features(packed) if self.specialise else GENERAL
+        self._stage("preparing the kernel")
         self.program = self._trace_program(self.settings.sampler)
         self.set_camera(scene.camera)
         built = [world_tree, *self._groups.new_trees]
@@ -407,6 +423,10 @@ class RenderSession:
                               kernel=time.perf_counter() - uploaded, trees_built=len(built),
                               trees_from_cache=sum(tree.from_cache for tree in built),
                               mesh_trees_built=self._groups.built, uploaded_bytes=gpu_scene.uploaded_bytes)
+
+    def _stage(self, name: str) -> None:
+        if self.on_stage is not None:
+            self.on_stage(name)
 
     @in_context
     def set_camera(self, camera: ThinLensCamera) -> None:
@@ -661,6 +681,12 @@ class RenderSession:
         target.bind_to_storage_buffer(ACCUMULATION_BINDING)
         if self._features is not None:
             self._features.bind_to_storage_buffer(FEATURES_BINDING)
+
+    @property
+    def pass_fraction(self) -> float:
+        """How much of the pass under way has its samples, 0 to 1 (0 between passes)."""
+        _x, _y, w, h = self.region_pixels
+        return self._pixels_done / max(1, w * h)
 
     def done(self, target_spp: int) -> bool:
         return self.samples_per_pixel >= target_spp
