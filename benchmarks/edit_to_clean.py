@@ -76,7 +76,7 @@ def time_edit(loop: RenderLoop, camera, size, generation: int, halves, seconds: 
     start = time.perf_counter()
     result = {"first": None, "first denoised": None, "full": None, "clean": None, "first relMSE": None,
               "full relMSE": None, "raw shown": 0}
-    while time.perf_counter() - start < seconds and result["clean"] is None:
+    while time.perf_counter() - start < seconds and (result["clean"] is None or result["full"] is None):
         loop.step()
         frame = loop.take_frame()
         if frame is None or frame.generation != generation:

@@ -90,3 +90,14 @@ def test_instances_scale_places_a_grid_of_one_mesh_and_stores_it_once(renderer, 
     placed, stored = (int(line.split()[k].replace(",", "")) for k in (2, 5))
     assert placed == 9 * (stored - 2) + 2 and "1 mesh trees" in line  # the floor's two triangles, once
     assert "M samples/s" in out
+
+
+@pytest.mark.gl
+def test_edit_to_clean_times_every_edit_and_counts_raw_pictures(renderer, tmp_path):
+    pytest.importorskip("pyoidn")
+    out = run("edit_to_clean.py", "--width", 24, "--height", 16, "--seconds", 1, "--reference-spp", 4,
+              "--cache", tmp_path, tmp_path=tmp_path)
+    rows = [line.split("|")[1:-1] for line in out.splitlines() if line.startswith("| f") or line.startswith("| focus")]
+    assert len(rows) == 3
+    assert all(cells[-1].strip() == "0" for cells in rows)  # no raw picture shown with the denoiser on
+    assert len(list(tmp_path.glob("edit_reference_*.npy"))) == 3

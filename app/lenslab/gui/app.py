@@ -24,6 +24,7 @@ def create_application(argv: list[str] | None = None):
     from lenslab.gui.main_window import app_icon
     from lenslab.gui.qtcompat import guard_singletons
     from lenslab.gui.theme import apply_theme
+    from lenslab.gui.wheel_guard import install_wheel_guard
 
     app = QApplication.instance()
     if app is None:
@@ -37,6 +38,7 @@ def create_application(argv: list[str] | None = None):
     app.setWindowIcon(app_icon())
     apply_theme(app)
     guard_singletons(app)
+    install_wheel_guard(app)  # the wheel scrolls panels, and changes only a focused control's value
     return app
 
 
@@ -54,15 +56,18 @@ def run_studio(scene_ref: str | None = None, overrides: SceneOverrides | None = 
     app = create_application()
     scene = path = None
     problem = None
+    warnings: list[str] = []  # what the scene's reader approximated or left out: shown in the window
     if scene_ref:
         try:
             path = resolve_scene_path(scene_ref)
-            scene = (overrides or SceneOverrides()).open(scene_ref)
+            scene = (overrides or SceneOverrides()).open(scene_ref, warn=warnings.append)
         except (SceneError, OSError, ValueError) as exc:
             problem = str(exc)
             scene = path = None
     window = MainWindow(scene, Path(path) if path else None, device_index=device_index)
     window.show()
+    if path is not None:
+        window.report_warnings(str(path), warnings)
     if problem:
         QMessageBox.critical(window, "Cannot open scene", problem)
     _close_on_interrupt(window)

@@ -4,10 +4,12 @@ Commands address what they change by target and field (see ``lenslab.scene.edita
 objects, so that any order of undo and redo finds the right thing. Values are deep-copied in and out. Each
 announces what it changed on the scene's own events (``doc.model``), whichever way it runs.
 
-Consecutive edits of the same fields from a slider or a spin box drag merge into one step (``mergeWith``) when
-they arrive within :data:`MERGE_SECONDS` of each other, so one Ctrl+Z undoes one gesture. A step's text (the
-History panel's row) names the value it sets, and a merged step takes the text of the last edit it took in: a drag
-from f/4 to f/22 reads "Aperture f/22", the value that row restores.
+Consecutive edits of the same fields from a spin box's arrows or a slider's keys merge into one step
+(``mergeWith``) when they arrive within :data:`MERGE_SECONDS` of each other, so one Ctrl+Z undoes one gesture. The
+edits of one mouse drag carry the drag's *gesture* (a token the control gives them from the press to the release):
+they merge however long the hand pauses on the way, and never with another drag's. A step's text (the History
+panel's row) names the value it sets, and a merged step takes the text of the last edit it took in: a drag from f/4
+to f/22 reads "Aperture f/22", the value that row restores.
 """
 
 from __future__ import annotations
@@ -88,15 +90,17 @@ def _label(doc, target: tuple, changes: dict) -> str:
 
 
 class SetValuesCommand(QUndoCommand):
-    """Set one or more fields of one target."""
+    """Set one or more fields of one target; ``gesture``: the mouse drag the edit is part of, if any."""
 
-    def __init__(self, doc, target: tuple, changes: dict[tuple, Any], text: str | None = None, merge: bool = False):
+    def __init__(self, doc, target: tuple, changes: dict[tuple, Any], text: str | None = None, merge: bool = False,
+                 gesture: object | None = None):
         super().__init__(text or _label(doc, target, changes))
         self.doc = doc
         self.target = tuple(target)
         self.new = {tuple(k): copy.deepcopy(v) for k, v in changes.items()}
         self.old = {k: copy.deepcopy(doc.model.get_value(self.target, k)) for k in self.new}
         self.merge = merge
+        self.gesture = gesture
         self.stamp = time.monotonic()
 
     def redo(self) -> None:
@@ -114,12 +118,17 @@ class SetValuesCommand(QUndoCommand):
     def id(self) -> int:
         return _SET_VALUES_ID
 
+    def continued_by(self, target: tuple, fields, merge: bool, gesture: object | None, stamp: float) -> bool:
+        """Whether an edit of ``fields`` of ``target`` made at ``stamp`` belongs to this step."""
+        if not (self.merge and merge) or tuple(target) != self.target or set(map(tuple, fields)) != set(self.new):
+            return False
+        if self.gesture is not None or gesture is not None:
+            return gesture == self.gesture  # one drag, however long it takes; another drag is another step
+        return stamp - self.stamp <= MERGE_SECONDS
+
     def mergeWith(self, other: QUndoCommand) -> bool:
-        if not isinstance(other, SetValuesCommand) or not (self.merge and other.merge):
-            return False
-        if other.target != self.target or set(other.new) != set(self.new):
-            return False
-        if other.stamp - self.stamp > MERGE_SECONDS:
+        if not isinstance(other, SetValuesCommand) or \
+                not self.continued_by(other.target, other.new, other.merge, other.gesture, other.stamp):
             return False
         self.new = other.new
         self.stamp = other.stamp
@@ -127,6 +136,31 @@ class SetValuesCommand(QUndoCommand):
         if self.new == self.old:
             self.setObsolete(True)
         return True
+
+
+def value_before_step(doc, target: tuple, field: tuple, fields, merge: bool, gesture: object | None = None) -> Any:
+    """The value ``field`` of ``target`` had before the History's newest step, when an edit of ``fields`` made now
+    would merge into that step; its value now otherwise. An edit that works out one value from another (a focal
+    length that moves the focus out) starts from there, so that what the step passed through on the way leaves no
+    trace at its end."""
+    now = doc.model.get_value(target, field)
+    stack = doc.undo_stack
+    index = stack.index()
+    if index == 0 or index == stack.cleanIndex():  # QUndoStack never merges into the state a file was saved at
+        return now
+    step = stack.command(index - 1)
+    merging = isinstance(step, SetValuesCommand) and step.id() == _SET_VALUES_ID and \
+        step.continued_by(target, fields, merge, gesture, time.monotonic())
+    return copy.deepcopy(step.old.get(tuple(field), now)) if merging else now
+
+
+def push_values(doc, target: tuple, changes: dict, text: str | None = None, merge: bool = False,
+                gesture: object | None = None) -> None:
+    """Set ``changes`` as one step, for an edit that may be part of a mouse drag (``gesture``): all the fields,
+    when any of them changes. A control that sets two fields (a focal length and the focus it moves out) sets both
+    every time, so its edits always name the same fields, and those of one gesture merge."""
+    if any(doc.model.get_value(target, tuple(k)) != v for k, v in changes.items()):
+        doc.push(SetValuesCommand(doc, target, changes, text, merge, gesture))
 
 
 class LensCommand(QUndoCommand):

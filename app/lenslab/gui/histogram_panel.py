@@ -178,6 +178,8 @@ class HistogramPanel(QWidget):
 
     def refresh(self) -> None:
         image = self.viewport.qimage
+        if image is not None and not self.viewport.worth_judging and self.histogram is not None:
+            return  # the last clean picture's histogram stands until the new picture is worth one
         self._stale = False
         self.histogram = None if image is None else histogram(crop_to_gate(qimage_to_array(image), self.viewport))
         self.view.set_histogram(self.histogram)

@@ -18,6 +18,7 @@ from PySide6.QtWidgets import QWidget
 
 from lenslab.gui import theme
 from lenslab.render.film import to_8bit, tone_map
+from lenslab.scene.navigation import MouseTravel
 
 ZOOM_STEPS = (0.125, 0.25, 1 / 3, 0.5, 2 / 3, 1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0)
 OVERLAY_HOLD_SECONDS = 1.2
@@ -72,7 +73,8 @@ class Viewport(QWidget):
     resized = Signal(int, int)  # the widget's new size in device pixels
     region_drawn = Signal(object)  # (x, y, width, height) in image pixels, drawn with the region tool
     # Moving the camera with the mouse (docs/studio.md, "Moving the camera"): a gesture starts, moves by
-    # (dx, dy) widget pixels since its start, and ends. The kind is "orbit", "pan" or "dolly".
+    # (dx, dy) widget pixels since its start (the travel made with the fine modifier held counting a tenth), and
+    # ends. The kind is "orbit", "pan" or "dolly".
     navigation_started = Signal(str, object)  # kind, the (x, y) image pixel it started on, or None
     navigation_moved = Signal(str, float, float)
     navigation_finished = Signal()
@@ -96,7 +98,7 @@ class Viewport(QWidget):
         self.region_rect: QRectF | None = None  # the render region being refined, image pixels
         self._region_start: QPointF | None = None
         self._region_end: QPointF | None = None
-        self._navigation: tuple[str, QPointF] | None = None  # (kind, where it started)
+        self._navigation: tuple[str, MouseTravel, Qt.KeyboardModifier] | None = None  # kind, travel, fine key
         self.pan = QPointF(0, 0)
         self.tool = "select"
         self.gbuffer = None
@@ -112,6 +114,10 @@ class Viewport(QWidget):
         self.hud_text = ""
         self.message = ""  # an error to show over the image
         self.status_text = ""  # e.g. "Preview" in the corner
+        self.idle_text = "Starting the renderer…"  # before the first picture: what is under way (work_banner.py)
+        # Whether the picture is clean enough for the judging aids (peaking, clipping, the histogram) to mean
+        # something: render_loop.Frame.worth_judging. Until one is, they wait rather than mark the noise.
+        self.worth_judging = True
         self.focus_pending = False
         # Drawn over the picture in order, each by ``layer.paint(painter, viewport, image_rect)`` where it is
         # ``visible``: the sensor's gate and guides, focus peaking, clipping warnings, the loupe.
@@ -329,7 +335,7 @@ class Viewport(QWidget):
             p.drawText(self.rect().adjusted(40, 40, -40, -40), Qt.AlignCenter | Qt.TextWordWrap, self.message)
         elif self.qimage is None:
             p.setPen(QColor(theme.DIM_TEXT))
-            p.drawText(self.rect(), Qt.AlignCenter, "Starting the renderer…")
+            p.drawText(self.rect(), Qt.AlignCenter, self.idle_text)
         p.end()
 
     def _draw_region(self, p: QPainter) -> None:
@@ -420,11 +426,17 @@ class Viewport(QWidget):
             return "dolly"  # Maya: Alt + right
         return None
 
+    @staticmethod
+    def fine_modifier(modifiers) -> Qt.KeyboardModifier:
+        """The key that makes a camera move fine while it is held: Shift, unless Shift chose the gesture
+        (Blender's pan), where it is Ctrl. A key that chose the gesture may be held all through it."""
+        return Qt.ControlModifier if modifiers & Qt.ShiftModifier else Qt.ShiftModifier
+
     def mousePressEvent(self, event) -> None:
         pos = event.position()
         kind = self.navigation_kind(event.button(), event.modifiers())
         if kind is not None and self._navigation is None:
-            self._navigation = (kind, pos)
+            self._navigation = (kind, MouseTravel(pos.x(), pos.y()), self.fine_modifier(event.modifiers()))
             xy = self.widget_to_image(pos)
             self.setCursor(Qt.SizeAllCursor)
             self.navigation_started.emit(kind, None if xy is None else (int(xy[0]), int(xy[1])))
@@ -450,8 +462,11 @@ class Viewport(QWidget):
     def mouseMoveEvent(self, event) -> None:
         pos = event.position()
         if self._navigation is not None:
-            kind, start = self._navigation
-            self.navigation_moved.emit(kind, pos.x() - start.x(), pos.y() - start.y())
+            # The travel is summed stretch by stretch, each at the speed of the keys held as it was made, so
+            # the camera depends on the mouse's path and not on how many events the system sent along it.
+            kind, travel, fine = self._navigation
+            dx, dy = travel.move_to(pos.x(), pos.y(), bool(event.modifiers() & fine))
+            self.navigation_moved.emit(kind, dx, dy)
             return
         if self._region_start is not None:
             self._region_end = QPointF(*self.widget_to_image_unclamped(pos))

@@ -1,5 +1,6 @@
 """Small widgets the panels are built from: collapsible sections, spin boxes you can scrub by dragging their
-label (Blender style: Shift for fine steps, Ctrl for coarse), vector and colour editors."""
+label (Blender style: Shift for fine steps, Ctrl for coarse), sliders that know their drags, vector and colour
+editors."""
 
 from __future__ import annotations
 
@@ -218,6 +219,25 @@ class SignedNumberEdit(QDoubleSpinBox):
             event.ignore()
 
 
+class DragSlider(QSlider):
+    """A slider that knows its drags: ``gesture`` is one token from the press on its handle to the release, and
+    None otherwise (the keys, a focused slider's wheel, a click beside the handle). The edits a drag makes carry it,
+    so that they are one step in the History however long the hand pauses on the way (lenslab.gui.commands)."""
+
+    def __init__(self, orientation=Qt.Horizontal, parent: QWidget | None = None):
+        super().__init__(orientation, parent)
+        self.setFocusPolicy(Qt.StrongFocus)  # the wheel changes it only once clicked or tabbed into
+        self.gesture: object | None = None
+        self.sliderPressed.connect(self._pressed)
+        self.sliderReleased.connect(self._released)
+
+    def _pressed(self) -> None:
+        self.gesture = object()
+
+    def _released(self) -> None:
+        self.gesture = None
+
+
 class ResetSlider(QSlider):
     """A slider that goes back to ``default`` on a double click (as Lightroom's sliders do)."""
 
@@ -373,5 +393,6 @@ def slider_to_log(position: int, lo: float, hi: float, steps: int = 1000) -> flo
     return math.exp(math.log(lo) + position / steps * (math.log(hi) - math.log(lo)))
 
 
-__all__ = ["Section", "ScrubLabel", "NumberEdit", "IntEdit", "SignedNumberEdit", "ResetSlider", "VectorEdit",
+__all__ = ["Section", "ScrubLabel", "NumberEdit", "IntEdit", "SignedNumberEdit", "DragSlider", "ResetSlider",
+           "VectorEdit",
            "ColorEdit", "ColorSwatch", "hint", "readout", "log_to_slider", "slider_to_log", "DIM_TEXT"]

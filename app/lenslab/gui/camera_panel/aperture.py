@@ -9,14 +9,16 @@ from typing import TYPE_CHECKING
 
 from PySide6.QtCore import QPointF, QRectF, QSize, Qt, Signal
 from PySide6.QtGui import QColor, QFont, QPainter, QPen, QPolygonF
-from PySide6.QtWidgets import QComboBox, QHBoxLayout, QLabel, QSlider, QToolButton, QVBoxLayout, QWidget
+from PySide6.QtWidgets import QComboBox, QHBoxLayout, QLabel, QToolButton, QVBoxLayout, QWidget
 
 from lenslab.gui import theme
 from lenslab.gui.camera_panel.section import CameraSection
-from lenslab.gui.widgets import hint
+from lenslab.gui.commands import push_values
+from lenslab.gui.widgets import DragSlider, hint
 from lenslab.optics import THIRD_STOPS, format_f_number, parse_f_number, step_stop
 from lenslab.optics.stops import STOP_SCALES, marked_f_number
 from lenslab.scene.camera import ThinLensCamera
+from lenslab.scene.editable import CAMERA
 
 if TYPE_CHECKING:
     from lenslab.gui.camera_panel import CameraPanel
@@ -71,8 +73,7 @@ class StopSlider(QWidget):
 
     def __init__(self, parent=None):
         super().__init__(parent)
-        self.slider = QSlider(Qt.Horizontal)
-        self.slider.setFocusPolicy(Qt.StrongFocus)
+        self.slider = DragSlider(Qt.Horizontal)
         self.labels = QWidget()
         self.labels.setFixedHeight(14)
         self.labels.paintEvent = self._paint_labels
@@ -158,7 +159,7 @@ class ApertureSection(CameraSection):
         row.addWidget(self.stop_down)
         self.add(row)
         self.stop_slider = StopSlider()
-        self.stop_slider.moved.connect(lambda n, merge: self.set_f_number(n, merge))
+        self.stop_slider.moved.connect(lambda n, merge: self.set_f_number(n, merge, self.stop_slider.slider.gesture))
         self.add(self.stop_slider)
         steps = QHBoxLayout()
         self.stop_scale_combo = QComboBox()
@@ -182,7 +183,7 @@ class ApertureSection(CameraSection):
             return
         self.panel.choose_stop_scale(self.stop_scale_combo.itemData(index))
 
-    def set_f_number(self, n: float, merge: bool = False) -> None:
+    def set_f_number(self, n: float, merge: bool = False, gesture: object | None = None) -> None:
         lens = self.doc.lens
         if lens is not None:
             clamped = lens.clamp_f_number(n)
@@ -190,7 +191,7 @@ class ApertureSection(CameraSection):
                 self.panel.status_message.emit(f"The {lens.name} goes from {format_f_number(lens.widest_f_number)} "
                                                f"to {format_f_number(lens.narrowest_f_number)}")
             n = clamped
-        self.doc.set_camera(f"Aperture {format_f_number(n)}", merge, f_number=float(n))
+        push_values(self.doc, CAMERA, {("f_number",): float(n)}, f"Aperture {format_f_number(n)}", merge, gesture)
         self.panel.refresh()  # the clamp may leave the camera as it was; show the truth either way
 
     def step_aperture(self, steps: int) -> None:

@@ -1,18 +1,27 @@
 """The camera panel's focal length section: a slider on a log scale, a field and the common focal lengths, within
-the mounted zoom's range (a prime's are asleep), and the field of view they give."""
+the mounted zoom's range (a prime's are asleep), and the field of view they give.
+
+A longer focal length cannot focus as near (four focal lengths from the sensor, or the lens's own minimum): a
+focal length that ends nearer than the focus allows moves the focus out, in the same step. The focus is the
+photographer's, though: each edit works it out from the focus as it was when its step began, so a drag out to
+800 mm and back to 31 mm, or the arrow keys run up and down, leave it as it was.
+"""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import TYPE_CHECKING
 
 from PySide6.QtCore import Qt
-from PySide6.QtWidgets import QHBoxLayout, QPushButton, QSlider
+from PySide6.QtWidgets import QHBoxLayout, QPushButton
 
 from lenslab.gui.camera_panel.section import CameraSection
-from lenslab.gui.widgets import NumberEdit, hint, log_to_slider, slider_to_log
+from lenslab.gui.commands import push_values, value_before_step
+from lenslab.gui.widgets import DragSlider, NumberEdit, hint, log_to_slider, slider_to_log
 from lenslab.optics import LensPreset, format_distance, format_focal_length
 from lenslab.scene.camera import ThinLensCamera
+from lenslab.scene.editable import CAMERA
 from lenslab.scene.editing import camera_changes_keeping_focus
 from lenslab.scene.fields import declared_range
 
@@ -21,6 +30,7 @@ if TYPE_CHECKING:
 
 COMMON_FOCAL_LENGTHS = (14, 24, 35, 50, 85, 135, 200)
 FOCAL_RANGE = (8.0, 800.0)
+_FOCAL_FIELDS = (("focal_length_mm",), ("focus_distance_m",))  # what a focal length edit sets, always both
 
 
 def focal_limits_for(lens: LensPreset | None) -> tuple[float, float]:
@@ -37,9 +47,8 @@ class FocalLengthSection(CameraSection):
         self.focal = NumberEdit(*declared_range(ThinLensCamera, "focal_length_mm"), decimals=1, step=1.0, suffix=" mm")
         self.focal.setObjectName("focalLength")
         self.focal.edited.connect(lambda v, merge: self.set_focal_length(v, merge))
-        self.focal_slider = QSlider(Qt.Horizontal)
+        self.focal_slider = DragSlider(Qt.Horizontal)
         self.focal_slider.setRange(0, 1000)
-        self.focal_slider.setFocusPolicy(Qt.StrongFocus)
         self.focal_slider.valueChanged.connect(self._focal_slid)
         row.addWidget(self.focal_slider, 1)
         row.addWidget(self.focal)
@@ -60,7 +69,7 @@ class FocalLengthSection(CameraSection):
         self.add(self.fov_info)
 
     # -- edits ----------------------------------------------------------------------------------------------------
-    def set_focal_length(self, mm: float, merge: bool) -> None:
+    def set_focal_length(self, mm: float, merge: bool, gesture: object | None = None) -> None:
         lens = self.doc.lens
         if lens is not None:
             if not lens.is_zoom and not math.isclose(mm, lens.focal_length_mm):
@@ -69,11 +78,16 @@ class FocalLengthSection(CameraSection):
                 self.panel.refresh()
                 return
             mm = lens.clamp_focal_length(mm)
-        changes = camera_changes_keeping_focus(self.doc.scene.camera, lens, focal_length_mm=float(mm))
-        if "focus_distance_m" in changes:
-            self.panel.status_message.emit(f"Focus moved out to {format_distance(changes['focus_distance_m'])}: a "
+        # The focus the photographer set: before this step began (a drag through a long lens moved it on the way).
+        chosen = value_before_step(self.doc, CAMERA, ("focus_distance_m",), _FOCAL_FIELDS, merge, gesture)
+        changes = camera_changes_keeping_focus(dataclasses.replace(self.doc.scene.camera, focus_distance_m=chosen),
+                                               lens, focal_length_mm=float(mm))
+        focus = changes.get("focus_distance_m", chosen)
+        if focus != chosen:
+            self.panel.status_message.emit(f"Focus moved out to {format_distance(focus)}: a "
                                            f"{format_focal_length(mm)} lens focuses no nearer")
-        self.doc.set_camera(f"Focal length {mm:g} mm", merge, **changes)
+        push_values(self.doc, CAMERA, dict(zip(_FOCAL_FIELDS, (float(mm), focus))), f"Focal length {mm:g} mm",
+                    merge, gesture)
         self.panel.refresh()
 
     def _focal_slid(self, position: int) -> None:
@@ -81,7 +95,7 @@ class FocalLengthSection(CameraSection):
             return
         lo, hi = focal_limits_for(self.doc.lens)
         mm = round(slider_to_log(position, lo, hi), 1)
-        self.set_focal_length(mm, True)
+        self.set_focal_length(mm, True, self.focal_slider.gesture)
 
     # -- following the document ---------------------------------------------------------------------------------
     def refresh(self, cam: ThinLensCamera, lens: LensPreset | None) -> None:

@@ -7,12 +7,14 @@ from typing import TYPE_CHECKING
 
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QAction
-from PySide6.QtWidgets import QCheckBox, QComboBox, QHBoxLayout, QPushButton, QSlider, QToolButton
+from PySide6.QtWidgets import QCheckBox, QComboBox, QHBoxLayout, QPushButton, QToolButton
 
 from lenslab.gui.camera_panel.section import CameraSection
-from lenslab.gui.widgets import NumberEdit, hint, log_to_slider, slider_to_log
+from lenslab.gui.commands import push_values
+from lenslab.gui.widgets import DragSlider, NumberEdit, hint, log_to_slider, slider_to_log
 from lenslab.optics import LensPreset, format_distance, format_focal_length
 from lenslab.scene.camera import ThinLensCamera
+from lenslab.scene.editable import CAMERA
 from lenslab.scene.editing import closest_focus
 from lenslab.scene.fields import declared_range
 
@@ -31,9 +33,8 @@ class FocusSection(CameraSection):
     def __init__(self, panel: CameraPanel, focus_action: QAction | None = None):
         super().__init__(panel, "focus", "Focus")
         row = QHBoxLayout()
-        self.focus_slider = QSlider(Qt.Horizontal)
+        self.focus_slider = DragSlider(Qt.Horizontal)
         self.focus_slider.setRange(0, 1000)
-        self.focus_slider.setFocusPolicy(Qt.StrongFocus)
         self.focus_slider.valueChanged.connect(self._focus_slid)
         self.focus = NumberEdit(*declared_range(ThinLensCamera, "focus_distance_m"), decimals=3, step=0.01, suffix=" m")
         self.focus.setObjectName("focusDistance")
@@ -100,7 +101,8 @@ class FocusSection(CameraSection):
             return
         closest, far = self.focus_limits()
         metres = max(closest, float(f"{slider_to_log(position, closest, far):.3g}"))
-        self.doc.set_camera(f"Focus {format_distance(metres)}", True, focus_distance_m=metres)
+        push_values(self.doc, CAMERA, {("focus_distance_m",): metres}, f"Focus {format_distance(metres)}", True,
+                    self.focus_slider.gesture)
 
     def _focus_from_chosen(self, index: int) -> None:
         if self._updating or index < 0:
