@@ -23,12 +23,15 @@ import contextlib
 import hashlib
 import os
 import re
+import shutil
 import socket
 import tempfile
 import time
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Callable, Iterator
+
+from lenslab.limits import format_bytes
 
 TEMPORARY_PREFIX = ".lenslab-"
 #: A temporary file older than this has lost its writer, wherever that ran: no image or scene takes hours to write.
@@ -75,6 +78,30 @@ def _create_temporary(path: Path) -> Path:
         raise WriteFailed(path, f"cannot write in {path.parent} ({exc.strerror or exc})", exc.errno) from None
     os.close(fd)
     return Path(name)
+
+
+def check_output_folder(path: str | os.PathLike, estimated_bytes: int = 0) -> None:
+    """Raise WriteFailed, naming ``path`` and the problem in one line, if ``path`` cannot be written now: its folder
+    is missing or a file, refuses a new file, or has less free space than ``estimated_bytes``. For a caller about
+    to spend minutes making the file (a render), so that it fails before the work, not after.
+
+    The folder is asked by doing what the writer will do: a temporary file of ours is made there and removed
+    (permission bits say nothing for root, nor for a read-only mount, an ACL or a full inode table)."""
+    path = Path(path)
+    folder = path.parent
+    if folder.exists() and not folder.is_dir():
+        raise WriteFailed(path, f"{folder} is a file, not a folder")
+    if not folder.is_dir():
+        raise WriteFailed(path, f"the folder {folder} does not exist")
+    _discard(_create_temporary(path))
+    if estimated_bytes > 0:
+        try:
+            free = shutil.disk_usage(folder).free
+        except OSError:  # a file system that will not say: the write itself will tell
+            return
+        if free < estimated_bytes:
+            raise WriteFailed(path, f"not enough space in {folder}: the file needs about "
+                                    f"{format_bytes(estimated_bytes)}, {format_bytes(free)} is free")
 
 
 def _process_alive(pid: int) -> bool:

@@ -87,6 +87,7 @@ def _print_info(device: int | None) -> int:
 
 
 def _check_output(path_text: str | None) -> Path:
+    from lenslab.atomic import check_output_folder
     from lenslab.render.film import EXPORT_SUFFIXES
 
     if not path_text:
@@ -103,6 +104,10 @@ def _check_output(path_text: str | None) -> Path:
         raise CliError(f"{path}: folder '{folder}' does not exist")
     if not os.access(folder, os.W_OK):
         raise CliError(f"{path}: folder '{folder}' is not writable")
+    try:  # permissions say nothing for root: the folder asked as the writer will ask it, before the render
+        check_output_folder(path)
+    except OSError as exc:
+        raise CliError(str(exc)) from None
     return path
 
 

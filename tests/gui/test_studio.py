@@ -414,10 +414,11 @@ def test_the_window_closes_cleanly_while_rendering(qtbot, make_window, small_sce
     window = make_window(small_scene)
     wait_for_frame(qtbot, window, min_spp=1)
     assert window.controller.worker.isRunning() and not window.controller.last_frame.converged
-    # An export in flight too: closing cancels it and leaves no file.
+    # An export in flight too: closing asks, and stopping it leaves no file.
     out = tmp_path / "never.exr"
     window.start_export(export_request(window, out, target_spp=1_000_000))
     qtbot.waitSignal(window.controller.export_progress, timeout=20000).wait()
+    answer_next_prompt(window, QMessageBox.Discard)  # Stop Export and Close
     start = time.perf_counter()
     assert window.close()
     assert window.controller.worker.isFinished()

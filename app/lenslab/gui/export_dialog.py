@@ -27,9 +27,11 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from lenslab.atomic import check_output_folder
 from lenslab.gui.controller import rate_text
 from lenslab.gui.document import copy_scene
 from lenslab.gui.worker import ExportRequest
+from lenslab.messages import one_line
 from lenslab.render.film import TONE_MAPS
 from lenslab.scene.camera import MAX_IMAGE_SIDE
 from lenslab.scene.fields import declared_range
@@ -42,6 +44,18 @@ def default_export_path(doc, suffix: str = ".png") -> Path:
     folder = Path(doc.path).parent if doc.path else Path.home()
     stem = doc.display_name if doc.display_name != "Untitled" else "render"
     return folder / f"{stem}{suffix}"
+
+
+def export_problem(path: Path, width: int, height: int, denoise: bool = False) -> str | None:
+    """Why an image of ``width`` x ``height`` cannot be written at ``path`` now (its folder refuses a new file, or
+    lacks the space), in one line naming the file; None if it can. Asked before the render, not after it."""
+    from lenslab.render.job import estimated_export_bytes  # here: it brings the tracer, left to the render thread
+
+    try:
+        check_output_folder(path, estimated_export_bytes(path, width, height, denoise))
+    except OSError as exc:
+        return one_line(exc)
+    return None
 
 
 def estimate_seconds(width: int, height: int, spp: int, samples_per_second: float | None) -> float | None:
@@ -238,7 +252,7 @@ class ExportDialog(QDialog):
             return f"{path.name}: choose a .exr or .png file name"
         if not path.parent.is_dir():
             return f"The folder {path.parent} does not exist"
-        return None
+        return export_problem(path, self.width_spin.value(), self.height_spin.value(), self.denoise_check.isChecked())
 
     def accept(self) -> None:
         problem = self.validate()
@@ -258,4 +272,4 @@ def _duration(seconds: float) -> str:
     return f"{seconds / 3600:.1f} h"
 
 
-__all__ = ["ExportDialog", "default_export_path", "estimate_seconds", "Qt"]
+__all__ = ["ExportDialog", "default_export_path", "estimate_seconds", "export_problem", "Qt"]

@@ -1,6 +1,6 @@
-"""The studio's files: new, open (a file, an example, a recent scene), save and save as, the question about unsaved
-changes, meshes imported (on a background thread) and files dropped on the window; and the folders each kind
-of file was last in and the recent scenes, remembered between runs (QSettings)."""
+"""The studio's files: new, open (a file, an example, a recent scene, with what its reader warned about), save and
+save as, the question about unsaved changes, meshes imported (on a background thread) and files dropped on the
+window; and the folders each kind of file was last in and the recent scenes, remembered between runs (QSettings)."""
 
 from __future__ import annotations
 
@@ -17,12 +17,26 @@ from lenslab.gui.defaults import studio_scene
 from lenslab.gui.document import Document, is_shipped
 from lenslab.messages import one_line
 from lenslab.scene import editing
-from lenslab.scene.io.loader import open_scene, resolve_scene_path, scene_title, shipped_scene_names
+from lenslab.scene.io.loader import (SCENE_FORMATS, SCENE_SUFFIXES, open_scene, resolve_scene_path, scene_title,
+                                     shipped_scene_names)
 from lenslab.scene.io.meshes import MESH_SUFFIXES, MeshLoadError, load_mesh
 from lenslab.scene.io.native import SCENE_SUFFIX, save_scene
 from lenslab.scene.scene import SceneError
 
 MAX_RECENT = 10
+
+
+def file_filter(name: str, suffixes) -> str:
+    return f"{name} ({' '.join('*' + suffix for suffix in suffixes)})"
+
+
+def open_dialog_filters() -> str:
+    """The Open dialog's filters, made from what the readers accept: every kind at once (the default), each scene
+    format, meshes (imported into the open scene, as a dropped mesh is), and any file."""
+    kinds = (*SCENE_FORMATS, ("Meshes", MESH_SUFFIXES))
+    supported = [suffix for _name, suffixes in kinds for suffix in suffixes]
+    return ";;".join([file_filter("All supported", supported), *(file_filter(*kind) for kind in kinds),
+                      "All files (*)"])
 
 
 class FileController(QObject):
@@ -31,6 +45,7 @@ class FileController(QObject):
 
     mesh_imported = Signal(str)  # path, once its node is in the scene
     mesh_import_failed = Signal(str, str)  # path, reason
+    scene_opened_with_warnings = Signal(str, list)  # path, what its reader approximated or left out (maybe none)
     _mesh_loaded = Signal(object, object, str)  # from the loading thread
 
     def __init__(self, window: QMainWindow, doc: Document, settings: QSettings,
@@ -74,24 +89,28 @@ class FileController(QObject):
             self.doc.replace(studio_scene(), None)
 
     def open_dialog(self) -> None:
-        if not self.maybe_save():
-            return
         start = str(self.last_folder("scenes") or (self.doc.path.parent if self.doc.path else Path.home()))
-        name, _ = QFileDialog.getOpenFileName(self.window, "Open scene", start,
-                                              f"LensLab scenes (*{SCENE_SUFFIX});;All files (*)")
-        if name:
-            self.open_path(name, ask=False)
+        name, _ = QFileDialog.getOpenFileName(self.window, "Open", start, open_dialog_filters())
+        if not name:
+            return
+        if Path(name).suffix.lower() in MESH_SUFFIXES:  # added to the open scene: no question about it
+            self.remember_folder("meshes", name)
+            self.window.import_mesh(Path(name))
+        else:
+            self.open_path(name)  # asks about unsaved changes now that a scene is chosen
 
     def open_path(self, text: str | os.PathLike, ask: bool = True) -> bool:
         if ask and not self.maybe_save():
             return False
+        warnings: list[str] = []  # the reader runs on this thread: it reports to this list as it reads
         try:
             path = resolve_scene_path(text)
-            scene = open_scene(text)
+            scene = open_scene(text, warn=warnings.append)
         except (SceneError, OSError) as exc:
             QMessageBox.critical(self.window, "Cannot open scene", one_line(exc))
             return False
         self.doc.replace(scene, path)
+        self.scene_opened_with_warnings.emit(str(path), warnings)
         if not is_shipped(path):
             self.add_recent(path)
             self.remember_folder("scenes", path)
@@ -177,7 +196,7 @@ class FileController(QObject):
     def import_dialog(self) -> None:
         self.warm_up_mesh_library()
         start = str(self.last_folder("meshes") or self.doc.scene.base_dir())
-        pattern = "Meshes (" + " ".join("*" + s for s in MESH_SUFFIXES) + ");;All files (*)"
+        pattern = file_filter("Meshes", MESH_SUFFIXES) + ";;All files (*)"
         names, _ = QFileDialog.getOpenFileNames(self.window, "Import mesh", start, pattern)
         if names:
             self.remember_folder("meshes", names[0])
@@ -238,13 +257,13 @@ class FileController(QObject):
         paths = self.dropped_paths(event)
         if any(p.suffix.lower() in MESH_SUFFIXES for p in paths):
             self.warm_up_mesh_library()
-        if any(p.suffix.lower() in MESH_SUFFIXES or p.suffix.lower() == SCENE_SUFFIX or p.is_dir() for p in paths):
+        if any(p.suffix.lower() in (*MESH_SUFFIXES, *SCENE_SUFFIXES) or p.is_dir() for p in paths):
             event.acceptProposedAction()
 
     def drop(self, event) -> None:
         paths = self.dropped_paths(event)
         meshes = [p for p in paths if p.suffix.lower() in MESH_SUFFIXES]
-        scenes = [p for p in paths if p.suffix.lower() == SCENE_SUFFIX or p.is_dir()]
+        scenes = [p for p in paths if p.suffix.lower() in SCENE_SUFFIXES or p.is_dir()]
         event.acceptProposedAction()
         if meshes:
             for p in meshes:
@@ -253,4 +272,4 @@ class FileController(QObject):
             QTimer.singleShot(0, lambda: self.open_path(scenes[0]))
 
 
-__all__ = ["FileController", "MAX_RECENT"]
+__all__ = ["FileController", "MAX_RECENT", "open_dialog_filters"]

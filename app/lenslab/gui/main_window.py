@@ -13,8 +13,8 @@ from pathlib import Path
 
 from PySide6.QtCore import QSettings, Qt, QTimer, Signal
 from PySide6.QtGui import QAction, QKeySequence
-from PySide6.QtWidgets import (QDockWidget, QMainWindow, QMenu, QMessageBox, QProgressDialog, QScrollArea, QUndoView,
-                               QVBoxLayout, QWidget)
+from PySide6.QtWidgets import (QDockWidget, QMainWindow, QMenu, QMessageBox, QProgressDialog, QUndoView, QVBoxLayout,
+                               QWidget)
 
 from lenslab import __version__
 from lenslab.gui.actions import build_menus, create_actions, make_action, selection_has_nodes, update_enabled
@@ -25,21 +25,28 @@ from lenslab.gui.document import Document, is_shipped, listen
 from lenslab.gui.edit_controller import EditController
 from lenslab.gui.export_flow import ExportFlow
 from lenslab.gui.file_controller import FileController
+from lenslab.gui.log_panel import LogPanel, install_log_dock, show_dock
 from lenslab.gui.navigation import CameraNavigator
+from lenslab.gui.panel_scroll import PanelScroll
 from lenslab.gui.properties import PropertyEditor
 from lenslab.gui.render_status import RenderStatus
 from lenslab.gui.scene_tree import SceneTreeView, node_context_menu
 from lenslab.gui.snapshot_panel import StudioSnapshots
 from lenslab.gui.viewing_aids import ViewingAids
 from lenslab.gui.viewport import Viewport
-from lenslab.gui.viewport_toolbar import ViewportToolbar, saved_look
+from lenslab.gui.viewport_toolbar import ViewportToolbar, saved_look, under_toolbar
 from lenslab.gui.viewport_tools import ViewportTools
+from lenslab.gui.warning_bar import WarningBar
 from lenslab.gui.worker import VIEWPORT_DISPATCH_SECONDS
 from lenslab.optics import format_camera_settings
 from lenslab.optics.exposure import format_shutter
 from lenslab.scene.io.loader import scene_title
 
 APP_NAME = "LensLab"
+#: The window's size when it has none remembered, and the default widths of the left and right panels (the property
+#: editor's rows and the camera panel whole, the toolbar above the picture in one row).
+DEFAULT_SIZE = (1480, 920)
+DEFAULT_DOCK_WIDTHS = (250, 330)
 
 
 def studio_settings() -> QSettings:
@@ -88,6 +95,7 @@ class MainWindow(QMainWindow):
         self.actions: dict[str, QAction] = create_actions(self)
         self.setCentralWidget(self._central())
         self._create_docks()
+        self._install_warnings()
         menus = build_menus(self.menuBar(), self.actions, {
             "examples": self.files.fill_examples_menu, "recent": self.files.fill_recent_menu,
             "panels": self._add_panel_toggles, "lenses": self._fill_lens_menu})
@@ -95,15 +103,16 @@ class MainWindow(QMainWindow):
         self.render_status = RenderStatus(self, self.viewport, self.controller)  # the status bar's labels
         self._connect()
         self.snapshots = StudioSnapshots(self)  # its dock exists before the saved layout is restored
+        self.docks["snapshots"].setWidget(PanelScroll(self.snapshots.panel))
         # The sensor's gate and guides, aspect presets, focus peaking, the histogram and clipping warnings, the loupe.
         self.viewing = ViewingAids(self)
         self.setAcceptDrops(True)
         self.setWindowIcon(app_icon())
-        self.resize(1480, 920)
+        self.resize(*DEFAULT_SIZE)
         if restore_layout:
             self._restore_layout()
         self._update_title()
-        self._update_hud()
+        self.update_camera_tag()
         self._update_actions()
 
     # -- construction ------------------------------------------------------------------------------------------
@@ -114,7 +123,8 @@ class MainWindow(QMainWindow):
         return make_action(self, text, slot, shortcut, icon, checkable, tip)
 
     def _central(self) -> QWidget:
-        """The viewport between its toolbar (the tools and the display settings) and the readout under the cursor."""
+        """The viewport between its toolbar (the tools and the display settings) and the readout under the cursor.
+        The viewport and the readout are ``viewport.parentWidget()``, in a column; the toolbar is above it."""
         self.toolbar = ViewportToolbar(self.actions, self.viewport, self.controller, self)
         # Its widgets, by the names the studio's panels and the tests know them by.
         t = self.toolbar
@@ -126,10 +136,9 @@ class MainWindow(QMainWindow):
         layout = QVBoxLayout(central)
         layout.setContentsMargins(0, 0, 0, 0)
         layout.setSpacing(0)
-        layout.addWidget(t.bar)
         layout.addWidget(self.viewport, 1)
         layout.addWidget(self.readout)
-        return central
+        return under_toolbar(t.bar, central)
 
     def _create_docks(self) -> None:
         self.setDockOptions(QMainWindow.AnimatedDocks | QMainWindow.AllowTabbedDocks)
@@ -140,11 +149,7 @@ class MainWindow(QMainWindow):
         self.camera_panel.stop_scale_changed.connect(self._name_stop_actions)
         self._name_stop_actions(self.camera_panel.scale_name)
         self.camera_panel.focus_selection_button.clicked.connect(self.focus_on_selection)
-        camera_scroll = QScrollArea()
-        camera_scroll.setWidgetResizable(True)
-        camera_scroll.setHorizontalScrollBarPolicy(Qt.ScrollBarAlwaysOff)
-        camera_scroll.setWidget(self.camera_panel)
-        camera_scroll.setMinimumWidth(330)
+        camera_scroll = PanelScroll(self.camera_panel)
         self.history = QUndoView(self.doc.undo_stack)
         self.history.setEmptyLabel("Opened")
         self.docks: dict[str, QDockWidget] = {}
@@ -161,6 +166,17 @@ class MainWindow(QMainWindow):
             self.docks[key] = dock
         self._default_dock_layout()
 
+    def _install_warnings(self) -> None:
+        """What opening a scene warned about: a bar above the picture, and the Log panel (View > Log) that keeps it."""
+        self.warning_bar = WarningBar()
+        layout = self.viewport.parentWidget().layout()
+        layout.insertWidget(layout.indexOf(self.viewport), self.warning_bar)
+        self.log_panel = LogPanel()
+        self.docks["log"] = install_log_dock(self, self.log_panel)
+        self.actions["reset_layout"].triggered.connect(self.docks["log"].hide)  # after the window's own reset
+        self.warning_bar.log_requested.connect(lambda: show_dock(self.docks["log"]))
+        self.files.scene_opened_with_warnings.connect(self.report_warnings)
+
     def _default_dock_layout(self) -> None:
         for dock in self.docks.values():
             dock.setFloating(False)
@@ -168,8 +184,21 @@ class MainWindow(QMainWindow):
         self.splitDockWidget(self.docks["scene"], self.docks["properties"], Qt.Vertical)
         self.tabifyDockWidget(self.docks["camera"], self.docks["history"])
         self.docks["camera"].raise_()
-        self.resizeDocks([self.docks["scene"], self.docks["camera"]], [360, 350], Qt.Horizontal)
+        self._dock_sizes_due = True
+        if self.isVisible():
+            self._size_docks()
+
+    def _size_docks(self) -> None:
+        """The panels' default widths and heights. A window given them before it is shown shares its width out
+        anew when it is, so a new window takes them in its first show (``showEvent``)."""
+        self._dock_sizes_due = False
+        self.resizeDocks([self.docks["scene"], self.docks["camera"]], list(DEFAULT_DOCK_WIDTHS), Qt.Horizontal)
         self.resizeDocks([self.docks["scene"], self.docks["properties"]], [300, 520], Qt.Vertical)
+
+    def showEvent(self, event) -> None:
+        super().showEvent(event)
+        if self._dock_sizes_due:
+            self._size_docks()
 
     def _add_panel_toggles(self, menu: QMenu) -> None:
         for dock in self.docks.values():
@@ -218,8 +247,8 @@ class MainWindow(QMainWindow):
         state = self.settings.value("window/state")
         if geometry is not None:
             self.restoreGeometry(geometry)
-        if state is not None:
-            self.restoreState(state)
+        if state is not None and self.restoreState(state):
+            self._dock_sizes_due = False  # the panels as they were left
 
     def _save_layout(self) -> None:
         s = self.settings
@@ -254,8 +283,11 @@ class MainWindow(QMainWindow):
         self.actions["open_up"].setText(f"Open Up {amount} Stop")
         self.actions["stop_down"].setText(f"Stop Down {amount} Stop")
 
-    def _update_hud(self) -> None:
-        cam = self.doc.scene.camera
+    def update_camera_tag(self) -> None:
+        """The camera tag describes the picture shown, not the document's latest camera: until the new picture
+        comes the work banner says one is on its way."""
+        frame = self.controller.last_frame
+        cam = frame.camera if frame is not None and frame.camera is not None else self.doc.scene.camera
         self.viewport.hud_text = format_camera_settings(cam.focal_length_mm, cam.f_number, cam.focus_distance_m)
         if cam.exposure_mode == "physical":
             self.viewport.hud_text += f" \u00b7 {format_shutter(cam.shutter_s)} \u00b7 ISO {cam.iso:g}"
@@ -270,11 +302,11 @@ class MainWindow(QMainWindow):
             self.viewport.fit()
             self.camera_panel.refresh()
         if change.kind == "camera":
-            self._update_hud()
+            self.update_camera_tag()
             if change.field[:1] in (("focus_distance_m",), ("f_number",), ("sensor_mm",)) or change.field == ():
                 self.tools.show_focus_overlay(self.doc.scene.camera.plane_of_focus_m)
         if change.kind == "scene":
-            self._update_hud()
+            self.update_camera_tag()
         self._update_actions()
 
     def _selection_changed(self) -> None:
@@ -378,6 +410,11 @@ class MainWindow(QMainWindow):
     def export_progress_dialog(self) -> QProgressDialog | None:
         return self.export_flow.progress_dialog
 
+    def report_warnings(self, source: str, lines: list[str]) -> None:
+        """Show what opening ``source`` warned about; with nothing to say, the bar about the last scene goes."""
+        self.warning_bar.show_warnings(source, lines)
+        self.log_panel.add(source, lines)
+
     # -- help ----------------------------------------------------------------------------------------------------------
     def show_shortcuts(self) -> None:
         rows = []
@@ -400,7 +437,8 @@ class MainWindow(QMainWindow):
 
     # -- closing -------------------------------------------------------------------------------------------------------
     def closeEvent(self, event) -> None:
-        if not self.files.maybe_save():
+        # An export running asks first: waiting for it closes later, when unsaved changes are asked about.
+        if not self.export_flow.may_close() or not self.files.maybe_save():
             event.ignore()
             return
         self.files.closing = self.export_flow.closing = True  # a failure now is not worth a message box

@@ -109,6 +109,22 @@ class Layer:
     radiance: bool = True  # scaled by the camera's exposure as the main image is (albedo and normal are not)
 
 
+#: Bytes per channel of what write_image writes: EXR float32, PNG 8-bit.
+BYTES_PER_CHANNEL = {".exr": 4, ".png": 1}
+#: Room for a file's header and metadata beside its pixels.
+HEADER_ALLOWANCE_BYTES = 64 << 10
+
+
+def estimated_file_bytes(path: str | os.PathLike, width: int, height: int, layer_channels: int = 0) -> int:
+    """What write_image will need on disk for a ``width`` x ``height`` image at ``path`` (its suffix names the
+    format), with ``layer_channels`` more channels of EXR layers. The pixels as stored, uncompressed: EXR's zip
+    and PNG's deflate gain little on a noisy render, and a check of free space should not pass a file that then
+    does not fit."""
+    suffix = Path(path).suffix.lower()
+    channels = 3 + (layer_channels if suffix == ".exr" else 0)  # a PNG has no room for layers
+    return width * height * channels * BYTES_PER_CHANNEL.get(suffix, 4) + HEADER_ALLOWANCE_BYTES
+
+
 def write_image(path: str | os.PathLike, linear: np.ndarray, metadata: dict[str, object] | None = None,
                 *, sensor_exposure: float = 1.0, exposure_stops: float = 0.0, tone_map_operator: str = "clamp",
                 before_rename: Callable[[], None] | None = None, layers: Sequence[Layer] = ()) -> Path:

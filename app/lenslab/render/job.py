@@ -36,6 +36,18 @@ REPORT_SECONDS = 0.5
 OFFLINE_DISPATCH_SECONDS = 0.25
 
 
+#: The channels a denoised EXR keeps beside its R, G, B (RenderJob.denoised): noisy.RGB, albedo.RGB, normal.XYZ.
+DENOISED_LAYER_CHANNELS = 9
+
+
+def estimated_export_bytes(path: str | os.PathLike, width: int, height: int, denoise: bool = False) -> int:
+    """What :meth:`RenderJob.write` will need on disk for a ``width`` x ``height`` image at ``path``: for a check of
+    the output folder before the render (lenslab.atomic.check_output_folder)."""
+    from lenslab.render.film import estimated_file_bytes
+
+    return estimated_file_bytes(path, width, height, DENOISED_LAYER_CHANNELS if denoise else 0)
+
+
 @dataclass(frozen=True)
 class JobProgress:
     samples_per_pixel: int  # every pixel has at least this many

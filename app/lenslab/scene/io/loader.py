@@ -13,6 +13,10 @@ from lenslab.scene.io.native import SCENE_SUFFIX, load_scene
 from lenslab.scene.scene import Scene, SceneError
 
 SCENE_FILE_NAME = "scene.json"
+MITSUBA_SUFFIX = ".xml"
+#: The formats open_scene reads: what a file dialog calls each, and its suffixes.
+SCENE_FORMATS = (("LensLab scenes", (SCENE_SUFFIX,)), ("Mitsuba 3 scenes", (MITSUBA_SUFFIX,)))
+SCENE_SUFFIXES = tuple(suffix for _name, suffixes in SCENE_FORMATS for suffix in suffixes)
 
 
 def shipped_scene_names() -> list[str]:
@@ -82,12 +86,12 @@ def open_scene(text: str | os.PathLike, defines: dict[str, str] | None = None,
 
 def _open(path: Path, defines: dict[str, str] | None, warn: Callable[[str], None] | None) -> Scene:
     suffix = path.suffix.lower()
-    if suffix == ".xml":
+    if suffix == MITSUBA_SUFFIX:
         from lenslab.scene.io.mitsuba_xml import load_mitsuba_scene  # only Mitsuba users pay for the importer
 
         return load_mitsuba_scene(path, defines=defines, warn=warn)
     if suffix != SCENE_SUFFIX:
-        raise SceneError(f"{path}: unknown scene type '{path.suffix}' (expected {SCENE_SUFFIX} or .xml)")
+        raise SceneError(f"{path}: unknown scene type '{path.suffix}' (expected {SCENE_SUFFIX} or {MITSUBA_SUFFIX})")
     if defines:
         raise SceneError(f"{path}: -D parameters apply to Mitsuba XML scenes only")
     return load_scene(path)
