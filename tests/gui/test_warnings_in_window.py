@@ -145,3 +145,24 @@ def test_a_mitsuba_scene_named_on_the_command_line_shows_its_warnings_too(qtbot,
     qtbot.waitUntil(lambda: "bar" in seen, timeout=10000)
     assert seen["bar"] and UNKNOWN_PLUGIN in seen["bar"][0]
     assert len(seen["log"]) == 1 and UNKNOWN_PLUGIN in seen["log"][0]
+
+
+def test_a_missing_texture_found_while_rendering_reaches_the_bar_and_the_log_once(make_window, small_scene, qtbot,
+                                                                                  tmp_path):
+    """The render worker packs the scene: what it finds there (a texture file that is not there) is shown beside
+    the load's warnings, once, however many edits restart the render."""
+    import dataclasses
+
+    from lenslab.scene.textures import ImageTexture
+
+    name, material = next(iter(small_scene.materials.items()))
+    small_scene.materials[name] = dataclasses.replace(material, albedo_texture=ImageTexture(file=str(tmp_path / "gone.png")))
+    window = make_window(small_scene)
+    qtbot.waitUntil(lambda: window.warning_bar.isVisible(), timeout=20000)
+    assert any("gone.png: texture file not found" in line for line in window.warning_bar.lines())
+    logged = [line for line in window.log_panel.lines() if "gone.png" in line]
+    assert len(logged) == 1
+    window.doc.set_camera(f_number=8.0)  # a restart: the same warning is not said again
+    qtbot.waitUntil(lambda: window.controller.last_frame is not None
+                    and window.controller.last_frame.generation == window.controller.generation, timeout=20000)
+    assert len([line for line in window.log_panel.lines() if "gone.png" in line]) == 1

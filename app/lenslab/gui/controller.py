@@ -49,6 +49,7 @@ class RenderController(QObject):
     gbuffer_ready = Signal(object)
     restarted = Signal(int)
     working = Signal(object)  # WorkNote of the latest edit, while its picture is not shown yet
+    render_warnings = Signal(list)  # what rendering the scene warned about (a missing texture...), once each
     device_ready = Signal(dict)
     render_error = Signal(str)  # "" when an edit made the scene renderable again
     export_progress = Signal(object)
@@ -89,6 +90,7 @@ class RenderController(QObject):
         w.pick_ready.connect(self._pick_answered)
         w.restarted.connect(self._restarted)
         w.working.connect(self._working)
+        w.render_warnings.connect(self.render_warnings)
         w.scene_failed.connect(self._scene_failed)
         w.export_progress.connect(self.export_progress)
         w.export_finished.connect(self.export_finished)

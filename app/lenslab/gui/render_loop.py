@@ -270,6 +270,8 @@ class LoopEvents(Protocol):
 
     def working(self, note: WorkNote) -> None: ...  # what the loop does before the edit's picture is shown
 
+    def render_warnings(self, lines: list) -> None: ...  # what the scene's packing warned about, each line once
+
     def scene_failed(self, generation: int, reason: str) -> None: ...  # one line: the scene cannot be rendered
 
     def export_progress(self, progress: ExportProgress) -> None: ...
@@ -304,6 +306,7 @@ class RenderLoop:
         if renderer is not None:
             renderer.on_compile = self._compiling
         self._work_generation = 0  # the edit being applied, for the notes on its progress
+        self._warned: set[str] = set()  # the scene's warnings already reported (since the last SceneEdit)
         self._last_note = 0.0
         self._session = None
         self._size = (0, 0)
@@ -484,6 +487,7 @@ class RenderLoop:
             self._events.scene_failed(generation, _one_line(exc))
             return
         self._scene_ok = self._camera_ok = True
+        self._warned = set()
         self._set_size(size, edit.margin)
         self._restart(generation, view_changed=True)
 
@@ -568,6 +572,15 @@ class RenderLoop:
         if view_changed:
             self._gbuffer_due = True
         self._events.restarted(generation)
+        self._report_warnings()
+
+    def _report_warnings(self) -> None:
+        """What the session warned about (a missing texture, an unmapped mesh material, a pixel filter the image
+        is too large to splat), each line once per scene: the window shows them beside the load's own."""
+        new = [line for line in self._session.warnings if line not in self._warned]
+        if new:
+            self._warned.update(new)
+            self._events.render_warnings(new)
 
     # -- saying what the loop is doing -----------------------------------------------------------------------
     def _note(self, stage: str, step: int = 0, steps: int = 0, fraction: float | None = None) -> None:

@@ -69,6 +69,13 @@ class WarningBar(QFrame):
         self.details_button.setChecked(False)
         self.show()
 
+    def add_warnings(self, source: str, lines: Sequence[str]) -> None:
+        """More about the scene on screen (what rendering it found, after it opened): added to the bar's lines."""
+        if not lines:
+            return
+        kept = self.lines() if self.isVisible() else []
+        self.show_warnings(source, [*kept, *lines])
+
     def lines(self) -> list[str]:
         return self.details.toPlainText().splitlines()
 

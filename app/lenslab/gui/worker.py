@@ -67,6 +67,7 @@ class RenderWorker(QThread):
     pick_ready = Signal(object)  # PickResult
     restarted = Signal(int)  # generation: accumulation restarted for this edit
     working = Signal(object)  # WorkNote: what is under way before the edit's picture is shown
+    render_warnings = Signal(list)  # lines the scene's packing warned about, each once per scene
     scene_failed = Signal(int, str)  # generation, one-line reason: the scene cannot be rendered
     export_progress = Signal(object)  # ExportProgress
     export_finished = Signal(int, str)  # request id, path written
@@ -192,6 +193,9 @@ class _SignalEvents:
 
     def working(self, note: WorkNote) -> None:
         self._worker.working.emit(note)
+
+    def render_warnings(self, lines: list) -> None:
+        self._worker.render_warnings.emit(list(lines))
 
     def scene_failed(self, generation: int, reason: str) -> None:
         self._worker.scene_failed.emit(generation, reason)
