@@ -97,7 +97,7 @@ ACTIONS: tuple[ActionSpec, ...] = (
     ActionSpec("add_spot_light", "Spot Light", lambda w: w.add_light("spot"), icon="light"),
     ActionSpec("add_sun", "Sun", lambda w: w.add_light("sun"), icon="light"),
     ActionSpec("new_material", "New Material", "new_material", icon="material"),
-    ActionSpec("duplicate", "&Duplicate", "duplicate_selection", "Ctrl+D", enabled_when=selection_has_nodes),
+    ActionSpec("duplicate", "Du&plicate", "duplicate_selection", "Ctrl+D", enabled_when=selection_has_nodes),
     ActionSpec("rename", "Re&name", "rename_selection", "F2", enabled_when=selection_has_nodes_or_materials),
     ActionSpec("delete", "&Delete", "delete_selection", QKeySequence.Delete, icon="delete",
                enabled_when=selection_has_nodes_or_materials),
@@ -111,9 +111,9 @@ ACTIONS: tuple[ActionSpec, ...] = (
                checked_when=lambda w: w.controller.denoise),
     ActionSpec("frame_selection", "&Frame Selection", "frame_selection", ".",
                tip="Point the camera at the selection, fill the frame with it and focus on it"),
-    ActionSpec("frame_all", "Frame &All", lambda w: w.frame_selection(everything=True), "Home",
+    ActionSpec("frame_all", "F&rame All", lambda w: w.frame_selection(everything=True), "Home",
                tip="Point the camera at the whole scene"),
-    ActionSpec("clear_region", "&Clear Render Region", lambda w: w.controller.set_region(None), "Alt+R",
+    ActionSpec("clear_region", "C&lear Render Region", lambda w: w.controller.set_region(None), "Alt+R",
                tip="Refine the whole picture again"),
     _tool("select", "Q", "Select: click an object"),
     _tool("focus", "F", "Focus: click to focus there"),
@@ -131,6 +131,8 @@ ACTIONS: tuple[ActionSpec, ...] = (
     ActionSpec("about", "About LensLab", "show_about"),
 )
 
+#: Each key does one thing: no two actions share a shortcut, no shortcut is a menu's Alt+letter, and no two entries
+#: of a menu share their letter (tests/gui/test_layout_holds.py walks them all).
 MENU_BAR: tuple[Submenu, ...] = (
     Submenu("&File", ("new", "open", Submenu("Open Example", key="examples", fill="examples"),
                       Submenu("Open &Recent", key="recent", fill_on_show="recent"), SEPARATOR,
@@ -145,7 +147,8 @@ MENU_BAR: tuple[Submenu, ...] = (
     Submenu("&Camera", ("tool_select", "tool_focus", "tool_pan", SEPARATOR, "frame_selection", "frame_all",
                         SEPARATOR, "open_up", "stop_down", "focus_on_selection",
                         Submenu("&Lens", fill="lenses"))),
-    Submenu("&Render", ("pause", "restart", SEPARATOR, "tool_region", "clear_region", SEPARATOR, "export")),
+    # Alt+R is Clear Render Region's (as Alt+letter clears what the letter draws): the menu answers to Alt+N.
+    Submenu("Re&nder", ("pause", "restart", SEPARATOR, "tool_region", "clear_region", SEPARATOR, "export")),
     Submenu("&Help", ("shortcuts", "about")),
 )
 

@@ -2,7 +2,9 @@
 
 Choosing a preset (:data:`lenslab.optics.aspect.ASPECT_PRESETS`) sets the camera's resolution to that shape,
 keeping its long edge in pixels, as one undo step; the preset the resolution has is shown checked, and "Custom"
-(with the shape's name) when it has none. Both follow the camera, whoever changes it."""
+(with the shape's name) when it has none: the combo lists that entry only then, so it never offers "Custom (3:2)"
+beside 3:2. A shape is a preset's when the preset gives it back, or when it is that preset's to the nearest pixel
+as the frame's label names it (1919 × 1280 is 3:2 there too). Both follow the camera, whoever changes it."""
 
 from __future__ import annotations
 
@@ -37,7 +39,6 @@ class AspectPresets(QObject):
         self.combo.setObjectName("aspectCombo")
         for preset in ASPECT_PRESETS:
             self.combo.addItem(preset.name, preset.name)
-        self.combo.addItem("Custom", None)
         self.combo.activated.connect(self._combo_chosen)
         listen(doc.model.events.changed, self, self._scene_changed)
         self.sync()
@@ -73,8 +74,9 @@ class AspectPresets(QObject):
     def sync(self) -> None:
         """Show the camera's shape: its preset checked, or Custom with its name."""
         w, h = self.doc.scene.camera.resolution
-        preset = matching_preset((w, h))
-        custom = f"Custom ({aspect_name(w, h)})"
+        name = aspect_name(w, h)
+        preset = next((p for p in ASPECT_PRESETS if p.name == name), None) or matching_preset((w, h))
+        custom = f"Custom ({name})"
         self.custom_action.setText(custom)
         self.custom_action.setVisible(preset is None)
         (self.actions[preset.name] if preset else self.custom_action).setChecked(True)
@@ -84,7 +86,13 @@ class AspectPresets(QObject):
             self.actions[p.name].setToolTip(tip)
             self.actions[p.name].setStatusTip(tip)
             self.combo.setItemData(self.combo.findText(p.name), tip, Qt.ToolTipRole)
-        self.combo.setItemText(len(ASPECT_PRESETS), custom)
-        self.combo.setCurrentIndex(ASPECT_PRESETS.index(preset) if preset else len(ASPECT_PRESETS))
+        custom_index = len(ASPECT_PRESETS)
+        if preset is None and self.combo.count() == custom_index:
+            self.combo.addItem(custom, None)
+        elif preset is not None and self.combo.count() > custom_index:
+            self.combo.removeItem(custom_index)
+        if preset is None:
+            self.combo.setItemText(custom_index, custom)
+        self.combo.setCurrentIndex(ASPECT_PRESETS.index(preset) if preset else custom_index)
         self.combo.setToolTip(f"Aspect ratio of the export: {w} × {h} ({aspect_name(w, h)}). A preset keeps the "
                               "long edge.")

@@ -29,6 +29,7 @@ from PySide6.QtCore import QEvent, QObject, QPointF, QRectF, Qt
 from PySide6.QtGui import QColor, QImage, QPainter, QPen
 
 from lenslab.gui import theme
+from lenslab.gui.corner_tags import COMPARE, camera_tag
 from lenslab.gui.snapshots import Snapshot, SnapshotStore, compare_tags
 from lenslab.gui.viewport import rgba_to_qimage
 
@@ -140,6 +141,18 @@ class Comparison(QObject):
         return min(x, w - 1), min(y, h - 1)
 
     # -- painting ---------------------------------------------------------------------------------------------------
+    def corner_texts(self, camera: str, state: str) -> tuple[str, str]:
+        """The corner tags' texts for the picture shown, given the live picture's (its camera, its render's state):
+        A's own while A is shown alone; the live ones, marked B, beside A in the wipe, whose left side (where the
+        camera tag sits) shows A."""
+        a = self.store.a
+        view = self.view()
+        if view == "a" and a is not None:
+            return f"A: {camera_tag(a.camera)}", f"A: {a.samples_per_pixel} spp"
+        if view == "wipe" and camera:
+            return f"B: {camera}", state
+        return camera, state
+
     def paint_picture(self, p: QPainter, rect: QRectF) -> bool:
         """Draw the picture for the current view in place of the live one; False: the view is the live picture
         alone, which the viewport draws itself. Side by side leaves the painter clipped to the right half, so that
@@ -217,13 +230,13 @@ class Comparison(QObject):
         self._tag(p, right, b_tag, B_COLOUR, "centre")
 
     def _tag(self, p: QPainter, area: QRectF, text: str, colour: str, align: str) -> None:
-        """A tag at the bottom of ``area``, against its left or right side or centred; none where it does not fit
-        (the side of a divider dragged to the edge)."""
-        width = p.fontMetrics().horizontalAdvance(text) + 12
-        if area.width() < width + 8 or area.height() < 40:
+        """A tag at the bottom of ``area``, against its left or right side or centred, shortened to fit it (the side
+        of a divider dragged near the edge) or left out."""
+        if area.height() < 40:
             return
-        x = {"left": area.left(), "right": area.right() - width}.get(align, area.center().x() - width / 2)
-        self.viewport.draw_tag(p, QPointF(x, area.bottom() - 10), text, colour)
+        x = {"left": area.left(), "right": area.right()}.get(align, area.center().x())
+        grows = {"left": "right", "right": "left"}.get(align, "both")
+        self.viewport.tags.want(text, QPointF(x, area.bottom() - 10), colour, COMPARE, grows=grows, bounds=area)
 
     # -- the mouse --------------------------------------------------------------------------------------------------
     def eventFilter(self, obj, event) -> bool:

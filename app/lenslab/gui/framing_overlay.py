@@ -11,7 +11,8 @@ from __future__ import annotations
 from PySide6.QtCore import QLineF, QPointF, QRectF, Qt
 from PySide6.QtGui import QColor, QPainter, QPainterPath, QPen
 
-from lenslab.gui.layer_support import draw_tag, gate_in_widget, tag_size
+from lenslab.gui.corner_tags import FRAME, SENSOR
+from lenslab.gui.layer_support import gate_in_widget, tag_size
 from lenslab.optics.aspect import aspect_name
 from lenslab.optics.composition import ACTION_SAFE, GUIDES, TITLE_SAFE, guide_lines, safe_rect, sensor_rect
 
@@ -112,18 +113,20 @@ class FramingLayer:
         p.restore()
 
     def _paint_label(self, p: QPainter, viewport, gate: QRectF, sensor: QRectF | None) -> None:
+        """The frame's label under its bottom-right corner (inside it where there is no room below) and the sensor's
+        size inside its top-left corner: tags the viewport lays out with its others (``viewport.tags``)."""
         text = self.label()
         if not text:
             return
-        w, h = tag_size(p, text)
+        h = tag_size(p, text)[1]
         below = gate.bottom() + 3 + h <= viewport.height() - 2  # room under the frame: the label goes there
         y = gate.bottom() + 3 + h if below else gate.bottom() - 6
-        x = max(gate.left(), gate.right() - w - (0 if below else 6))
-        draw_tag(p, QPointF(x, y), text, QColor(220, 220, 220) if below else QColor(200, 200, 200),
-                 QColor(20, 20, 22, 0 if below else 170))
+        viewport.tags.want(text, QPointF(gate.right() - (0 if below else 6), y),
+                           QColor(220, 220, 220) if below else QColor(200, 200, 200), FRAME, grows="left",
+                           background=QColor(20, 20, 22, 0 if below else 170),
+                           bounds=QRectF(gate.left(), 0, gate.width(), viewport.height()))
         if sensor is not None and self.sensor_mm is not None:
             note = f"sensor {self.sensor_mm[0]:g} × {self.sensor_mm[1]:g} mm"
-            sw, sh = tag_size(p, note)
             inside = sensor.intersected(gate)
-            draw_tag(p, QPointF(inside.left() + 4, inside.top() + sh + 4), note, SENSOR_COLOUR.lighter(130),
-                     QColor(20, 20, 22, 150))
+            viewport.tags.want(note, QPointF(inside.left() + 4, inside.top() + tag_size(p, note)[1] + 4),
+                               SENSOR_COLOUR.lighter(130), SENSOR, background=QColor(20, 20, 22, 150), bounds=inside)

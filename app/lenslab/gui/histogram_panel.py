@@ -21,6 +21,9 @@ SHADOW_LIT = QColor(70, 140, 255)
 HIGHLIGHT_LIT = QColor(255, 70, 60)
 INDICATOR_OFF = QColor(90, 92, 97)
 INDICATOR = 11  # the clipping triangles' side, pixels
+#: The histogram's height: enough to read its shape, and no more however tall the window (the camera panel under it
+#: has better use for the room).
+MIN_PLOT_HEIGHT, MAX_PLOT_HEIGHT = 90, 140
 
 
 def percent(fraction: float) -> str:
@@ -43,7 +46,8 @@ class HistogramView(QWidget):
         super().__init__(parent)
         self.setObjectName("histogramView")
         self.histogram: Histogram | None = None
-        self.setMinimumHeight(90)
+        self.setMinimumHeight(MIN_PLOT_HEIGHT)
+        self.setMaximumHeight(MAX_PLOT_HEIGHT)
         self.setCursor(Qt.ArrowCursor)
 
     def sizeHint(self) -> QSize:
@@ -164,6 +168,10 @@ class HistogramPanel(QWidget):
         layout.addLayout(row)
         self._throttle = Throttle(self.refresh, HISTOGRAM_INTERVAL_MS, self)
         self._show_figures()
+        # The dock holding the panel grows no taller than the plot's limit and the row under it.
+        margins = layout.contentsMargins()
+        self.setMaximumHeight(margins.top() + MAX_PLOT_HEIGHT + layout.spacing() + row.sizeHint().height()
+                              + margins.bottom())
 
     def changed(self) -> None:
         """The viewport's picture or frame changed: count again soon (or when the dock is next shown)."""

@@ -20,6 +20,7 @@ from lenslab import __version__
 from lenslab.gui.actions import build_menus, create_actions, make_action, selection_has_nodes, update_enabled
 from lenslab.gui.camera_panel import CameraPanel
 from lenslab.gui.controller import RenderController
+from lenslab.gui.corner_tags import camera_tag
 from lenslab.gui.defaults import studio_scene
 from lenslab.gui.document import Document, is_shipped, listen
 from lenslab.gui.edit_controller import EditController
@@ -38,8 +39,6 @@ from lenslab.gui.viewport_toolbar import ViewportToolbar, saved_look, under_tool
 from lenslab.gui.viewport_tools import ViewportTools
 from lenslab.gui.warning_bar import WarningBar
 from lenslab.gui.worker import VIEWPORT_DISPATCH_SECONDS
-from lenslab.optics import format_camera_settings
-from lenslab.optics.exposure import format_shutter
 from lenslab.scene.io.loader import scene_title
 
 APP_NAME = "LensLab"
@@ -176,6 +175,7 @@ class MainWindow(QMainWindow):
         self.actions["reset_layout"].triggered.connect(self.docks["log"].hide)  # after the window's own reset
         self.warning_bar.log_requested.connect(lambda: show_dock(self.docks["log"]))
         self.files.scene_opened_with_warnings.connect(self.report_warnings)
+        self.controller.render_warnings.connect(self.report_render_warnings)
 
     def _default_dock_layout(self) -> None:
         for dock in self.docks.values():
@@ -288,9 +288,7 @@ class MainWindow(QMainWindow):
         comes the work banner says one is on its way."""
         frame = self.controller.last_frame
         cam = frame.camera if frame is not None and frame.camera is not None else self.doc.scene.camera
-        self.viewport.hud_text = format_camera_settings(cam.focal_length_mm, cam.f_number, cam.focus_distance_m)
-        if cam.exposure_mode == "physical":
-            self.viewport.hud_text += f" \u00b7 {format_shutter(cam.shutter_s)} \u00b7 ISO {cam.iso:g}"
+        self.viewport.hud_text = camera_tag(cam)  # as a snapshot's is written (the A/B comparison)
         self.viewport.update()
 
     # -- document events ---------------------------------------------------------------------------------------
@@ -413,6 +411,12 @@ class MainWindow(QMainWindow):
     def report_warnings(self, source: str, lines: list[str]) -> None:
         """Show what opening ``source`` warned about; with nothing to say, the bar about the last scene goes."""
         self.warning_bar.show_warnings(source, lines)
+        self.log_panel.add(source, lines)
+
+    def report_render_warnings(self, lines: list[str]) -> None:
+        """What rendering the scene found (a texture that is not there...): added to the bar and the Log."""
+        source = str(self.doc.path or self.doc.scene.source_path or self.doc.display_name)
+        self.warning_bar.add_warnings(source, lines)
         self.log_panel.add(source, lines)
 
     # -- help ----------------------------------------------------------------------------------------------------------

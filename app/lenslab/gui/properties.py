@@ -15,7 +15,6 @@ import typing
 from pathlib import Path
 from typing import Any, Callable
 
-from PySide6.QtCore import Qt
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
@@ -24,7 +23,6 @@ from PySide6.QtWidgets import (
     QHBoxLayout,
     QLabel,
     QLineEdit,
-    QScrollArea,
     QToolButton,
     QVBoxLayout,
     QWidget,
@@ -33,6 +31,8 @@ from PySide6.QtWidgets import (
 from lenslab.gui import theme
 from lenslab.gui.commands import AddMaterialCommand, RenameMaterialCommand
 from lenslab.gui.document import listen
+from lenslab.gui.panel_form import PanelForm
+from lenslab.gui.panel_scroll import PanelScroll
 from lenslab.gui.widgets import ColorEdit, IntEdit, NumberEdit, Section, VectorEdit, hint
 from lenslab.scene.editing import file_reference, screen_drag_rate
 from lenslab.scene.lights import LIGHT_TYPES, Light
@@ -153,9 +153,7 @@ class PropertyEditor(QWidget):
         self.title.setObjectName("bigReadout")
         self.title.setStyleSheet("font-size: 14px;")
         self.subtitle = hint("")
-        self.scroll = QScrollArea()
-        self.scroll.setWidgetResizable(True)
-        self.scroll.setHorizontalScrollBarPolicy(Qt.ScrollBarAsNeeded)  # never clip a field
+        self.scroll = PanelScroll()  # up and down only, as wide as the fields need
         layout = QVBoxLayout(self)
         layout.setContentsMargins(8, 6, 8, 4)
         layout.addWidget(self.title)
@@ -239,13 +237,7 @@ class PropertyEditor(QWidget):
 
     @staticmethod
     def _form() -> QFormLayout:
-        form = QFormLayout()
-        form.setLabelAlignment(Qt.AlignRight | Qt.AlignVCenter)
-        form.setFieldGrowthPolicy(QFormLayout.AllNonFixedFieldsGrow)
-        form.setRowWrapPolicy(QFormLayout.WrapLongRows)  # a narrow panel puts labels above their fields
-        form.setHorizontalSpacing(8)
-        form.setVerticalSpacing(5)
-        return form
+        return PanelForm()  # a narrow panel puts labels above their fields
 
     def _build_node(self, layout, node: Node) -> None:
         target = self.target

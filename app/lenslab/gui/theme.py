@@ -60,6 +60,7 @@ QSlider::sub-page:horizontal:disabled {{ background: #3a3b3f; }}
 QProgressBar {{ background: {BASE}; border: 1px solid #3a3b3f; border-radius: 3px; text-align: center; height: 12px; }}
 QProgressBar::chunk {{ background: #6b5a3e; }}
 QMenu::item:selected {{ background: #4a3d28; }}
+QToolButton#qt_toolbar_ext_button {{ min-width: 16px; padding: 2px; }}
 """
 
 
@@ -115,6 +116,7 @@ _ICONS = {
     "add": '<path d="M12 5 V19 M5 12 H19" {s}/>',
     "delete": '<path d="M5 7 H19 M10 7 V4.5 H14 V7 M7 7 L8 20 H16 L17 7 M10.5 10.5 V16.5 M13.5 10.5 V16.5" {s}/>',
     "lens": '<circle cx="12" cy="12" r="8.5" {s}/><circle cx="12" cy="12" r="4.5" {s}/>',
+    "more": '<path d="M6 6 L12 12 L6 18 M12 6 L18 12 L12 18" {s}/>',
 }
 
 

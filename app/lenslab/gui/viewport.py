@@ -17,6 +17,7 @@ from PySide6.QtGui import QColor, QFont, QImage, QPainter, QPen
 from PySide6.QtWidgets import QWidget
 
 from lenslab.gui import theme
+from lenslab.gui.corner_tags import CAMERA, FOCUS_PLANE, FOCUSING, STATE, TagBoard
 from lenslab.render.film import to_8bit, tone_map
 from lenslab.scene.navigation import MouseTravel
 
@@ -127,6 +128,8 @@ class Viewport(QWidget):
         # The A/B comparison with a snapshot (lenslab.gui.compare.Comparison): it draws the picture in the live
         # one's place and, side by side, has the live picture laid out in the right half; None: live alone.
         self.compare = None
+        # The tags wanted over the picture in a paint, laid out at its end so that none covers another.
+        self.tags = TagBoard(QRectF())
         self._fade_timer = QTimer(self)
         self._fade_timer.setInterval(40)
         self._fade_timer.timeout.connect(self._fade_tick)
@@ -302,6 +305,7 @@ class Viewport(QWidget):
     def paintEvent(self, event) -> None:
         p = QPainter(self)
         p.fillRect(self.rect(), QColor(theme.BACKGROUND))
+        self.tags.begin(QRectF(self.rect()).adjusted(4, 4, -4, -4))
         if self.qimage is not None:
             rect = self.image_rect()
             # Pixel-peeping at 200% and above shows the pixels as they are; a fitted picture is always smooth.
@@ -317,8 +321,9 @@ class Viewport(QWidget):
             if self._overlay is not None and self._overlay.size() == self.qimage.size():
                 p.setOpacity(self._overlay_opacity())
                 p.drawImage(rect, self._overlay)
-                self.draw_tag(p, QPointF(rect.left() + 10, rect.bottom() - 12), self._overlay_label, theme.FOCUS)
                 p.setOpacity(1.0)
+                self.tags.want(self._overlay_label, QPointF(rect.left() + 10, rect.bottom() - 12), theme.FOCUS,
+                               FOCUS_PLANE, opacity=self._overlay_opacity())
             for layer in self.layers:
                 if getattr(layer, "visible", True):
                     layer.paint(p, self, rect)
@@ -326,6 +331,7 @@ class Viewport(QWidget):
             if self.compare is not None:
                 self.compare.paint_over(p, rect)
         self._draw_hud(p)
+        self.tags.draw(p)
         if self.message:
             p.setPen(QColor("#f0c0a0"))
             font = QFont(self.font())
@@ -361,33 +367,19 @@ class Viewport(QWidget):
         y0, y1 = sorted((min(max(a.y(), 0), h), min(max(b.y(), 0), h)))
         return QRectF(x0, y0, x1 - x0, y1 - y0)
 
-    def draw_tag(self, p: QPainter, at: QPointF, text: str, colour: str) -> None:
-        """A label on a dark rounded box whose bottom-left corner is ``at``: the HUD's and the status's, and the
-        A/B comparison's, so that all the viewport's tags look alike."""
-        if not text:
-            return
-        metrics = p.fontMetrics()
-        w = metrics.horizontalAdvance(text) + 12
-        h = metrics.height() + 4
-        box = QRectF(at.x(), at.y() - h, w, h)
-        p.setPen(Qt.NoPen)
-        p.setBrush(QColor(20, 20, 22, 200))
-        p.drawRoundedRect(box, 3, 3)
-        p.setPen(QColor(colour))
-        p.drawText(box, Qt.AlignCenter, text)
-
     def _draw_hud(self, p: QPainter) -> None:
+        """The corner tags: the camera's settings top left, the render's state top right (both of the picture shown:
+        a snapshot's while the comparison shows it alone), and "focusing…" while a focus click is on its way."""
         rect = self.image_rect() if self.qimage is not None else QRectF(self.rect())
         top = max(4.0, rect.top() - 4)
-        if self.hud_text:
-            self.draw_tag(p, QPointF(max(4.0, rect.left()), top + 22 if rect.top() < 26 else top), self.hud_text,
-                          "#e6e6e6")
-        if self.status_text:
-            metrics = p.fontMetrics()
-            x = min(self.width() - 4.0, rect.right()) - metrics.horizontalAdvance(self.status_text) - 12
-            self.draw_tag(p, QPointF(x, top + 22 if rect.top() < 26 else top), self.status_text, theme.DIM_TEXT)
+        y = top + 22 if rect.top() < 26 else top
+        hud, status = self.hud_text, self.status_text
+        if self.compare is not None:
+            hud, status = self.compare.corner_texts(hud, status)
+        self.tags.want(hud, QPointF(max(4.0, rect.left()), y), "#e6e6e6", CAMERA)
+        self.tags.want(status, QPointF(min(self.width() - 4.0, rect.right()), y), theme.DIM_TEXT, STATE, grows="left")
         if self.tool == "focus" and self.focus_pending:
-            self.draw_tag(p, QPointF(8, self.height() - 8), "focusing…", theme.FOCUS)
+            self.tags.want("focusing…", QPointF(8, self.height() - 8), theme.FOCUS, FOCUSING)
 
     # -- interaction --------------------------------------------------------------------------------------------
     def set_tool(self, tool: str) -> None:

@@ -1,15 +1,19 @@
 """The viewport's toolbar: the tools, fit and the zoom, the display exposure (a slider, a field and a reset, one
 setting), the tone map, the viewport's resolution, the denoiser, the sample limit, pause and restart. The
-display settings change what the picture looks like, never what is rendered."""
+display settings change what the picture looks like, never what is rendered.
+
+Where the window is too narrow for all of it, the toolbar's extension button (») at its right end opens it into
+more rows over the top of the picture (:func:`under_toolbar`)."""
 
 from __future__ import annotations
 
 import math
 
-from PySide6.QtCore import QObject, QSettings, Qt
+from PySide6.QtCore import QObject, QSettings, QSize, Qt
 from PySide6.QtGui import QAction
-from PySide6.QtWidgets import QComboBox, QLabel, QSizePolicy, QToolBar, QToolButton, QWidget
+from PySide6.QtWidgets import QComboBox, QLabel, QMainWindow, QSizePolicy, QToolBar, QToolButton, QWidget
 
+from lenslab.gui import theme
 from lenslab.gui.controller import SAMPLE_LIMITS, RenderController
 from lenslab.gui.viewport import Viewport
 from lenslab.gui.widgets import ResetSlider, SignedNumberEdit
@@ -32,6 +36,27 @@ def saved_look(settings: QSettings) -> tuple[float, str]:
     return exposure, tone_map if tone_map in TONE_MAPS else "filmic"
 
 
+def under_toolbar(bar: QToolBar, picture: QWidget) -> QMainWindow:
+    """``picture`` with ``bar`` above it, in a QMainWindow of their own (a plain widget inside the window).
+
+    A QToolBar hides what it has no room for behind its extension button; only in a QMainWindow does the button
+    open the bar into more rows with every control in them. Anywhere else it opens a menu of the hidden actions,
+    which leaves the boxes out (the resolution, the sample limit, the aspect ratio)."""
+    host = QMainWindow()
+    host.setObjectName("viewportArea")
+    host.setWindowFlags(Qt.Widget)
+    host.setAnimated(False)  # the extension opens and closes at once
+    bar.setFloatable(False)
+    bar.setContextMenuPolicy(Qt.PreventContextMenu)  # no menu to hide the bar with: nothing would bring it back
+    host.addToolBar(Qt.TopToolBarArea, bar)
+    host.setCentralWidget(picture)
+    extension = bar.findChild(QToolButton, "qt_toolbar_ext_button")
+    if extension is not None:  # the style's own arrow is drawn for light toolbars: nearly black on ours
+        extension.setIcon(theme.icon("more"))
+        extension.setToolTip("More of the toolbar: what the window has no room for")
+    return host
+
+
 class ViewportToolbar(QObject):
     """The toolbar above the viewport (``bar``, named "viewportBar") and what its own widgets do: the display
     exposure and tone map go to the viewport (and the controller), the resolution and sample limit to the
@@ -45,13 +70,14 @@ class ViewportToolbar(QObject):
         bar = self.bar = QToolBar()
         bar.setObjectName("viewportBar")
         bar.setMovable(False)
+        bar.setIconSize(QSize(20, 20))  # compact: the whole bar fits beside the panels at the default window size
         for name in ("tool_select", "tool_focus", "tool_pan", "tool_region"):
             bar.addAction(actions[name])
         bar.addSeparator()
         bar.addAction(actions["fit"])
         self.zoom_label = QLabel("Fit")
         self.zoom_label.setObjectName("readout")
-        self.zoom_label.setMinimumWidth(44)
+        self.zoom_label.setMinimumWidth(40)
         bar.addWidget(self.zoom_label)
         bar.addSeparator()
         exposure_label = QLabel(" EV ")
@@ -61,13 +87,13 @@ class ViewportToolbar(QObject):
         # all three the same setting (display only).
         self.exposure_slider = ResetSlider(Qt.Horizontal, default=0)
         self.exposure_slider.setRange(round(-10 * DISPLAY_EXPOSURE_STOPS), round(10 * DISPLAY_EXPOSURE_STOPS))
-        self.exposure_slider.setFixedWidth(110)
+        self.exposure_slider.setFixedWidth(84)
         self.exposure_slider.setValue(round(self.viewport.exposure * 10))
         self.exposure_slider.setToolTip("Display exposure in stops (display only: the render is not restarted); "
                                         "double-click: back to 0")
         self.exposure_spin = SignedNumberEdit(-DISPLAY_EXPOSURE_STOPS, DISPLAY_EXPOSURE_STOPS, 1, 0.1, " EV")
         self.exposure_spin.setObjectName("displayExposure")
-        self.exposure_spin.setFixedWidth(70)
+        self.exposure_spin.setFixedWidth(64)
         self.exposure_spin.setToolTip("Display exposure in stops: type a value (1.5 is +1.5 EV); the arrow keys "
                                       "and the wheel step a tenth")
         self.exposure_reset = QToolButton()
@@ -151,4 +177,4 @@ class ViewportToolbar(QObject):
         self.controller.set_target_spp(self.limit_combo.currentData())
 
 
-__all__ = ["ViewportToolbar", "DISPLAY_EXPOSURE_STOPS", "saved_look"]
+__all__ = ["ViewportToolbar", "DISPLAY_EXPOSURE_STOPS", "saved_look", "under_toolbar"]
