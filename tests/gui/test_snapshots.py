@@ -302,7 +302,8 @@ def test_restore_camera_is_one_undo_step(qtbot, window):
     window.snapshots.panel.restore_button.click()
     assert doc.scene.camera == a_camera and doc.lens is None
     assert doc.undo_stack.count() == steps + 1 and doc.undo_stack.undoText().startswith("Restore camera: 50 mm f/1.4")
-    assert window.viewport.hud_text.find("f/1.4") >= 0
+    # The camera tag follows once the restored camera's picture is on screen.
+    qtbot.waitUntil(lambda: "f/1.4" in window.viewport.hud_text, timeout=20000)
     doc.undo_stack.undo()
     assert doc.scene.camera == before and doc.lens == lens
     doc.undo_stack.redo()

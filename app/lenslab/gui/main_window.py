@@ -416,8 +416,13 @@ class MainWindow(QMainWindow):
     def report_render_warnings(self, lines: list[str]) -> None:
         """What rendering the scene found (a texture that is not there...): added to the bar and the Log."""
         source = str(self.doc.path or self.doc.scene.source_path or self.doc.display_name)
+        # The reader may have said it already (a Mitsuba scene's missing texture): a line about a file the
+        # scene's warnings named is not said twice.
+        said = "\n".join(self.warning_bar.lines())
+        lines = [line for line in lines if line.split(": ", 1)[0] not in said]
         self.warning_bar.add_warnings(source, lines)
-        self.log_panel.add(source, lines)
+        if lines:
+            self.log_panel.add(source, lines)
 
     # -- help ----------------------------------------------------------------------------------------------------------
     def show_shortcuts(self) -> None:

@@ -74,7 +74,9 @@ class WarningBar(QFrame):
         if not lines:
             return
         kept = self.lines() if self.isVisible() else []
+        expanded = bool(kept) and self.details_button.isChecked()
         self.show_warnings(source, [*kept, *lines])
+        self.details_button.setChecked(expanded)  # the user's choice of seeing the lines or not stands
 
     def lines(self) -> list[str]:
         return self.details.toPlainText().splitlines()
