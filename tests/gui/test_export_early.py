@@ -231,9 +231,23 @@ def test_closing_during_an_export_asks_and_keep_the_window_keeps_both(qtbot, win
 
 def test_closing_during_an_export_can_wait_for_it_to_be_written(qtbot, window, tmp_path):
     out = tmp_path / "awaited.png"
-    start_long_export(qtbot, window, out, seconds=3.0)
+    # Long enough (its clock is the device's, never ahead of the wall's) that the question is answered before the
+    # export ends even on a loaded machine, where the answer may take seconds to come round.
+    start_long_export(qtbot, window, out, seconds=8.0)
     seen = answer_export_question(window, QMessageBox.Ok)  # Close When Done
     with qtbot.waitSignal(window.closed, timeout=30000):
         assert not window.close()  # not yet: the export goes on
         assert seen and window.isVisible() and window.export_id is not None
     assert out.is_file() and not window.isVisible()
+
+
+def test_the_window_hears_an_exports_progress_while_it_renders(qtbot, window, tmp_path):
+    """The render thread holds the interpreter for a whole dispatch: a Python filter on every event of the
+    application (a wheel guard once was one) made the window wait for each, and the export's progress reached it
+    only when the export was over. It must arrive while the export still runs."""
+    window.start_export(export_request(window, tmp_path / "long.exr", seconds=30.0))
+    with qtbot.waitSignal(window.controller.export_progress, timeout=12000):
+        pass
+    assert window.export_id is not None  # still rendering: the progress came while it ran
+    window.export_flow.cancel()
+    qtbot.waitSignal(window.controller.export_cancelled, timeout=20000).wait()

@@ -418,11 +418,15 @@ def test_the_window_closes_cleanly_while_rendering(qtbot, make_window, small_sce
     out = tmp_path / "never.exr"
     window.start_export(export_request(window, out, target_spp=1_000_000))
     qtbot.waitSignal(window.controller.export_progress, timeout=20000).wait()
+    answered = []
+    window.export_flow.cancel = lambda cancel=window.export_flow.cancel: (answered.append(time.perf_counter()),
+                                                                          cancel())
     answer_next_prompt(window, QMessageBox.Discard)  # Stop Export and Close
-    start = time.perf_counter()
     assert window.close()
     assert window.controller.worker.isFinished()
-    assert time.perf_counter() - start < 5.0
+    # Once the question is answered the render thread stops at once (how soon a loaded machine gets round to the
+    # question box is not the window's doing).
+    assert answered and time.perf_counter() - answered[0] < 5.0
     assert not out.exists()
     assert window.settings.value("window/state") is not None  # the layout is remembered
 

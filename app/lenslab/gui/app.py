@@ -24,7 +24,6 @@ def create_application(argv: list[str] | None = None):
     from lenslab.gui.main_window import app_icon
     from lenslab.gui.qtcompat import guard_singletons
     from lenslab.gui.theme import apply_theme
-    from lenslab.gui.wheel_guard import install_wheel_guard
 
     app = QApplication.instance()
     if app is None:
@@ -38,7 +37,6 @@ def create_application(argv: list[str] | None = None):
     app.setWindowIcon(app_icon())
     apply_theme(app)
     guard_singletons(app)
-    install_wheel_guard(app)  # the wheel scrolls panels, and changes only a focused control's value
     return app
 
 

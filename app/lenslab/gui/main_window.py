@@ -38,6 +38,7 @@ from lenslab.gui.viewport import Viewport
 from lenslab.gui.viewport_toolbar import ViewportToolbar, saved_look, under_toolbar
 from lenslab.gui.viewport_tools import ViewportTools
 from lenslab.gui.warning_bar import WarningBar
+from lenslab.gui.wheel_guard import guard_wheels
 from lenslab.gui.worker import VIEWPORT_DISPATCH_SECONDS
 from lenslab.scene.io.loader import scene_title
 
@@ -113,6 +114,7 @@ class MainWindow(QMainWindow):
         self._update_title()
         self.update_camera_tag()
         self._update_actions()
+        guard_wheels(self)  # every value control the window holds; the property editor guards its own rebuilds
 
     # -- construction ------------------------------------------------------------------------------------------
     def make_action(self, text: str, slot=None, shortcut=None, icon: str | None = None, checkable: bool = False,

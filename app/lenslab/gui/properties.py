@@ -33,6 +33,7 @@ from lenslab.gui.commands import AddMaterialCommand, RenameMaterialCommand
 from lenslab.gui.document import listen
 from lenslab.gui.panel_form import PanelForm
 from lenslab.gui.panel_scroll import PanelScroll
+from lenslab.gui.wheel_guard import guard_wheels
 from lenslab.gui.widgets import ColorEdit, IntEdit, NumberEdit, Section, VectorEdit, hint
 from lenslab.scene.editing import file_reference, screen_drag_rate
 from lenslab.scene.lights import LIGHT_TYPES, Light
@@ -234,6 +235,7 @@ class PropertyEditor(QWidget):
             old.hide()
             old.deleteLater()
         self.scroll.setWidget(container)
+        guard_wheels(container)
 
     @staticmethod
     def _form() -> QFormLayout:

@@ -810,18 +810,18 @@ class RenderLoop:
     def start_export(self, start: ExportStart) -> bool:
         """Start the export; False if it could not start (the reason goes out by export_failed)."""
         from lenslab.render.job import RenderJob
-        from lenslab.render.tracer import DEFAULT_DISPATCH_SECONDS
 
         if self._export is not None:
             self._events.export_failed(start.request_id, "another export is still running")
             return False
         request = start.request
         try:
-            # An export's dispatches are the session's default, not the headless job's longer ones
-            # (job.OFFLINE_DISPATCH_SECONDS): long enough to keep the device busy, short enough for a cancel
-            # to be felt within a tenth of a second.
+            # An export's dispatches are the viewport's (a display frame), not the headless job's longer ones
+            # (job.OFFLINE_DISPATCH_SECONDS): the thread holds Python's interpreter for a whole dispatch (moderngl
+            # does not release it), and the window, whose every Python slot and filter waits for it, must stay
+            # responsive while the studio exports.
             job = RenderJob(self._renderer, request.scene, spp=request.target_spp, time_limit=request.seconds,
-                            dispatch_seconds=max(self.dispatch_seconds, DEFAULT_DISPATCH_SECONDS),
+                            dispatch_seconds=self.dispatch_seconds,
                             feature_buffers=request.denoise)
         except Exception as exc:
             self._events.export_failed(start.request_id, _one_line(exc))

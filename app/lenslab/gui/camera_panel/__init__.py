@@ -28,6 +28,7 @@ from lenslab.gui.camera_panel.lens import LensSection, lens_short_name
 from lenslab.gui.camera_panel.section import CameraSection
 from lenslab.gui.camera_panel.sensor import SENSOR_FIT_NAMES, AutoNumberEdit, SensorSection
 from lenslab.gui.document import listen
+from lenslab.gui.wheel_guard import guard_wheels
 from lenslab.optics import LensPreset, PresetError, SensorPreset, load_lens_presets, load_sensor_presets
 from lenslab.optics.stops import DEFAULT_STOP_SCALE, STOP_SCALES
 
@@ -138,6 +139,7 @@ class CameraPanel(QWidget):
         listen(doc.model.events.changed, self, self._on_change)
         doc.lens_changed.connect(self.refresh)
         self.refresh()
+        guard_wheels(self)  # the wheel scrolls the panel; it turns only the control that has the focus
 
     def _add(self, section: CameraSection):
         self.sections[section.key] = section
