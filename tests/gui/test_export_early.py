@@ -22,6 +22,8 @@ import pytest
 from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QApplication, QMessageBox
 
+from tests.gui.helpers import wait_for_frame
+
 pytestmark = pytest.mark.gl
 
 
@@ -231,9 +233,10 @@ def test_closing_during_an_export_asks_and_keep_the_window_keeps_both(qtbot, win
 
 def test_closing_during_an_export_can_wait_for_it_to_be_written(qtbot, window, tmp_path):
     out = tmp_path / "awaited.png"
+    wait_for_frame(qtbot, window)  # a window that has settled, as a user's is when they export
     # Long enough (its clock is the device's, never ahead of the wall's) that the question is answered before the
     # export ends even on a loaded machine, where the answer may take seconds to come round.
-    start_long_export(qtbot, window, out, seconds=8.0)
+    start_long_export(qtbot, window, out, seconds=12.0)
     seen = answer_export_question(window, QMessageBox.Ok)  # Close When Done
     with qtbot.waitSignal(window.closed, timeout=30000):
         assert not window.close()  # not yet: the export goes on
