@@ -1,6 +1,35 @@
-"""Waiting helpers for the studio tests (never sleeps: each waits on a condition with a timeout)."""
+"""Helpers for the studio tests: waiting (never sleeps: each waits on a condition with a timeout) and the pointer.
+
+The pointer's events are sent to the widget itself. ``qtbot.mouseMove`` moves the platform cursor instead, and on
+the offscreen platform that move goes to whichever top-level window is under the global point (a window of an
+earlier test not yet deleted will do), and a move to where the cursor already is sends nothing: hover tests that
+used it failed now and then on a loaded machine."""
 
 from __future__ import annotations
+
+from PySide6.QtCore import QEvent, QPointF, Qt
+from PySide6.QtGui import QMouseEvent
+from PySide6.QtWidgets import QApplication
+
+
+def send_mouse(widget, kind, pos, button=Qt.NoButton, buttons=Qt.NoButton, modifiers=Qt.NoModifier) -> None:
+    """One mouse event of ``kind`` at widget position ``pos`` (a QPoint, QPointF or (x, y)), handled at once."""
+    if not isinstance(pos, (QPointF,)):
+        pos = QPointF(pos) if hasattr(pos, "x") else QPointF(*pos)
+    event = QMouseEvent(kind, pos, widget.mapToGlobal(pos), button, buttons, modifiers)
+    QApplication.sendEvent(widget, event)
+
+
+def hover(widget, pos) -> None:
+    """The pointer moved to ``pos`` over ``widget`` with no button held."""
+    send_mouse(widget, QEvent.MouseMove, pos)
+
+
+def press_drag_release(widget, start, end, button=Qt.LeftButton, modifiers=Qt.NoModifier) -> None:
+    """A press at ``start``, one move to ``end`` with the button held, and the release there."""
+    send_mouse(widget, QEvent.MouseButtonPress, start, button, button, modifiers)
+    send_mouse(widget, QEvent.MouseMove, end, Qt.NoButton, button, modifiers)
+    send_mouse(widget, QEvent.MouseButtonRelease, end, button, Qt.NoButton, modifiers)
 
 
 def wait_for_frame(qtbot, window, min_spp: int = 1, generation: int | None = None, timeout: int = 20000):

@@ -11,8 +11,10 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 from PySide6.QtCore import QEvent, QPoint, QPointF, Qt
-from PySide6.QtGui import QMouseEvent, QWheelEvent
+from PySide6.QtGui import QWheelEvent
 from PySide6.QtWidgets import QApplication
+
+from .helpers import send_mouse
 
 VIEW = (640, 480)
 
@@ -42,11 +44,6 @@ def studio(qtbot, small_scene):
     navigator = CameraNavigator(doc, viewport, lambda: doc.scene.camera.view_frame(*VIEW, 0.04))
     yield SimpleNamespace(doc=doc, viewport=viewport, navigator=navigator)
     doc.silence()
-
-
-def send_mouse(widget, kind, pos, button, buttons, modifiers) -> None:
-    event = QMouseEvent(kind, QPointF(*pos), widget.mapToGlobal(QPointF(*pos)), button, buttons, modifiers)
-    QApplication.sendEvent(widget, event)
 
 
 def drag(viewport, travel, events: int, gesture: str = "orbit", during=None) -> None:

@@ -26,7 +26,7 @@ from lenslab.optics.histogram import clipping_masks
 from lenslab.optics.peaking import within_depth_of_field
 from lenslab.scene.camera import ThinLensCamera
 
-from .helpers import wait_for_frame, wait_for_gbuffer
+from .helpers import hover, wait_for_frame, wait_for_gbuffer
 
 
 # -- a viewport of its own -------------------------------------------------------------------------------------------
@@ -224,7 +224,7 @@ def test_loupe_shows_the_pixel_under_the_cursor_and_hides_when_it_leaves(viewpor
     viewport.layers.append(loupe)
     loupe.set_visible(True)
     loupe.set_zoom(4)
-    qtbot.mouseMove(viewport, QPoint(*widget_pixel(viewport, 70.5, 40.5)))
+    hover(viewport, QPoint(*widget_pixel(viewport, 70.5, 40.5)))
     qtbot.waitUntil(lambda: loupe.pixel == (70, 40))
     assert loupe.source_rect().center() == QPoint(70, 40) and loupe.span() % 2 == 1
     caption = loupe.caption()

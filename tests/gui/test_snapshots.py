@@ -18,7 +18,7 @@ from lenslab.gui.snapshots import SnapshotStore, camera_label, compare_tags
 from lenslab.render.film import to_8bit, tone_map
 from lenslab.scene.camera import ThinLensCamera
 
-from .helpers import wait_for_frame, wait_for_gbuffer
+from .helpers import hover, press_drag_release, wait_for_frame, wait_for_gbuffer
 
 ZOOM = 4.0
 
@@ -202,23 +202,19 @@ def test_dragging_the_divider_moves_it(qtbot, window):
     x = comparison.divider_x()
     assert x == pytest.approx(rect.center().x())
     y = round(rect.center().y())
-    qtbot.mouseMove(v, QPoint(1, 1))  # from elsewhere: a move to where the cursor already is sends no event
-    qtbot.mouseMove(v, QPoint(round(x) + 3, y))
+    hover(v, QPoint(round(x) + 3, y))
     assert v.cursor().shape() == Qt.SplitHCursor  # within a few pixels, the cursor says it can be dragged
     selection = list(window.doc.selection)
-    qtbot.mousePress(v, Qt.LeftButton, pos=QPoint(round(x) + 3, y))
     target = rect.left() + 0.2 * rect.width()
-    qtbot.mouseMove(v, QPoint(round(target), y + 20))
-    qtbot.mouseRelease(v, Qt.LeftButton, pos=QPoint(round(target), y + 20))
+    press_drag_release(v, QPoint(round(x) + 3, y), QPoint(round(target), y + 20))
     assert store.divider == pytest.approx((round(target) - rect.left()) / rect.width(), abs=1e-9)
     assert store.divider == pytest.approx(0.2, abs=0.01)
     assert window.doc.selection == selection  # the drag was the divider's, not the select tool's click
     # Away from the divider the cursor is the tool's again, and a press there is the tool's.
-    qtbot.mouseMove(v, QPoint(round(rect.left() + 0.7 * rect.width()), y))
+    hover(v, QPoint(round(rect.left() + 0.7 * rect.width()), y))
     assert v.cursor().shape() == Qt.ArrowCursor
-    qtbot.mousePress(v, Qt.LeftButton, pos=QPoint(round(rect.left() + 0.7 * rect.width()), y))
-    qtbot.mouseMove(v, QPoint(round(rect.left() + 0.9 * rect.width()), y))
-    qtbot.mouseRelease(v, Qt.LeftButton, pos=QPoint(round(rect.left() + 0.9 * rect.width()), y))
+    press_drag_release(v, QPoint(round(rect.left() + 0.7 * rect.width()), y),
+                       QPoint(round(rect.left() + 0.9 * rect.width()), y))
     assert store.divider == pytest.approx(0.2, abs=0.01)
 
 
@@ -246,10 +242,10 @@ def test_side_by_side_maps_the_mouse_to_each_half(qtbot, window):
         assert np.abs(rgb(screen, *at(on_screen(rect, px, py))) - rgb(live, px, py)).max() <= 1
         assert np.abs(rgb(screen, *at(on_screen(a_rect, px, py))) - rgb(a, px, py)).max() <= 1
     # The readout reads the half under the cursor: A's radiance on the left, the live picture's on the right.
-    qtbot.mouseMove(v, left)
+    hover(v, left)
     text = window.readout.text()
     assert text.startswith("<b>A</b>  x 24  y 28") and f"{snapshot.linear[y, x, 0]:.4f}" in text
-    qtbot.mouseMove(v, right)
+    hover(v, right)
     # The live half's readout needs the live picture's radiance, which may come with the next frame.
     qtbot.waitUntil(lambda: window.readout.text().startswith("x 24  y 28"), timeout=10000)
     text = window.readout.text()

@@ -7,16 +7,10 @@ import dataclasses
 
 import numpy as np
 import pytest
-from PySide6.QtCore import QEvent, QPointF, Qt
-from PySide6.QtGui import QMouseEvent
-from PySide6.QtWidgets import QApplication
+from PySide6.QtCore import QEvent, Qt
 
+from tests.gui.helpers import send_mouse as _mouse
 from tests.gui.helpers import wait_for_frame
-
-
-def _mouse(widget, kind, pos, button, buttons, modifiers=Qt.NoModifier):
-    event = QMouseEvent(kind, QPointF(*pos), widget.mapToGlobal(QPointF(*pos)), button, buttons, modifiers)
-    QApplication.sendEvent(widget, event)
 
 
 def drag(widget, start, end, button=Qt.MiddleButton, modifiers=Qt.NoModifier, steps=5):
