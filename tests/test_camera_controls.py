@@ -95,12 +95,12 @@ def test_click_to_focus_sets_the_reading_that_makes_the_point_sharp():
 
 
 def test_nothing_nearer_than_four_focal_lengths_from_the_sensor(tmp_path):
-    with pytest.raises(ValueError, match="nearer than a 100 mm lens can focus"):
+    with pytest.raises(ValueError, match="nearer than any 100 mm lens can focus"):
         ThinLensCamera(focal_length_mm=100.0, focus_distance_m=0.39).validate()
     ThinLensCamera(focal_length_mm=100.0, focus_distance_m=0.4).validate()  # 1:1
     path = tmp_path / "scene.json"
     path.write_text(json.dumps({"lenslab_scene": 2, "camera": {"focal_length_mm": 100, "focus_distance_m": 0.3}}))
-    with pytest.raises(SceneError, match=r"scene.json: camera: focus_distance_m 30.0 cm from the sensor"):
+    with pytest.raises(SceneError, match=r"scene.json: camera: focus_distance_m 0.3 m from the sensor is nearer than any 100 mm lens"):
         load_scene(path)
 
 

@@ -156,9 +156,10 @@ def sphere_pixels(image):
 
 @pytest.mark.parametrize("material", [
     Dielectric(ior=1.5),
+    Dielectric(ior=0.75),  # an air bubble in water: relative index below 1, total internal reflection from outside
     ThinDielectric(ior=1.5),
     Conductor(**PERFECT_MIRROR),
-], ids=["smooth glass", "thin glass", "perfect mirror"])
+], ids=["smooth glass", "smooth bubble", "thin glass", "perfect mirror"])
 def test_lossless_smooth_materials_keep_all_energy(renderer, material):
     image = render_mean(renderer, furnace(material), spp=64)
     ball = image[sphere_pixels(image)]

@@ -227,10 +227,12 @@ def test_thinlens_gives_the_same_lens_radius_and_focus(tmp_path):
         load(tmp_path, camera_xml("thinlens"))
 
 
-def test_tiny_or_huge_apertures_are_clamped_with_a_warning(tmp_path):
+def test_tiny_or_huge_apertures_are_kept_as_written(tmp_path):
+    # Past the studio's f/128 and f/0.5 alike: the camera takes any lens float32 carries (tests/test_scene_as_written.py).
     scene, warnings = load(tmp_path, camera_xml("thinlens", params='<float name="aperture_radius" value="1e-6"/>'))
-    assert scene.camera.f_number == 128
-    assert "f/128" in only(warnings, "aperture_radius")
+    assert scene.camera.lens_radius == pytest.approx(1e-6) and scene.camera.f_number > 128 and warnings == []
+    scene, warnings = load(tmp_path, camera_xml("thinlens", params='<float name="aperture_radius" value="1"/>'))
+    assert scene.camera.lens_radius == pytest.approx(1.0) and scene.camera.f_number < 0.5 and warnings == []
 
 
 def mitsuba_direction(to_world: np.ndarray, sx: float, sy: float, fov_x_deg: float, aspect: float) -> np.ndarray:

@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import pytest
 
 from lenslab.scene.io.loader import open_scene
+from lenslab.optics.lenses import find_lens
 from lenslab.optics.stops import exact_f_number
 from lenslab.scene.overrides import SceneOverrides
 from lenslab.validate.runner import scene_path
@@ -33,7 +36,7 @@ def test_defines_reach_a_mitsuba_scenes_parameters():
     assert scene.camera.resolution == (24, 24) and scene.render.spp == 3
 
 
-@pytest.mark.parametrize("bad", [{"f_number": 0.2}, {"focal_length": 5000.0}, {"width": 0}, {"spp": 0},
+@pytest.mark.parametrize("bad", [{"f_number": 0.0}, {"focal_length": 0.0}, {"width": 0}, {"spp": 0},
                                  {"sampler": "halton"}, {"focus_distance": float("nan")}, {"clamp": -1.0}])
 def test_nonsense_is_refused_by_name(bad):
     name = next(iter(bad))
@@ -117,9 +120,9 @@ def test_a_lens_focuses_no_nearer_than_its_minimum_from_the_sensor():
     assert _focused(lens="85mm f/1.4", focus_distance=0.8).focus_distance_m == 0.8  # the minimum itself
     with pytest.raises(ValueError) as caught:
         _focused(lens="85mm f/1.4", focus_distance=0.79)
-    assert str(caught.value) == ("focus 79.0 cm from the sensor is nearer than the lens '85 mm f/1.4' focuses "
-                                 "(minimum 80.0 cm)")
-    with pytest.raises(ValueError, match="minimum 80.0 cm"):  # holding the framing does not move the sensor mark
+    assert str(caught.value) == ("--focus-distance 0.79 m from the sensor is nearer than the 85 mm f/1.4 lens's "
+                                 "minimum focus of 0.8 m from the sensor")
+    with pytest.raises(ValueError, match="minimum focus of 0.8 m"):  # holding the framing does not move the sensor mark
         _focused(lens="85mm f/1.4", focus_distance=0.79, focus_breathing=False)
 
 
@@ -129,16 +132,17 @@ def test_a_focus_measured_from_the_lens_is_compared_from_the_sensor():
     for breathing in (True, False):
         with pytest.raises(ValueError) as caught:
             _focused(lens="85mm f/1.4", focus_from="lens", focus_distance=0.6, focus_breathing=breathing)
-        assert str(caught.value) == ("focus 60.0 cm from the lens (69.9 cm from the sensor) is nearer than the lens "
-                                     "'85 mm f/1.4' focuses (minimum 80.0 cm from the sensor)")
+        assert str(caught.value) == ("--focus-distance 0.6 m from the lens is nearer than the 85 mm f/1.4 lens's "
+                                     "minimum focus of 0.8 m from the sensor (the plane of focus 0.7033 m from "
+                                     "the lens)")
 
 
 def test_nothing_nearer_than_the_thin_lens_can_focus():
-    with pytest.raises(ValueError, match=r"nearer than a 200 mm lens can focus: at least 80\.0 cm"):
+    with pytest.raises(ValueError, match=r"nearer than any 200 mm lens can focus: at least 0\.8 m"):
         _focused(focal_length=200.0, focus_distance=0.5)
-    with pytest.raises(ValueError, match="nearer than a 50 mm lens can focus"):
+    with pytest.raises(ValueError, match="nearer than any 50 mm lens can focus"):
         _focused(focal_length=50.0, focus_from="lens", focus_distance=0.04)
-    with pytest.raises(ValueError, match="nearer than a 50 mm lens can focus"):  # a lens without a marked minimum
+    with pytest.raises(ValueError, match="minimum focus of 0.4 m"):  # a lens's marked minimum says more
         _focused(lens="50mm f/1.2", focus_from="lens", focus_distance=0.04)
 
 
@@ -160,3 +164,35 @@ def test_nonsense_camera_controls_are_refused_by_name(bad, message):
     with pytest.raises(ValueError) as caught:
         SceneOverrides(**bad)
     assert message in str(caught.value)
+
+
+def test_focus_from_the_lens_meets_the_same_limits_as_focus_from_the_sensor():
+    """Both readings of one lens stop at the same plane of focus: life size for the thin lens (a sensor 550 mm behind
+    a 50 mm lens focused at 55 mm was accepted from the lens and refused from the sensor), and the lens's marked
+    minimum."""
+    from lenslab.optics.thinlens import sensor_distance_m
+
+    for given in (dict(lens="50mm f/1.2", focus_distance=0.055), dict(focal_length=100.0, focus_distance=0.101)):
+        with pytest.raises(ValueError, match=r"^--focus-distance 0\.\d+ m from the lens is nearer than"):
+            _focused(focus_from="lens", **given)
+    for given in (dict(focal_length=100.0), dict(lens="50mm f/1.2")):
+        from_lens = _focused(focus_from="lens", focus_distance=1.0, **given)
+        from_sensor = _focused(focus_from="sensor", focus_distance=1.0, **given)
+        lens = find_lens(given["lens"]) if "lens" in given else None
+        nearest_from_lens = from_lens.closest_focus_with(lens)
+        nearest_from_sensor = from_sensor.closest_focus_with(lens)
+        # The same plane: the nearest lens reading, read from the sensor, is the nearest sensor reading.
+        assert sensor_distance_m(from_lens.focal_length_mm, nearest_from_lens) == pytest.approx(nearest_from_sensor)
+        _focused(focus_from="lens", focus_distance=nearest_from_lens * 1.0001, **given)
+        with pytest.raises(ValueError):
+            _focused(focus_from="lens", focus_distance=nearest_from_lens * 0.999, **given)
+
+
+def test_a_scene_value_is_named_as_the_scene_holds_it_and_an_option_by_its_flag():
+    scene = open_scene("cornell_box")
+    near = dataclasses.replace(scene, camera=dataclasses.replace(scene.camera, focus_distance_m=0.5))
+    with pytest.raises(ValueError, match=r"^the scene's focus distance 0\.5 m from the sensor is nearer than the "
+                                         r"85 mm f/1\.4 lens's minimum focus of 0\.8 m"):
+        SceneOverrides(lens="85mm f/1.4").apply(near)
+    with pytest.raises(ValueError, match=r"^--focus-distance 0\.5 m from the sensor"):
+        SceneOverrides(lens="85mm f/1.4", focus_distance=0.5).apply(scene)

@@ -78,7 +78,7 @@ def _write_broken(tmp_path, edit):
     [
         (lambda d: d["camera"].update(f_stop=2.8), r"broken\.json: camera\.f_stop: unknown key"),
         (lambda d: d["camera"].update(f_number="2.8"), r"broken\.json: camera\.f_number: expected a number, got \"2\.8\""),
-        (lambda d: d["camera"].update(f_number=0.1), r"broken\.json: camera\.f_number: 0\.1 is out of range \[0\.5, 128\]"),
+        (lambda d: d["camera"].update(f_number=0), r"broken\.json: camera\.f_number: 0 is out of range \[1e-06, 1e\+06\]"),
         (lambda d: d["camera"].update(resolution=[640]), r"camera\.resolution: expected a list of 2 numbers"),
         (lambda d: d["camera"].update(aperture_blades=2), r"camera: aperture_blades must be 0 \(round\) or at least 3"),
         (lambda d: d["camera"].update(look_at=d["camera"]["position"]), r"camera: camera look_at equals its position"),

@@ -396,7 +396,29 @@ def _ignore_stop_signals() -> None:
         signal.signal(signal.SIGTERM, signal.SIG_IGN)
 
 
+#: The exit status when whoever reads the output stops reading (``lenslab --list-lenses | head -3``): a C program
+#: dies of SIGPIPE there, which a shell reports as 128 + 13; nothing is printed, since there is no one to tell.
+EXIT_READER_GONE = 141
+
+
 def main(argv: list[str] | None = None) -> int:
+    try:
+        return _main(argv)
+    except BrokenPipeError:
+        _stop_writing_to_stdout()
+        return EXIT_READER_GONE
+
+
+def _stop_writing_to_stdout() -> None:
+    """Point stdout at /dev/null, so that the interpreter's last flush at exit finds no closed pipe to complain of."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):  # no stdout to redirect (a caller's StringIO): nothing will be flushed to a pipe
+        pass
+
+
+def _main(argv: list[str] | None) -> int:
     args_list = sys.argv[1:] if argv is None else list(argv)
     _report_library_warnings()
     if argv is None and args_list[:1] in (["validate"], ["batch"]):  # the process's own command
@@ -426,6 +448,8 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("lenslab: interrupted; nothing was written", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except BrokenPipeError:
+        raise  # the reader went away: main says nothing
     except OSError as exc:
         _error(describe_os_error(exc))
         return EXIT_ERROR

@@ -25,6 +25,31 @@ class CommandParser(argparse.ArgumentParser):
     def error(self, message: str):
         raise CliError(f"{message} (see {self.prog} --help)", EXIT_USAGE)
 
+    def parse_known_args(self, args=None, namespace=None):
+        return super().parse_known_args(self._negative_values_attached(args), namespace)
+
+    def _negative_values_attached(self, args):
+        """``--shutter -1/60`` as ``--shutter=-1/60``: argparse takes a value that starts with '-' for a value only
+        when it reads as a plain negative number (-2, -0.5), so a negative fraction or a negative "-1e3" would be
+        "expected one argument". Attached to its flag, it reaches the option's own check, which says what is
+        wrong with it."""
+        import sys
+
+        args = list(sys.argv[1:] if args is None else args)
+        takes_value = {flag for action in self._actions if action.option_strings and action.nargs is None
+                       and action.const is None for flag in action.option_strings if flag.startswith("--")}
+        joined, i = [], 0
+        while i < len(args):
+            arg = args[i]
+            if (arg in takes_value and i + 1 < len(args) and len(args[i + 1]) > 1
+                    and args[i + 1][0] == "-" and (args[i + 1][1].isdigit() or args[i + 1][1] == ".")):
+                joined.append(f"{arg}={args[i + 1]}")
+                i += 2
+                continue
+            joined.append(arg)
+            i += 1
+        return joined
+
 
 def number_argument(kind, low: float, high: float):
     """An argparse type: an int or float in [low, high], refused in one line naming the value."""

@@ -45,7 +45,8 @@ def test_focus_nearer_than_the_lens_is_refused_and_a_longer_lens_moves_it_out(wi
     before = window.doc.scene.camera.focus_distance_m
     assert not panel.set_focus(0.5)
     assert window.doc.scene.camera.focus_distance_m == before
-    assert "85 mm f/1.4 focuses no nearer than 80.0 cm from the sensor" in messages[-1]
+    assert messages[-1] == ("Cannot focus there: focus 0.5 m from the sensor is nearer than the 85 mm f/1.4 lens's "
+                            "minimum focus of 0.8 m from the sensor")  # the command line's check, in the panel's word
     assert panel.set_focus(0.9)
     # Free, 50 mm at 0.25 m: a 200 mm lens cannot focus there (four focal lengths), so zooming moves it out.
     panel.choose_lens(None)
@@ -171,3 +172,32 @@ def test_folded_sections_are_remembered(make_window, small_scene, settings):
     assert not again.camera_panel.sections["bokeh"].header.isChecked()
     assert not again.camera_panel.sections["bokeh"].body.isVisibleTo(again)
     assert again.camera_panel.sections["exposure"].header.isChecked()
+
+
+def test_a_scene_at_f_0_13_opens_as_written_and_the_panel_shows_it(make_window, small_scene, tmp_path, qtbot):
+    # The controls offer f/0.5 to f/128 and 1 to 2000 mm; a scene holds what it holds (Mitsuba's sensor_thinlens is
+    # f/0.13): shown as it is, and neither opening, showing nor leaving the fields changes it.
+    import dataclasses
+
+    from lenslab.scene.io.loader import open_scene
+    from lenslab.scene.io.native import save_scene
+
+    small_scene.camera = dataclasses.replace(small_scene.camera, f_number=0.13, focal_length_mm=0.5,
+                                             focus_from="lens", focus_breathing=False)
+    path = tmp_path / "wide_open.json"
+    save_scene(small_scene, path)
+    window = make_window(open_scene(str(path)), path)
+    panel = window.camera_panel
+    assert panel.aperture_combo.currentText() == "f/0.13"
+    assert panel.focal.value() == 0.5 and panel.focal.text().startswith("0.5")
+    assert not panel.open_up.isEnabled() and panel.stop_down.isEnabled()  # wider than every stop on the scale
+    wait_for_frame(qtbot, window)
+    panel.aperture_combo.lineEdit().editingFinished.emit()  # leaving the fields as shown edits nothing
+    panel.focal.editingFinished.emit()
+    cam = window.doc.scene.camera
+    assert (cam.f_number, cam.focal_length_mm) == (0.13, 0.5)
+    assert window.doc.undo_stack.count() == 0 and window.doc.undo_stack.isClean()
+    window.actions["stop_down"].trigger()  # a step is a control: onto the scale, at its widest stop
+    assert window.doc.scene.camera.f_number == pytest.approx(2 ** -0.5)
+    window.doc.undo_stack.undo()
+    assert window.doc.scene.camera.f_number == 0.13 and panel.aperture_combo.currentText() == "f/0.13"

@@ -14,7 +14,6 @@ import os
 import re
 import shutil
 import tempfile
-import time
 import types
 from pathlib import Path
 
@@ -121,12 +120,9 @@ def test_an_export_the_folder_cannot_take_fails_at_once_without_rendering(window
     started = []
     monkeypatch.setattr(window.controller, "start_export", lambda request: started.append(request) or 1)
 
-    begin = time.perf_counter()
     result = window.start_export(export_request(window, folder / "shot.exr", target_spp=64))
-    seconds = time.perf_counter() - begin
 
-    assert started == [] and result is None  # no render started
-    assert seconds < 0.5
+    assert started == [] and result is None  # refused before any render started (not timed: no test needs an idle machine)
     assert len(shown) == 1 and expected in shown[0] and str(folder / "shot.exr") in shown[0]
     assert window.export_progress_dialog is None and window.export_id is None
     assert window.files.last_folder("images") == earlier  # the next export does not start there

@@ -137,7 +137,7 @@ class CameraNavigator(QObject):
         distance = float(np.linalg.norm(np.subtract(changes["look_at"], changes["position"])))
         try:
             setting = round(camera.focus_setting_for(distance), 4)
-            if setting >= camera.closest_focus_m:
+            if setting >= camera.closest_focus_with(self.doc.lens):  # the camera's own check, lens and all
                 changes["focus_distance_m"] = setting
         except ValueError:
             pass

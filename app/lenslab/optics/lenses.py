@@ -13,8 +13,10 @@ from dataclasses import KW_ONLY, dataclass, field
 from typing import Iterable, Sequence
 
 from .presetfiles import FieldError, PresetError, build_preset, merge_by_name, preset_dirs, read_json
-from .stops import MAX_F_NUMBER, MIN_F_NUMBER, Scale, exact_f_number, is_valid_f_number
-from .thinlens import FOCAL_LENGTH_RANGE_MM
+from .stops import MAX_F_NUMBER, MIN_F_NUMBER, Scale, exact_f_number, is_offered_f_number
+# A lens preset is a control (the studio mounts it): it marks stops and focal lengths within the controls' ranges,
+# not everything a scene may hold (stops.F_NUMBER_RANGE, thinlens.FOCAL_LENGTH_RANGE_MM).
+from .thinlens import FOCAL_LENGTH_CONTROL_RANGE_MM
 
 __all__ = ["LensPreset", "LENSES_DIR", "MAX_APERTURE_BLADES", "find_lens", "load_lens_presets"]
 
@@ -63,7 +65,7 @@ class LensPreset:
         self._check_focal()
         for key in ("widest_f_number", "narrowest_f_number"):
             value = getattr(self, key)
-            if not is_valid_f_number(value):
+            if not is_offered_f_number(value):
                 raise FieldError(
                     key, f"f-number must lie in [{MIN_F_NUMBER:g}, {MAX_F_NUMBER:g}], got {value!r}"
                 )
@@ -95,7 +97,7 @@ class LensPreset:
 
     def _check_focal(self):
         def check_mm(key, value):
-            low, high = FOCAL_LENGTH_RANGE_MM
+            low, high = FOCAL_LENGTH_CONTROL_RANGE_MM
             if not (low <= value <= high):
                 raise FieldError(key, f"must lie in [{low:g}, {high:g}] mm, got {value!r}")
             return float(value)

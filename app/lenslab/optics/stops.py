@@ -35,7 +35,9 @@ __all__ = [
     "MIN_F_NUMBER",
     "MAX_F_NUMBER",
     "F_NUMBER_RANGE",
+    "F_NUMBER_CONTROL_RANGE",
     "is_valid_f_number",
+    "is_offered_f_number",
     "stops_between",
     "nearest_stop",
     "step_stop",
@@ -50,7 +52,7 @@ THIRD_STOPS: tuple[float, ...] = (
     6.3, 7.1, 8, 9, 10, 11, 13, 14, 16, 18, 20, 22,
 )
 
-#: The same scale continued both ways over the whole valid range, f/0.7 to
+#: The same scale continued both ways over the controls' range, f/0.7 to
 #: f/128 (marked values: 1.1 and 1.2 for 1.12 and 1.26, 25 and 29 for 25.4
 #: and 28.5, ...): the marks of ``STOP_SCALES["third"]``.
 EXTENDED_THIRD_STOPS: tuple[float, ...] = (
@@ -154,14 +156,22 @@ def marked_f_number(n: float, scale: str | StopScale | None = None) -> float:
     return float(n)
 
 
-#: Valid f-numbers lie in [MIN_F_NUMBER, MAX_F_NUMBER], the one range every
-#: part of LensLab accepts (scene files, the command line, the studio, lens
-#: presets, importers).  0.5 is the theoretical limit of an aplanatic lens in
-#: air (N = 1 / (2 NA), NA < 1); f/128 is about the smallest aperture ever
-#: marked on a lens.
+#: Two ranges, not one. F_NUMBER_CONTROL_RANGE, [MIN_F_NUMBER, MAX_F_NUMBER], is what the studio's controls
+#: offer and a lens preset may mark: 0.5 is the theoretical limit of an aplanatic lens in air (N = 1 / (2 NA),
+#: NA < 1); f/128 is about the smallest aperture ever marked on a lens. It limits what the controls offer, never
+#: what a scene holds.
 MIN_F_NUMBER = 0.5
 MAX_F_NUMBER = 128.0
-F_NUMBER_RANGE = (MIN_F_NUMBER, MAX_F_NUMBER)
+F_NUMBER_CONTROL_RANGE = (MIN_F_NUMBER, MAX_F_NUMBER)
+#: F_NUMBER_RANGE is what an f-number may *be*: what a scene file, an importer, the command line and a batch file
+#: accept, and what the studio shows as it is. The thin lens itself takes any N > 0 (pbrt and Mitsuba take any
+#: aperture radius: Mitsuba's own documentation scene sensor_thinlens is f/0.13). What bounds N is the GPU's
+#: float32: the lens radius f / 2N and the focal length meet in the camera's float32 sums (the ray's origin on
+#: the lens, its direction to the point of focus), and float32 resolves one beside the other only while they
+#: differ by less than its 24-bit significand, 2^24 = 1.7e7. A million either way keeps 4 bits to spare, and the
+#: exposure's N^2 stays within 1e+-12 (float32 reaches 3.4e38). Beyond f/1e6 the lens is a pinhole to float32;
+#: below f/1e-6 the aperture is a million focal lengths wide.
+F_NUMBER_RANGE = (1e-6, 1e6)
 
 # Two values closer than this (relative) are the same marked stop.  Adjacent
 # third stops differ by about 12 %, so this only absorbs float noise and
@@ -170,7 +180,17 @@ _SAME_STOP_REL_TOL = 1e-3
 
 
 def is_valid_f_number(n: float) -> bool:
-    """True when ``n`` is a finite number in [0.5, 128]."""
+    """True when ``n`` is an f-number a scene may hold: a finite number in :data:`F_NUMBER_RANGE` (f/0.13 is one;
+    the studio's controls offer :data:`F_NUMBER_CONTROL_RANGE`)."""
+    try:
+        n = float(n)
+    except (TypeError, ValueError):
+        return False
+    return F_NUMBER_RANGE[0] <= n <= F_NUMBER_RANGE[1]
+
+
+def is_offered_f_number(n: float) -> bool:
+    """True when ``n`` lies in what the controls offer and a lens may mark, :data:`F_NUMBER_CONTROL_RANGE`."""
     try:
         n = float(n)
     except (TypeError, ValueError):
@@ -180,7 +200,7 @@ def is_valid_f_number(n: float) -> bool:
 
 def _checked(n: float) -> float:
     if not is_valid_f_number(n):
-        raise ValueError(f"f-number must lie in [{MIN_F_NUMBER:g}, {MAX_F_NUMBER:g}], got {n!r}")
+        raise ValueError(f"f-number must be a number in [{F_NUMBER_RANGE[0]:g}, {F_NUMBER_RANGE[1]:g}], got {n!r}")
     return float(n)
 
 
@@ -254,9 +274,11 @@ def format_f_number(n: float) -> str:
     """Text as photographers write it: ``"f/2.8"``, ``"f/2"``, ``"f/0.95"``, ``"f/22"``.
 
     An exact stop shows its mark (``"f/11"`` for 11.31). Otherwise one decimal (two below f/1, where 0.95
-    vs 0.9 matters), trailing zeros dropped.
+    vs 0.9 matters, and two significant digits below f/0.1: ``"f/0.013"``), trailing zeros dropped.
     """
     n = marked_f_number(_checked(n))
+    if n < 0.1:
+        return f"f/{n:.2g}"
     text = f"{n:.2f}" if n < 1.0 else f"{n:.1f}"
     return "f/" + text.rstrip("0").rstrip(".")
 
@@ -273,8 +295,9 @@ def parse_f_number(text: str, scale: str | StopScale = DEFAULT_STOP_SCALE) -> fl
     engraved 11, whose iris is 2^3.5 = 11.31; ``scale`` settles marks two scales read differently ("13" is
     12.70 on thirds, 13.45 on halves).
 
-    Raises ValueError naming the text when it is not an f-number or is
-    outside [0.5, 128].
+    Raises ValueError naming the text when it is not an f-number or is outside what an f-number may be,
+    :data:`F_NUMBER_RANGE` (f/0 is none; f/0.2 is one, as a scene file may hold it, though the studio's stops
+    begin at f/0.7).
     """
     match = _F_NUMBER_RE.match(text) if isinstance(text, str) else None
     if match is None:
@@ -282,6 +305,6 @@ def parse_f_number(text: str, scale: str | StopScale = DEFAULT_STOP_SCALE) -> fl
     n = float(match.group(1).replace(",", "."))
     if not is_valid_f_number(n):
         raise ValueError(
-            f"f-number out of range [{MIN_F_NUMBER:g}, {MAX_F_NUMBER:g}]: {text!r}"
+            f"f-number out of range [{F_NUMBER_RANGE[0]:g}, {F_NUMBER_RANGE[1]:g}]: {text!r}"
         )
     return exact_f_number(n, scale)

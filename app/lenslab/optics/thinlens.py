@@ -27,6 +27,7 @@ import numpy as np
 __all__ = [
     "MM_PER_M",
     "FOCAL_LENGTH_RANGE_MM",
+    "FOCAL_LENGTH_CONTROL_RANGE_MM",
     "FOCUS_DISTANCE_RANGE_M",
     "f_number_for_lens_radius",
     "format_camera_settings",
@@ -42,9 +43,18 @@ __all__ = [
 #: Millimetres in a metre; named so that every unit conversion is greppable.
 MM_PER_M = 1000.0
 
-#: The focal lengths LensLab accepts, mm: a 1 mm fisheye-free wide angle to a 2000 mm mirror lens. Scene
-#: files, the command line, the studio's fields, lens presets and importers all read this one range.
-FOCAL_LENGTH_RANGE_MM = (1.0, 2000.0)
+#: The focal lengths the studio's controls offer and a lens preset may have, mm: a 1 mm fisheye-free wide angle
+#: to a 2000 mm mirror lens. It limits what the controls offer, never what a scene holds.
+FOCAL_LENGTH_CONTROL_RANGE_MM = (1.0, 2000.0)
+#: The focal lengths a scene may hold, mm: what scene files, importers, the command line and batch files accept
+#: (a Mitsuba sensor's fov becomes a focal length on a 36 mm sensor). Any f > 0 gives a field of view strictly
+#: between 0 and 180 degrees; what bounds it is float32 on the GPU, which takes tan(fov / 2) = w / 2v (w the
+#: sensor's side, v >= f) and builds each ray's direction as (x tan, y tan, -1): past 2^24 (float32's significand)
+#: the -1 is lost beside the image edge's x tan and those rays lie in the sensor's plane (180 degrees). 1e-4 mm
+#: keeps tan(fov / 2) under 2.5e6 on the widest sensor (500 mm; fov 179.99998 degrees on it, 179.9997 on 36 mm).
+#: The long end is where a lens can no longer focus on anything: its closest focus, four focal lengths, lies
+#: beyond the farthest focus distance (FOCUS_DISTANCE_RANGE_M's 1e6 m): 2.5e8 mm (fov 8e-6 degrees on 36 mm).
+FOCAL_LENGTH_RANGE_MM = (1e-4, 2.5e8)
 #: The focus distances LensLab accepts, metres: 1 cm (macro) to 1000 km (infinity for any lens).
 FOCUS_DISTANCE_RANGE_M = (0.01, 1e6)
 
@@ -166,7 +176,10 @@ def textbook_blur_diameter_mm(focal_length_mm, f_number, focus_distance_m, depth
 
 
 def format_focal_length(mm: float) -> str:
-    """Text as a lens barrel reads: ``"50 mm"``, ``"31.2 mm"`` (one decimal at most, trailing zeros dropped)."""
+    """Text as a lens barrel reads: ``"50 mm"``, ``"31.2 mm"`` (one decimal at most, trailing zeros dropped;
+    two significant digits below 1 mm, as a scene may hold: ``"0.16 mm"``)."""
+    if float(mm) < 1.0:
+        return f"{float(mm):.2g} mm"
     return f"{float(mm):.1f}".rstrip("0").rstrip(".") + " mm"
 
 
@@ -233,7 +246,9 @@ def sensor_distance_m(focal_length_mm: float, object_distance: float) -> float:
 
 
 def closest_focus_m(focal_length_mm: float, focus_from: str = "sensor") -> float:
-    """The nearest focus distance a thin lens of this focal length can set: four focal lengths from the sensor
-    (1:1), or just beyond one focal length from the lens."""
+    """The nearest focus distance a thin lens of this focal length can set: life size (1:1), the plane of focus two
+    focal lengths ahead of the lens and the sensor two behind it, so four focal lengths from the sensor. Both
+    references meet the same limit: nearer than 2f from the lens the sensor would have to go further back than 2f
+    (ten metres behind a 100 mm lens focused at 101 mm), a bellows no lens has."""
     f = require_positive("focal_length_mm", focal_length_mm) / MM_PER_M
-    return 4.0 * f if focus_from == "sensor" else f * (1.0 + 1e-6)
+    return 4.0 * f if focus_from == "sensor" else 2.0 * f

@@ -26,11 +26,12 @@ from lenslab.optics.aperture import Aperture
 from lenslab.optics.dof import COC_DIAGONAL_DIVISOR, DepthOfField
 from lenslab.optics.exposure import EXPOSURE_MODES, ISO_RANGE, SHUTTER_RANGE_S, exposure_scale
 from lenslab.optics.framing import SENSOR_FITS, imaged_area_mm
-from lenslab.optics.lenses import MAX_APERTURE_BLADES
+from lenslab.optics.lenses import MAX_APERTURE_BLADES, LensPreset
 from lenslab.optics.sensors import SENSOR_SIDE_RANGE_MM
-from lenslab.optics.stops import F_NUMBER_RANGE
-from lenslab.optics.thinlens import (FOCAL_LENGTH_RANGE_MM, FOCUS_DISTANCE_RANGE_M, FOCUS_REFERENCES, MM_PER_M,
-                                     closest_focus_m, format_distance, image_distance_mm, lens_radius_m,
+from lenslab.optics.stops import F_NUMBER_CONTROL_RANGE, F_NUMBER_RANGE
+from lenslab.optics.thinlens import (FOCAL_LENGTH_CONTROL_RANGE_MM, FOCAL_LENGTH_RANGE_MM, FOCUS_DISTANCE_RANGE_M,
+                                     FOCUS_REFERENCES, MM_PER_M,
+                                     closest_focus_m, image_distance_mm, lens_radius_m,
                                      object_distance_m, sensor_distance_m)
 
 Vec3 = tuple[float, float, float]
@@ -44,13 +45,33 @@ SQUEEZE_RANGE = (0.25, 4.0)
 COC_RANGE_MM = (0.0005, 1.0)
 
 
+class CameraValueError(ValueError):
+    """A camera value the camera cannot take, kept with its field so that each path names it in the user's words:
+    the command line its option (``--focus-distance 0.01 m is nearer than ...``), a scene file its key, the studio
+    its control. ``str()`` names the field as the scene format does."""
+
+    def __init__(self, field_name: str, value, reason: str):
+        self.field_name, self.value, self.reason = field_name, value, reason
+        super().__init__(self.worded(field_name))
+
+    def worded(self, name: str) -> str:
+        """The message with the value called ``name`` ("--focus-distance", "camera.focus_distance_m", "Focus")."""
+        unit = " m" if self.field_name.endswith("_m") else " mm" if self.field_name.endswith("_mm") else ""
+        value = f"{self.value:g}" if isinstance(self.value, (int, float)) else str(self.value)
+        return f"{name} {value}{unit} {self.reason}"
+
+
 @dataclass
 class ThinLensCamera:
     position: Vec3 = field(default=(0.0, 1.0, 5.0), metadata={"doc": "centre of the lens, metres"})
     look_at: Vec3 = field(default=(0.0, 1.0, 0.0), metadata={"doc": "a point on the view axis"})
     up: Vec3 = field(default=(0.0, 1.0, 0.0), metadata={"doc": "which way is up in the image"})
-    focal_length_mm: float = field(default=50.0, metadata={"range": FOCAL_LENGTH_RANGE_MM})
-    f_number: float = field(default=2.8, metadata={"range": F_NUMBER_RANGE, "doc": "N; aperture diameter is f/N"})
+    # "range": what the field may hold (scene files, importers, the command line); "controls": what the studio's
+    # controls offer, where that is less (scene/fields.py).
+    focal_length_mm: float = field(default=50.0, metadata={"range": FOCAL_LENGTH_RANGE_MM,
+                                                            "controls": FOCAL_LENGTH_CONTROL_RANGE_MM})
+    f_number: float = field(default=2.8, metadata={"range": F_NUMBER_RANGE, "controls": F_NUMBER_CONTROL_RANGE,
+                                                   "doc": "N; aperture diameter is f/N"})
     focus_distance_m: float = field(default=5.0, metadata={"range": FOCUS_DISTANCE_RANGE_M,
                                                                   "doc": "distance to the plane of focus"})
     focus_from: str = field(default="sensor", metadata={"choices": FOCUS_REFERENCES,
@@ -105,10 +126,40 @@ class ThinLensCamera:
 
     @property
     def closest_focus_m(self) -> float:
-        """The nearest focus distance this camera's lens can set, in its own reference (thin-lens limit)."""
+        """The nearest focus distance this camera's lens can set, in its own reference (thin-lens limit): life
+        size, the sensor two focal lengths behind the lens and the plane of focus two ahead, whichever reference
+        the distance is read in. With the sensor held at one focal length (pbrt's and Mitsuba's camera, no
+        breathing) the plane of focus may be anywhere: no sensor moves to follow it."""
         if self.pinhole or (self.focus_from == "lens" and not self.focus_breathing):
             return FOCUS_DISTANCE_RANGE_M[0]
         return closest_focus_m(self.focal_length_mm, self.focus_from)
+
+    def closest_focus_with(self, lens: "LensPreset | None" = None) -> float:
+        """The nearest focus distance (in this camera's reference) the camera can set with ``lens`` mounted: the
+        thin lens's limit, and the lens's marked minimum, which a focus scale reads from the sensor plane."""
+        closest = self.closest_focus_m
+        if lens is None or lens.min_focus_distance_m is None or self.pinhole:
+            return closest
+        marked = float(lens.min_focus_distance_m)
+        if self.focus_from == "lens":  # the plane of focus that reading puts the sensor behind
+            marked = object_distance_m(self.focal_length_mm, max(marked, 4.0 * self.focal_length_mm / MM_PER_M))
+        return max(closest, marked)
+
+    def focus_problem(self, lens: "LensPreset | None" = None) -> "CameraValueError | None":
+        """Why the focus distance cannot be set on this camera (with ``lens`` mounted), or None. The one check
+        every path makes: the scene files, the command line, batch shots and the studio."""
+        distance = float(self.focus_distance_m)
+        reference = "from the sensor" if self.focus_from == "sensor" else "from the lens"
+        closest = self.closest_focus_with(lens)
+        if distance >= closest * (1 - 1e-9):
+            return None
+        if closest > self.closest_focus_m:  # the lens's marked minimum says more than the thin lens's limit
+            where = "" if self.focus_from == "sensor" else f" (the plane of focus {closest:.4g} m from the lens)"
+            return CameraValueError("focus_distance_m", distance, f"{reference} is nearer than the {lens.name} "
+                                    f"lens's minimum focus of {lens.min_focus_distance_m:g} m from the sensor{where}")
+        return CameraValueError("focus_distance_m", distance, f"{reference} is nearer than any "
+                                f"{self.focal_length_mm:g} mm lens can focus: at least {closest:.4g} m, where the "
+                                "image is life size")
 
     def focus_setting_for(self, depth_m: float) -> float:
         """The focus distance (in this camera's reference) that makes a point ``depth_m`` ahead of the lens, along
@@ -191,14 +242,14 @@ class ThinLensCamera:
         true_up = np.cross(right, forward)
         return np.stack([right, true_up, -forward])
 
-    def validate(self) -> None:
+    def validate(self, lens: "LensPreset | None" = None) -> None:
+        """Raise ValueError (CameraValueError for a value of one field) if the renderer cannot draw this camera,
+        with ``lens`` mounted: the checks the field ranges cannot make alone."""
         if self.aperture_blades in (1, 2):
             raise ValueError("aperture_blades must be 0 (round) or at least 3")
-        if self.focus_distance_m < self.closest_focus_m:
-            reference = "the sensor" if self.focus_from == "sensor" else "the lens"
-            raise ValueError(f"focus_distance_m {format_distance(self.focus_distance_m)} from {reference} is nearer "
-                             f"than a {self.focal_length_mm:g} mm lens can focus: at least "
-                             f"{format_distance(self.closest_focus_m)}")
+        problem = self.focus_problem(lens)
+        if problem is not None:
+            raise problem
         self.basis()
 
     def frame(self, width: int | None = None, height: int | None = None, *,

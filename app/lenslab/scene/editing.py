@@ -316,16 +316,8 @@ def _rounded(v, digits: int) -> tuple[float, ...]:
 # -- the camera ---------------------------------------------------------------------------------------------------
 def closest_focus(camera, lens=None) -> float:
     """The nearest focus distance (in the camera's reference) the camera can set: the thin lens's limit, and a
-    mounted lens's marked minimum (which is from the sensor plane)."""
-    closest = camera.closest_focus_m
-    if lens is not None and lens.min_focus_distance_m is not None:
-        limit = lens.min_focus_distance_m
-        if camera.focus_from == "lens":  # the plane the sensor-side reading puts in focus
-            from lenslab.optics.thinlens import object_distance_m
-
-            limit = object_distance_m(camera.focal_length_mm, max(limit, 4 * camera.focal_length_mm / 1000))
-        closest = max(closest, limit)
-    return closest
+    mounted lens's marked minimum (which is from the sensor plane); the camera's own check."""
+    return camera.closest_focus_with(lens)
 
 
 def camera_changes_keeping_focus(camera, lens=None, **changes) -> dict:

@@ -3,6 +3,12 @@
 Scene classes declare each field's range or choices once, in the dataclass field's metadata
 (``field(default=2.8, metadata={"range": F_NUMBER_RANGE})``). Everything that checks or offers a value asks
 here: the scene-file reader, the command line's arguments, the studio's number fields, overrides.
+
+Two ranges, where they differ. ``"range"`` is what a value may *be*: what the scene-file reader, importers, the
+command line and batch files accept (:func:`declared_range`). ``"controls"`` is what the studio's sliders, spin
+boxes and presets *offer* (:func:`control_range`; the declared range where a field names none): f/0.5 to f/128
+for an f-number that may be f/0.13. A control range limits what the controls offer, never what a scene holds: a
+control showing a value outside it shows it as it is (:func:`range_holding`) and leaves it so.
 """
 
 from __future__ import annotations
@@ -25,3 +31,16 @@ def declared_range(cls: type, field_name: str) -> tuple:
 def declared_choices(cls: type, field_name: str) -> tuple[str, ...]:
     """The values a text field of ``cls`` may take."""
     return tuple(_metadata(cls, field_name)["choices"])
+
+
+def control_range(cls: type, field_name: str) -> tuple:
+    """(low, high) the studio's controls offer for a numeric field of ``cls``: its ``"controls"`` metadata, else
+    its declared range."""
+    meta = _metadata(cls, field_name)
+    return tuple(meta["controls"] if "controls" in meta else meta["range"])
+
+
+def range_holding(low: float, high: float, value: float) -> tuple[float, float]:
+    """A control's range widened just enough to hold ``value`` (a scene's value beyond what the control offers
+    is shown as it is, not clamped into the control's range)."""
+    return min(low, value), max(high, value)

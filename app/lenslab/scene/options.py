@@ -161,6 +161,16 @@ def _existing_file(text: str) -> str:
     return str(path.resolve())
 
 
+def _aperture_image_file(text: str) -> str:
+    """An aperture image named on the command line or in a batch file: read now, so that a file that is missing,
+    unreadable or black is blamed on the option that named it, not on the scene it is rendered with."""
+    from lenslab.scene.aperture_images import read_aperture_image
+
+    path = _existing_file(text)
+    read_aperture_image(path)
+    return path
+
+
 TONE_MAPS = ("clamp", "reinhard", "filmic")
 
 _ROWS = (
@@ -207,7 +217,7 @@ _ROWS = (
     Option("barrel_clipping", float, "cat's-eye bokeh toward the frame's corners, 0 to 1", "camera.barrel_clipping",
            metavar="C", metadata="lenslab:BarrelClipping"),
     Option("aperture_image", str, "a grayscale image of the stop (custom bokeh), relative to the current folder",
-           "camera.aperture_image", metavar="FILE", parse_text=_existing_file, metadata="lenslab:ApertureImage"),
+           "camera.aperture_image", metavar="FILE", parse_text=_aperture_image_file, metadata="lenslab:ApertureImage"),
     Option("exposure_mode", str, "compensated (brightness kept) or physical (each stop a stop of light)",
            "camera.exposure_mode", metadata="lenslab:ExposureMode"),
     Option("iso", float, "sensor speed; implies the physical exposure mode", "camera.iso", metavar="S",

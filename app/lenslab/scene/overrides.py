@@ -14,9 +14,8 @@ from typing import Callable
 
 from lenslab.optics.lenses import find_lens
 from lenslab.optics.sensors import find_sensor
-from lenslab.optics.thinlens import format_distance, sensor_distance_m
 from lenslab.optics.stops import exact_f_number, format_f_number
-from lenslab.scene.camera import MAX_IMAGE_SIDE, ThinLensCamera
+from lenslab.scene.camera import MAX_IMAGE_SIDE, CameraValueError
 from lenslab.scene.options import SCENE_OPTIONS
 from lenslab.scene.scene import Scene
 
@@ -73,10 +72,18 @@ class _OverridesMethods:
             camera_changes["resolution"] = self._resolution(scene.camera.resolution)
         render_changes = self._changes("render")
         camera = dataclasses.replace(scene.camera, **camera_changes)
-        if self.lens is not None:  # the lens's marked minimum first: it says more than the thin-lens limit
-            _check_minimum_focus(camera, find_lens(self.lens))
-        camera.validate()  # nothing nearer than the thin lens can focus, whatever the lens
+        try:  # the camera's own check, as every path makes it: the thin lens's limit and the lens's marked minimum
+            camera.validate(find_lens(self.lens) if self.lens is not None else None)
+        except CameraValueError as exc:
+            raise ValueError(exc.worded(self._word_for(exc.field_name))) from None
         return dataclasses.replace(scene, camera=camera, render=dataclasses.replace(scene.render, **render_changes))
+
+    def _word_for(self, field_name: str) -> str:
+        """What the user calls a camera field: the option that set it (``--focus-distance``), or the scene's value."""
+        for option in SCENE_OPTIONS:
+            if option.sets == "camera." + field_name and getattr(self, option.name) is not None:
+                return option.flag
+        return f"the scene's {field_name.removesuffix('_m').removesuffix('_mm').replace('_', ' ')}"
 
     def _changes(self, owner: str) -> dict[str, object]:
         """The given options that set fields of the scene's ``owner`` ("camera" or "render"), by field name."""
@@ -106,24 +113,3 @@ SceneOverrides.__module__ = __name__
 SceneOverrides.__doc__ = """Settings for one render on top of the scene's: one field per option of scene/options.py,
 None where the scene's own value stays, and the Mitsuba defines. Checked when made (a ValueError of one line);
 ``open`` reads a scene file with them, ``apply`` sets them on a scene already read."""
-
-
-def _check_minimum_focus(camera: ThinLensCamera, lens) -> None:
-    """A lens focuses no nearer than its marked minimum, which is measured from the sensor plane: a camera that
-    measures focus from the lens is compared by the distance from the sensor of the plane it focuses on (the
-    lens's own extension, whether or not the framing is held)."""
-    if lens.min_focus_distance_m is None or camera.pinhole:
-        return
-    minimum = format_distance(lens.min_focus_distance_m)
-    if camera.focus_from == "sensor":
-        from_sensor = float(camera.focus_distance_m)
-        said = f"focus {format_distance(from_sensor)} from the sensor"
-    else:
-        if camera.plane_of_focus_m * 1000.0 <= camera.focal_length_mm:
-            return  # within one focal length: no lens focuses there (validate says so)
-        from_sensor = sensor_distance_m(camera.focal_length_mm, camera.plane_of_focus_m)
-        said = (f"focus {format_distance(camera.focus_distance_m)} from the lens "
-                f"({format_distance(from_sensor)} from the sensor)")
-        minimum += " from the sensor"
-    if from_sensor < lens.min_focus_distance_m * (1 - 1e-9):
-        raise ValueError(f"{said} is nearer than the lens '{lens.name}' focuses (minimum {minimum})")

@@ -40,7 +40,10 @@ class Node:
     transform: Transform = field(default_factory=Transform)
     shape: Shape | None = None
     material: str = field(default="", metadata={"doc": "name of an entry in the scene's materials"})
-    children: list["Node"] = field(default_factory=list)
+    # Unquoted: under ``from __future__ import annotations`` this whole annotation is already a string, and a name
+    # quoted inside it stays a string after typing.get_type_hints on Python 3.10 (3.11 resolves it), which the
+    # scene reader (io/native.py) cannot read.
+    children: list[Node] = field(default_factory=list)
 
     def walk(self, parent_matrix: np.ndarray | None = None) -> Iterator[tuple["Node", np.ndarray]]:
         """Yield (node, local-to-world matrix) depth first."""
@@ -142,7 +145,12 @@ class RenderSettings:
     sampler: str = field(default="sobol", metadata={"choices": ("sobol", "independent")})
     pixel_filter: str = field(default="box", metadata={"choices": ("box", "gaussian"),
                                                       "doc": "how samples are spread over a pixel"})
-    filter_stddev: float = field(default=0.5, metadata={"range": (0.05, 4.0), "doc": "gaussian: standard deviation in pixels"})
+    # What the film draws (a scene may hold it): past 1/1024 px a gaussian is narrower than the 1/4096-px buckets
+    # trace.comp stores each sample's place in its pixel in; up to 32 px one smallest splat dispatch (LOCAL_SIZE_X
+    # pixels, 32 x (2 ceil(4 sigma + 0.5) + 1)^2 terms a sample) stays within SPLAT_GATHER_TERMS (render/tracer.py).
+    # The studio's field offers 0.05 to 4.
+    filter_stddev: float = field(default=0.5, metadata={"range": (1.0 / 1024.0, 32.0), "controls": (0.05, 4.0),
+                                                        "doc": "gaussian: standard deviation in pixels"})
     filter_weights: str = field(default="expected", metadata={
         "choices": ("expected", "sampled"),
         "doc": "gaussian: divide each pixel's weighted sum by the weight it expects (unbiased), or by the weights "

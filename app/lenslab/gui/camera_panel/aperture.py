@@ -208,6 +208,8 @@ class ApertureSection(CameraSection):
         if self._updating:
             return
         text = self.aperture_combo.lineEdit().text()
+        if text.strip() == format_f_number(self.doc.scene.camera.f_number):
+            return  # the camera's own value as shown (f/0.1234 shows "f/0.12"): leaving the field changes nothing
         try:
             n = parse_f_number(text, self.panel.scale_name)
         except ValueError as exc:

@@ -12,7 +12,7 @@ from lenslab.gui.camera_panel.section import CameraSection
 from lenslab.gui.widgets import IntEdit, NumberEdit, hint
 from lenslab.scene.camera import ThinLensCamera
 from lenslab.scene.editing import file_reference
-from lenslab.scene.fields import declared_range
+from lenslab.scene.fields import control_range
 
 if TYPE_CHECKING:
     from lenslab.gui.camera_panel import CameraPanel
@@ -25,11 +25,11 @@ class BokehSection(CameraSection):
         super().__init__(panel, "bokeh", "Iris and bokeh")
         grid = QGridLayout()
         grid.setHorizontalSpacing(6)
-        self.blades = IntEdit(*declared_range(ThinLensCamera, "aperture_blades"))
+        self.blades = IntEdit(*control_range(ThinLensCamera, "aperture_blades"))
         self.blades.setSpecialValueText("round")
         self.blades.setToolTip("Number of aperture blades: round (0) or 3 to 32. Shapes the bokeh.")
         self.blades.edited.connect(self._blades_edited)
-        self.rotation = NumberEdit(*declared_range(ThinLensCamera, "blade_rotation_deg"), decimals=1, step=1.0,
+        self.rotation = NumberEdit(*control_range(ThinLensCamera, "blade_rotation_deg"), decimals=1, step=1.0,
                                    suffix=" °")
         self.rotation.setToolTip("Rotation of the blade polygon")
         self.rotation.edited.connect(lambda v, merge: self.doc.set_camera(f"Blade rotation {v:g}°", merge,
@@ -70,7 +70,7 @@ class BokehSection(CameraSection):
 
     def _camera_number(self, field: str, undo_text: str, decimals: int, step: float, tip: str) -> NumberEdit:
         """A number field that edits one of the camera's fields, within the range the field declares."""
-        edit = NumberEdit(*declared_range(ThinLensCamera, field), decimals=decimals, step=step)
+        edit = NumberEdit(*control_range(ThinLensCamera, field), decimals=decimals, step=step)
         edit.setToolTip(tip)
         edit.edited.connect(lambda v, merge: self.doc.set_camera(f"{undo_text} {v:g}", merge, **{field: float(v)}))
         return edit

@@ -14,7 +14,7 @@ from lenslab.gui.widgets import hint
 from lenslab.optics.exposure import ev100, format_shutter, parse_shutter
 from lenslab.optics.stops import DEFAULT_STOP_SCALE
 from lenslab.scene.camera import ThinLensCamera
-from lenslab.scene.fields import declared_range
+from lenslab.scene.fields import control_range
 
 if TYPE_CHECKING:
     from lenslab.gui.camera_panel import CameraPanel
@@ -110,7 +110,7 @@ class ExposureSection(CameraSection):
 
     # -- edits ----------------------------------------------------------------------------------------------------
     def _set_iso(self, value) -> None:
-        low, high = declared_range(ThinLensCamera, "iso")
+        low, high = control_range(ThinLensCamera, "iso")
         if value is None or not low <= float(value) <= high:
             self.panel.status_message.emit(f"ISO must lie between {low:g} and {high:g}")
             self.panel.refresh()

@@ -13,7 +13,7 @@ import dataclasses
 import math
 from typing import TYPE_CHECKING
 
-from PySide6.QtCore import Qt
+from PySide6.QtCore import QSignalBlocker, Qt
 from PySide6.QtWidgets import QHBoxLayout, QPushButton
 
 from lenslab.gui.camera_panel.section import CameraSection
@@ -23,7 +23,7 @@ from lenslab.optics import LensPreset, format_distance, format_focal_length
 from lenslab.scene.camera import ThinLensCamera
 from lenslab.scene.editable import CAMERA
 from lenslab.scene.editing import camera_changes_keeping_focus
-from lenslab.scene.fields import declared_range
+from lenslab.scene.fields import control_range, range_holding
 
 if TYPE_CHECKING:
     from lenslab.gui.camera_panel import CameraPanel
@@ -44,7 +44,7 @@ class FocalLengthSection(CameraSection):
     def __init__(self, panel: CameraPanel):
         super().__init__(panel, "focal", "Focal length")
         row = QHBoxLayout()
-        self.focal = NumberEdit(*declared_range(ThinLensCamera, "focal_length_mm"), decimals=1, step=1.0, suffix=" mm")
+        self.focal = NumberEdit(*control_range(ThinLensCamera, "focal_length_mm"), decimals=1, step=1.0, suffix=" mm")
         self.focal.setObjectName("focalLength")
         self.focal.edited.connect(lambda v, merge: self.set_focal_length(v, merge))
         self.focal_slider = DragSlider(Qt.Horizontal)
@@ -102,7 +102,7 @@ class FocalLengthSection(CameraSection):
         with self._showing_camera():
             lo, hi = focal_limits_for(lens)
             prime = lens is not None and not lens.is_zoom
-            self.focal.set_quietly(cam.focal_length_mm)
+            self._show_focal_length(cam.focal_length_mm)
             if not self.focal_slider.isSliderDown():
                 self.focal_slider.setValue(log_to_slider(cam.focal_length_mm, lo, hi))
             for widget in [self.focal, self.focal_slider] + self.focal_buttons:
@@ -112,3 +112,14 @@ class FocalLengthSection(CameraSection):
             fov_y = math.degrees(cam.frame().fov_y)
             self.fov_info.setText(f"Field of view {math.degrees(cam.fov_x):.1f}° × {fov_y:.1f}°"
                                   + (" · fixed by the prime" if prime else ""))
+
+    def _show_focal_length(self, mm: float) -> None:
+        """Show ``mm`` in the field as the camera holds it: a scene's focal length beyond what the field offers
+        (an imported 0.16 mm fisheye) widens the field's range to hold it rather than being clamped, with the
+        decimals to read it; nothing is edited by showing it."""
+        low, high = range_holding(*control_range(ThinLensCamera, "focal_length_mm"), mm)
+        decimals = 1 if mm >= 1.0 else min(6, 2 - math.floor(math.log10(mm)))
+        with QSignalBlocker(self.focal):  # a range or decimals change may move the value: not the user's edit
+            self.focal.setDecimals(decimals)
+            self.focal.setRange(low, high)
+        self.focal.set_quietly(mm)

@@ -3,6 +3,7 @@ focus breathing, and the tools that focus on a point or on the selection."""
 
 from __future__ import annotations
 
+import dataclasses
 from typing import TYPE_CHECKING
 
 from PySide6.QtCore import Qt
@@ -12,11 +13,11 @@ from PySide6.QtWidgets import QCheckBox, QComboBox, QHBoxLayout, QPushButton, QT
 from lenslab.gui.camera_panel.section import CameraSection
 from lenslab.gui.commands import push_values
 from lenslab.gui.widgets import DragSlider, NumberEdit, hint, log_to_slider, slider_to_log
-from lenslab.optics import LensPreset, format_distance, format_focal_length
+from lenslab.optics import LensPreset, format_distance
 from lenslab.scene.camera import ThinLensCamera
 from lenslab.scene.editable import CAMERA
 from lenslab.scene.editing import closest_focus
-from lenslab.scene.fields import declared_range
+from lenslab.scene.fields import control_range
 
 if TYPE_CHECKING:
     from lenslab.gui.camera_panel import CameraPanel
@@ -36,7 +37,7 @@ class FocusSection(CameraSection):
         self.focus_slider = DragSlider(Qt.Horizontal)
         self.focus_slider.setRange(0, 1000)
         self.focus_slider.valueChanged.connect(self._focus_slid)
-        self.focus = NumberEdit(*declared_range(ThinLensCamera, "focus_distance_m"), decimals=3, step=0.01, suffix=" m")
+        self.focus = NumberEdit(*control_range(ThinLensCamera, "focus_distance_m"), decimals=3, step=0.01, suffix=" m")
         self.focus.setObjectName("focusDistance")
         self.focus.setFixedWidth(86)
         self.focus.edited.connect(lambda v, merge: self.set_focus(v, merge))
@@ -82,15 +83,10 @@ class FocusSection(CameraSection):
     def set_focus(self, metres: float, merge: bool = False, text: str | None = None) -> bool:
         """Focus at ``metres`` (in the camera's reference), or refuse and say why when the lens cannot. The undo
         step reads ``text``, by default "Focus" and the distance."""
-        closest, _ = self.focus_limits()
-        if metres < closest * (1 - 1e-9):
-            lens = self.doc.lens
-            why = (f"the {lens.name} focuses no nearer than {format_distance(lens.min_focus_distance_m)} from the "
-                   "sensor" if lens is not None and lens.min_focus_distance_m is not None
-                   and closest > self.doc.scene.camera.closest_focus_m else
-                   f"a {format_focal_length(self.doc.scene.camera.focal_length_mm)} lens focuses no nearer than "
-                   f"{format_distance(closest)}")
-            self.panel.status_message.emit(f"Cannot focus at {format_distance(metres)}: {why}")
+        camera = dataclasses.replace(self.doc.scene.camera, focus_distance_m=float(metres))
+        problem = camera.focus_problem(self.doc.lens)  # the camera's own check, as the command line makes it
+        if problem is not None:
+            self.panel.status_message.emit(f"Cannot focus there: {problem.worded('focus')}")
             self.panel.refresh()
             return False
         self.doc.set_camera(text or f"Focus {format_distance(metres)}", merge, focus_distance_m=float(metres))

@@ -13,7 +13,7 @@ from lenslab.gui.widgets import NumberEdit, hint
 from lenslab.optics.dof import COC_DIAGONAL_DIVISOR
 from lenslab.optics.sensors import crop_factor
 from lenslab.scene.camera import ThinLensCamera
-from lenslab.scene.fields import declared_choices, declared_range
+from lenslab.scene.fields import control_range, declared_choices
 
 if TYPE_CHECKING:
     from lenslab.gui.camera_panel import CameraPanel
@@ -54,8 +54,8 @@ class SensorSection(CameraSection):
         self.sensor_combo.currentIndexChanged.connect(self._sensor_chosen)
         self.add(self.sensor_combo)
         row = QHBoxLayout()
-        self.sensor_w = NumberEdit(*declared_range(ThinLensCamera, "sensor_mm"), decimals=2, step=0.1, suffix=" mm")
-        self.sensor_h = NumberEdit(*declared_range(ThinLensCamera, "sensor_mm"), decimals=2, step=0.1, suffix=" mm")
+        self.sensor_w = NumberEdit(*control_range(ThinLensCamera, "sensor_mm"), decimals=2, step=0.1, suffix=" mm")
+        self.sensor_h = NumberEdit(*control_range(ThinLensCamera, "sensor_mm"), decimals=2, step=0.1, suffix=" mm")
         self.sensor_w.edited.connect(lambda v, merge: self._sensor_edited(merge))
         self.sensor_h.edited.connect(lambda v, merge: self._sensor_edited(merge))
         row.addWidget(QLabel("W"))
@@ -72,7 +72,7 @@ class SensorSection(CameraSection):
         self.sensor_fit.currentIndexChanged.connect(
             lambda i: self._updating or self.doc.set_camera("Sensor fit", False,
                                                             sensor_fit=self.sensor_fit.itemData(i)))
-        low, high = declared_range(ThinLensCamera, "circle_of_confusion_mm")
+        low, high = control_range(ThinLensCamera, "circle_of_confusion_mm")
         self.coc = AutoNumberEdit(0.0, high, decimals=4, step=0.001, suffix=" mm")
         self.coc.setObjectName("circleOfConfusion")
         self.coc.setToolTip("Circle of confusion, the blur the depth-of-field readout calls sharp: auto is the "

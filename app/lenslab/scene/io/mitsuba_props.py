@@ -110,6 +110,8 @@ def ior_value(p: "Props", name: str, default: float) -> float:
     text = node.attrs.get("value", "")
     try:
         ior = mv.parse_number(text)
+    except mv.NumberTooLarge as exc:
+        raise node.error(str(exc)) from None
     except ValueError:
         raise node.error(f'could not parse "{text}" as a finite floating point value') from None
     if ior <= 0:
@@ -117,12 +119,22 @@ def ior_value(p: "Props", name: str, default: float) -> float:
     return ior
 
 
-def relative_ior(p: "Props", notes: list[str], lo: float) -> float:
-    """A dielectric's int_ior / ext_ior (Mitsuba's defaults: bk7 in air), clamped to [lo, 4] with a note."""
+#: Within this of 1 a boundary is index-matched: it bends nothing, and a rough one's half vector is undefined.
+INDEX_MATCHED = 1e-4
+
+
+def relative_ior(p: "Props", notes: list[str], bounds: tuple[float, float]) -> float:
+    """A dielectric's int_ior / ext_ior (Mitsuba's defaults: bk7 in air) as it is, less than 1 included; outside
+    ``bounds`` (the material's range), or index-matched, the nearest index LensLab draws, with a note."""
+    lo, hi = bounds
     ior = ior_value(p, "int_ior", 1.5046) / ior_value(p, "ext_ior", 1.000277)
-    if not lo <= ior <= 4.0:
-        clamped = min(max(ior, lo), 4.0)
-        notes.append(f"relative index of refraction {ior:.4g} is outside LensLab's {lo:g}-4: {clamped:g} used")
+    if abs(ior - 1.0) < INDEX_MATCHED:
+        notes.append(f"relative index of refraction {ior:.6g} is index-matched (no boundary to draw): "
+                     f"{1.0 + INDEX_MATCHED:g} used")
+        return 1.0 + INDEX_MATCHED
+    if not lo <= ior <= hi:
+        clamped = min(max(ior, lo), hi)
+        notes.append(f"relative index of refraction {ior:.4g} is outside LensLab's {lo:g}-{hi:g}: {clamped:g} used")
         ior = clamped
     return ior
 

@@ -41,10 +41,12 @@ from xml.parsers import expat
 
 import numpy as np
 
-from lenslab.optics.stops import MAX_F_NUMBER, MIN_F_NUMBER
+from lenslab.image_files import not_a_file, not_found, read_file_bytes
+from lenslab.optics.stops import F_NUMBER_RANGE, MAX_F_NUMBER
 from lenslab.optics.thinlens import (FOCAL_LENGTH_RANGE_MM, FOCUS_DISTANCE_RANGE_M, f_number_for_lens_radius,
-                                     focal_length_for_fov)
+                                     field_of_view_x, focal_length_for_fov)
 from lenslab.scene.camera import ThinLensCamera
+from lenslab.scene.fields import declared_range
 from lenslab.scene.materials import Diffuse, Emissive, Material
 from lenslab.scene.lights import Light, PointLight, SpotLight, SunLight
 from lenslab.scene.scene import ConstantEnvironment, EnvironmentMap, Node, RenderSettings, Scene, SceneError
@@ -265,7 +267,7 @@ class _Expander:
             raise node.error("needs a filename")
         path = Path(filename) if Path(filename).is_absolute() else node.folder / filename
         if not os.path.isfile(path):
-            raise node.error(f"included file not found: {path}")
+            raise node.error(not_found("included file", path))
         if depth + 1 >= MAX_INCLUDE_DEPTH:
             raise node.error(f"includes nested deeper than {MAX_INCLUDE_DEPTH} (an include cycle?)")
         self.includes += 1
@@ -279,7 +281,7 @@ class _Expander:
 
     def parse_file(self, path: Path) -> XNode:
         try:
-            data = path.read_bytes()
+            data = read_file_bytes(path)  # a named pipe or a device is refused, not waited on
         except OSError as exc:
             raise SceneError(f"{path}: cannot read ({exc.strerror})") from None
         self.files.append(path)
@@ -361,6 +363,8 @@ class Props:
         text = self._attr(node)
         try:
             return mv.parse_number(text)
+        except mv.NumberTooLarge as exc:
+            raise node.error(str(exc)) from None
         except ValueError:
             raise node.error(f'could not parse "{text}" as a finite floating point value') from None
 
@@ -432,6 +436,8 @@ def _xyz(node: XNode, default: float) -> np.ndarray:
         return np.array([mv.parse_number(node.attrs.get(k, str(default))) for k in "xyz"])
     except SceneError:
         raise
+    except mv.NumberTooLarge as exc:  # it reads, but as nothing a scene can hold: said as it is
+        raise node.error(str(exc)) from None
     except ValueError:
         raise node.error("could not parse a number") from None
 
@@ -476,11 +482,26 @@ def _transform_matrix(node: XNode, importer: "MitsubaImporter") -> np.ndarray:
 def _three(node: XNode, key: str) -> np.ndarray:
     try:
         values = mv.split_numbers(node.attrs[key])
+    except mv.NumberTooLarge as exc:
+        raise node.error(f'"{key}": {exc}') from None
     except ValueError:
         raise node.error(f'could not parse "{key}"') from None
     if len(values) != 3:
         raise node.error(f'"{key}" needs 3 values, got {len(values)}')
     return np.array(values)
+
+
+def _check_camera_frame(to_world: np.ndarray, node: XNode) -> None:
+    """Refuse a sensor's to_world that gives the camera no frame: a view direction (+Z) or an up (+Y) mapped
+    to nothing or onto each other, as an all-zero matrix does. Mitsuba cannot invert such a matrix either; read
+    on, the camera would look along NaN and every pixel would be lost without a word."""
+    linear = to_world[:3, :3]
+    forward, up = linear @ (0.0, 0.0, 1.0), linear @ (0.0, 1.0, 0.0)
+    lengths = np.linalg.norm(forward), np.linalg.norm(up)
+    if not (lengths[0] > 0 and lengths[1] > 0) or np.linalg.norm(np.cross(forward / lengths[0],
+                                                                         up / lengths[1])) < 1e-9:
+        raise node.error("to_world gives the camera no direction to look in or no up (its matrix maps +Z or +Y to "
+                         "zero, or both onto one line): a sensor needs an invertible placement")
 
 
 def _copy_tree(node: Node) -> Node:
@@ -850,7 +871,7 @@ class MitsubaImporter:
             raise node.error('needs a "filename"')
         path = self.resolve_file(node, filename)
         if not os.path.isfile(path):
-            raise node.error(f"environment map not found: {path}")
+            raise node.error(not_found("environment map", path))
         rotation = self._nearest_rotation(node, to_world[:3, :3], "the map")
         half_turn = np.diag([-1.0, 1.0, -1.0])  # Ry(180), exactly
         zenith, rotation_deg = environment_orientation(rotation @ half_turn)
@@ -935,8 +956,10 @@ class MitsubaImporter:
         if kind == "sphere":
             center = p.vector("center", (0, 0, 0))
             radius = p.float("radius", 1.0)
+            if not radius > 0:  # Mitsuba's sphere is scaled by it: a negative one is no sphere it means
+                raise node.error(f"a sphere's radius must be positive, not {radius:g}")
             local = mv.translate_matrix(center)
-            shape = Sphere(radius=abs(radius))
+            shape = Sphere(radius=radius)
         elif kind == "rectangle":
             shape = Rectangle(size=(2.0, 2.0))
             if flip:  # the same square seen from behind: turn it half a turn about its x axis
@@ -951,8 +974,11 @@ class MitsubaImporter:
                 flip = False
         elif kind == "cylinder":  # a tube of the cylinder's area; the node's matrix carries Mitsuba's placement
             p0, p1 = p.vector("p0", (0, 0, 0)), p.vector("p1", (0, 0, 1))
+            radius = p.float("radius", 1.0)
+            if not radius > 0:
+                raise node.error(f"a cylinder's radius must be positive, not {radius:g}")
             with _named_errors(node):
-                whole = mt.cylinder_matrix(p0, p1, p.float("radius", 1.0), to_world)
+                whole = mt.cylinder_matrix(p0, p1, radius, to_world)
             shape, to_world = mt.cylinder_shape(whole, flip)
             flip = False  # the tube's normals turn themselves
         elif kind in ("obj", "ply", "stl", "serialized"):
@@ -961,7 +987,7 @@ class MitsubaImporter:
                 raise node.error('needs a "filename"')
             path = self.resolve_file(node, filename)
             if not os.path.isfile(path):
-                raise node.error(f"mesh file not found: {path}")
+                raise node.error(not_found("mesh file", path))
             smooth = not p.bool("face_normals", False)
             shape_index = p.int("shape_index", 0) if kind == "serialized" else 0  # which of the file's meshes
             if not 0 <= shape_index < 2**31:
@@ -1118,6 +1144,7 @@ class MitsubaImporter:
             self._unsupported_sensor = True
             return
         to_world = p.transform("to_world")
+        _check_camera_frame(to_world, node)
         width, height = self.resolution
         aspect = width / height
         try:
@@ -1132,6 +1159,8 @@ class MitsubaImporter:
             radius = p.float("aperture_radius")
             if radius is None:
                 raise node.error('needs an "aperture_radius" (Mitsuba has no default either)')
+            if radius < 0:  # no lens has one: f/N with N < 0
+                raise node.error(f"aperture_radius {radius:g} is negative: a lens's radius is 0 (a pinhole) or more")
         for key in ("principal_point_offset_x", "principal_point_offset_y"):
             if p.float(key, 0.0) != 0.0:
                 self.warn(node, f"{key} (an off-centre image) is not supported: centred")
@@ -1165,9 +1194,14 @@ class MitsubaImporter:
         if rfilter.type == "gaussian":
             stddev = rp.float("stddev", 0.5)
             rp.finish(silent={"radius"})
-            if not 0.05 <= stddev <= 4.0:
-                self.warn(rfilter, f"stddev {stddev:g} is outside LensLab's 0.05-4 pixels: clamped")
-                stddev = min(max(stddev, 0.05), 4.0)
+            low, high = declared_range(RenderSettings, "filter_stddev")  # what the film can draw, as written
+            if stddev <= 0:
+                raise rfilter.error(f"stddev {stddev:g} must be positive (a gaussian's width)")
+            if not low <= stddev <= high:
+                nearest = min(max(stddev, low), high)
+                self.warn(rfilter, f"stddev {stddev:g} pixels is beyond what LensLab's film draws ({low:g}-{high:g}): "
+                          f"{nearest:g} used")
+                stddev = nearest
             self._gaussian_filter(float(stddev))
             return
         rp.finish(silent=set(rp.values))
@@ -1213,23 +1247,33 @@ class MitsubaImporter:
         up = up - np.dot(up, forward) * forward
         up = up / np.linalg.norm(up)
 
+        # Every value is kept as written where LensLab can render it: the camera's ranges are what a value may be
+        # (thinlens.FOCAL_LENGTH_RANGE_MM, stops.F_NUMBER_RANGE: float32's limits), not what the studio's controls
+        # offer (f/0.5 to f/128, 1 to 2000 mm). Mitsuba's own sensor_thinlens is f/0.13.
         fov_x = math.radians(cam.fov_x_deg)
         focal_mm = focal_length_for_fov(fov_x, SENSOR_WIDTH_MM)
         low, high = FOCAL_LENGTH_RANGE_MM
         if not low <= focal_mm <= high:
-            self.warn(where, f"a field of view of {cam.fov_x_deg:.4g} degrees needs a {focal_mm:.4g} mm lens, "
-                      f"outside LensLab's {low:g}-{high:g} mm: clamped")
-            focal_mm = min(max(focal_mm, low), high)
+            nearest = min(max(focal_mm, low), high)
+            self.warn(where, f"a field of view of {cam.fov_x_deg:.8g} degrees needs a {focal_mm:.4g} mm lens, beyond "
+                      f"what float32 carries on the GPU ({low:g}-{high:g} mm): {nearest:g} mm "
+                      f"({math.degrees(field_of_view_x(nearest, SENSOR_WIDTH_MM)):.8g} degrees) used")
+            focal_mm = nearest
         focus = cam.focus_distance
-        pinhole = cam.aperture_radius is None
-        f_number = MAX_F_NUMBER  # a pinhole ignores it; the nearest a lens gets to one, should it be turned off
+        pinhole = cam.aperture_radius is None or cam.aperture_radius == 0.0  # a lens of radius 0 is a pinhole
+        f_number = MAX_F_NUMBER  # a pinhole ignores it; the narrowest the controls offer, should it be turned off
         if not pinhole:
             r = cam.aperture_radius
-            f_number = f_number_for_lens_radius(focal_mm, r) if r > 0 else math.inf
-            if not MIN_F_NUMBER <= f_number <= MAX_F_NUMBER:
-                self.warn(where, f"aperture_radius {r:g} gives f/{f_number:.4g}, outside LensLab's "
-                          f"f/{MIN_F_NUMBER:g}-f/{MAX_F_NUMBER:g}: clamped")
-                f_number = min(max(f_number, MIN_F_NUMBER), MAX_F_NUMBER)
+            f_number = f_number_for_lens_radius(focal_mm, r)
+            low, high = F_NUMBER_RANGE
+            if f_number > high:  # a lens float32 cannot tell from a pinhole: render it as one, exactly
+                self.warn(where, f"aperture_radius {r:g} gives f/{f_number:.4g}, narrower than float32 resolves "
+                          f"beside the focal length (f/{high:g}): rendered as a pinhole")
+                pinhole, f_number = True, MAX_F_NUMBER
+            elif f_number < low:
+                self.warn(where, f"aperture_radius {r:g} gives f/{f_number:.4g}, wider than float32 carries "
+                          f"(f/{low:g}): f/{low:g} used")
+                f_number = low
         low, high = FOCUS_DISTANCE_RANGE_M
         if not low <= focus <= high and not pinhole:
             self.warn(where, f"focus_distance {focus:g} is outside {low:g}-{high:g}: clamped")
@@ -1378,7 +1422,7 @@ def load_mitsuba_scene(path: str | os.PathLike, defines: dict[str, str] | None =
     """
     path = Path(path)
     if not os.path.isfile(path):
-        raise SceneError(f"{path}: no such scene file")
+        raise SceneError(f"{path}: {not_a_file(path) or 'no such scene file'}")
     folder = path.resolve().parent
     return _load(lambda ex: ex.parse_file(path), str(path), folder, path.resolve(), defines, warn)
 

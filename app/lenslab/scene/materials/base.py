@@ -14,6 +14,9 @@ from dataclasses import dataclass
 from typing import Any, ClassVar, Protocol
 
 RGB = tuple[float, float, float]
+#: The relative indices of refraction a dielectric may have, inside over outside: below 1 a bubble (air in water,
+#: 0.75), above 1 glass or diamond (2.42); the kernel's Fresnel and Snell terms take either (glsl/microfacet.glsl).
+RELATIVE_IOR_RANGE = (0.25, 4.0)
 
 # vec4 rows per material record, and how deep materials may hold one another (glsl/bsdf.glsl's resolve loop
 # runs at most this many steps).

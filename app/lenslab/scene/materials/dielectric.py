@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, ClassVar
 import numpy as np
 
 from lenslab.scene.io import mitsuba_props as mp
-from lenslab.scene.materials.base import DISTRIBUTION_FIELD, RGB, Material, PackContext
+from lenslab.scene.materials.base import RELATIVE_IOR_RANGE, DISTRIBUTION_FIELD, RGB, Material, PackContext
 from lenslab.scene.materials.spec import MaterialKind
 
 if TYPE_CHECKING:
@@ -25,7 +25,8 @@ class Dielectric(Material):
     """
 
     type_name: ClassVar[str] = "dielectric"
-    ior: float = field(default=1.5, metadata={"range": (1.0001, 4.0), "doc": "index of refraction inside"})
+    ior: float = field(default=1.5, metadata={"range": RELATIVE_IOR_RANGE, "doc": (
+        "index of refraction inside over outside; below 1 for a bubble (air in water: 0.75)")})
     roughness: float = field(default=0.0, metadata={"range": (0.0, 1.0)})
     distribution: str = field(default="ggx", metadata=DISTRIBUTION_FIELD)
     tint: RGB = field(default=(1.0, 1.0, 1.0), metadata={"range": (0.0, 1.0), "doc": "scales reflection and transmission"})
@@ -50,7 +51,7 @@ def from_mitsuba(p: "Props", imp: "MitsubaImporter") -> mp.Mapped:
     kind = p.node.type
     roughness, distribution = mp.roughness(p, notes) if kind == "roughdielectric" else (0.0, "ggx")
     transmit = mp.transmittance_tint(p, notes)
-    ior = mp.relative_ior(p, notes, 1.0001)
+    ior = mp.relative_ior(p, notes, RELATIVE_IOR_RANGE)
     return mp.Mapped(Dielectric(ior=ior, roughness=roughness, distribution=distribution, tint=transmit),
                      mp.joined_notes(notes))
 

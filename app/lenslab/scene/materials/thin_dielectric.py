@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, ClassVar
 import numpy as np
 
 from lenslab.scene.io import mitsuba_props as mp
-from lenslab.scene.materials.base import RGB, Material, PackContext
+from lenslab.scene.materials.base import RELATIVE_IOR_RANGE, RGB, Material, PackContext
 from lenslab.scene.materials.spec import MaterialKind
 
 if TYPE_CHECKING:
@@ -20,7 +20,7 @@ class ThinDielectric(Material):
     """A pane of glass too thin to model: reflects, and lets light through without bending it."""
 
     type_name: ClassVar[str] = "thin_dielectric"
-    ior: float = field(default=1.5, metadata={"range": (1.0001, 4.0)})
+    ior: float = field(default=1.5, metadata={"range": RELATIVE_IOR_RANGE})
     tint: RGB = field(default=(1.0, 1.0, 1.0), metadata={"range": (0.0, 1.0)})
 
 
@@ -34,7 +34,7 @@ def from_mitsuba(p: "Props", imp: "MitsubaImporter") -> mp.Mapped:
     """Mitsuba's thindielectric."""
     notes: list[str] = []
     transmit = mp.transmittance_tint(p, notes)
-    return mp.Mapped(ThinDielectric(ior=mp.relative_ior(p, notes, 1.0001), tint=transmit), mp.joined_notes(notes))
+    return mp.Mapped(ThinDielectric(ior=mp.relative_ior(p, notes, RELATIVE_IOR_RANGE), tint=transmit), mp.joined_notes(notes))
 
 
 # Only a Dirac lobe: evaluation is never asked of it (glsl/bsdf.glsl's bsdf_is_delta), so it has no _eval.
