@@ -34,6 +34,15 @@ def renderer():
     r.release()
 
 
+@pytest.hookimpl(tryfirst=True)  # before -m deselects: the marks must be on the items by then
+def pytest_collection_modifyitems(config, items):
+    """Every comparison with Mitsuba 3 is in the slow tier (the full validation, docs/testing.md), whichever file
+    it is in: a test that asks for the ``mitsuba`` fixture is marked slow here."""
+    for item in items:
+        if "mitsuba" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.slow)
+
+
 @pytest.fixture(scope="session")
 def mitsuba():
     """Mitsuba 3's Python module with its comparison variant set, or a skip saying why it cannot render here."""

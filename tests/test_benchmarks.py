@@ -10,6 +10,9 @@ import pytest
 
 BENCHMARKS = Path(__file__).resolve().parents[1] / "benchmarks"
 
+# Each runs a whole script in a process of its own, the slow tier's kind of test (docs/testing.md).
+pytestmark = pytest.mark.slow
+
 
 def run(script, *args, tmp_path):
     result = subprocess.run([sys.executable, str(BENCHMARKS / script), *map(str, args)], capture_output=True,

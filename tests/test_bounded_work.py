@@ -42,6 +42,7 @@ def coplanar_disks(copies: int, segments: int) -> np.ndarray:
 # The kd-tree: a reference budget
 
 
+@pytest.mark.slow
 def test_a_641_byte_scene_of_coplanar_disks_builds_within_its_reference_budget(tmp_path):
     path = tmp_path / "disks.json"
     path.write_text(COPLANAR_DISKS)
@@ -109,6 +110,7 @@ def test_memory_too_small_for_any_tree_is_one_clear_error():
         build_kdtree(triangle_bounds(tris), triangles=tris, max_refs=999)
 
 
+@pytest.mark.slow
 def test_the_cli_renders_the_disks_and_says_the_tree_met_its_limit(renderer, tmp_path, capsys):
     scene = tmp_path / "disks.json"
     scene.write_text(COPLANAR_DISKS)

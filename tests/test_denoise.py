@@ -134,6 +134,7 @@ def rel_mse(image, reference):
     return float(np.mean((image - reference) ** 2 / (reference ** 2 + 1e-2)))
 
 
+@pytest.mark.slow
 @pytest.mark.gl
 def test_the_denoised_image_is_closer_to_the_converged_one(renderer):
     from lenslab.render.denoise import denoise

@@ -31,6 +31,7 @@ def million_triangle_scene(tmp_path_factory):
     )
 
 
+@pytest.mark.slow
 def test_million_triangles_render_like_the_sphere_they_approximate(renderer, million_triangle_scene):
     session = RenderSession(renderer, million_triangle_scene)
     flat = session.flat_scene

@@ -34,6 +34,7 @@ def test_wheel_ships_shaders_scenes_and_presets(wheel):
     assert "lenslab = lenslab.cli:main" in zipfile.ZipFile(wheel).read(entry_points).decode()
 
 
+@pytest.mark.slow
 def test_wheel_in_a_fresh_virtualenv_renders_from_any_directory(renderer, wheel, tmp_path):
     venv = tmp_path / "fresh"
     subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(venv)], check=True, timeout=120)
@@ -88,6 +89,7 @@ def _declared_closure() -> set[str]:
     return closure
 
 
+@pytest.mark.slow
 def test_a_plain_install_declares_every_package_a_render_imports(tmp_path):
     """What trimesh imports for smooth normals (scipy) is nowhere in its own requirements: without it in ours,
     a plain install printed 'unable to use sparse matrix' and a ModuleNotFoundError on product_shot."""

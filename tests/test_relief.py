@@ -76,6 +76,7 @@ def test_nonsense_relief_parameters_name_the_key(tmp_path, key, value, message):
         load_scene(tmp_path / "scene.json")
 
 
+@pytest.mark.slow
 def test_the_shipped_sand_holds_a_million_triangles_and_is_made_once_per_edit_session():
     scene = load_scene(scenes_dir() / "marbles_on_sand" / "scene.json")
     flatten._relief_mesh.cache_clear()
@@ -87,6 +88,7 @@ def test_the_shipped_sand_holds_a_million_triangles_and_is_made_once_per_edit_se
     assert np.array_equal(again.triangles, flat.triangles)
 
 
+@pytest.mark.slow
 @pytest.mark.gl
 def test_the_million_triangle_scene_renders_headless(renderer, tmp_path, capsys):
     out = tmp_path / "sand.exr"

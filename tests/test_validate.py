@@ -116,6 +116,7 @@ def test_usage_errors(capsys):
 # The `mitsuba` fixture (tests/conftest.py) gives Mitsuba's module, or skips saying why it cannot render here.
 
 
+@pytest.mark.slow
 @pytest.mark.gl
 def test_validate_command_prints_the_table_and_writes_docs(mitsuba, tmp_path, capsys):
     from lenslab.validate.cli import main
