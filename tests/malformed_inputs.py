@@ -3,10 +3,15 @@
 Every case starts from a scene that ships with LensLab (native JSON, or one of the Mitsuba XML validation
 scenes) and breaks one thing the way real files break: a key deleted, a value of the wrong type, a number out
 of range or not finite, a string a terminal would obey, a nest too deep, a truncation, flipped bytes, a mesh
-whose faces point past its vertices, a texture cut short, an entity trick in the XML. The contract
-(:func:`check`): the command ends with exit 0 and a whole, finite image, or with a non-zero exit and exactly
-one line ``lenslab: error: ...`` that names a file the case wrote and holds no control characters; never a
-traceback, never a hang.
+whose faces point past its vertices, a texture cut short, an entity trick in the XML; a batch file's value of
+the wrong kind (a TOML date), a Mitsuba ``.serialized`` mesh cut short, a glTF field of the wrong type, a named
+pipe (FIFO) where a file is read or written. The contract (:func:`judge`): the command ends with exit 0 and a
+whole, finite image, or with a non-zero exit and exactly one line ``lenslab: error: ...`` that names a file the
+case wrote and holds no control characters; never a traceback, never a hang.
+
+A hang is found from the work a case does, not from the clock (the watcher, ``_WATCHER``): a case that spends more than
+``CASE_CPU_SECONDS`` of CPU (a loop without end) or none at all for ``STALLED_CHECKS`` checks in a row (a read that
+waits for ever) is stopped. A machine busy with other work slows a case, but never makes it do more work.
 
 ``tests/test_malformed_inputs.py`` runs a few hundred cases in-process; for a larger run, in a subprocess per
 case as a user meets them::
@@ -26,10 +31,13 @@ import random
 import re
 import shutil
 import signal
+import stat
+import struct
 import subprocess
 import sys
 import time
 import xml.etree.ElementTree as ET
+import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -37,7 +45,15 @@ REPO = Path(__file__).resolve().parent.parent
 NATIVE_SCENES = ("cornell_box", "dof_chart", "product_shot", "cornell_caustic")  # marbles: a million triangles
 MITSUBA_SCENES = (REPO / "app/lenslab/validate/scenes", REPO / "tests/data/mitsuba")
 RENDER_ARGS = ["--spp", "1", "--width", "8", "--height", "8"]
-CASE_SECONDS = 30
+#: The work one case may do, in CPU seconds of its process (all threads): a case renders 8 x 8 pixels at one
+#: sample in well under one; a reader that loops without end reaches this and is stopped.
+CASE_CPU_SECONDS = 300
+#: A case whose process does no work at all (no CPU) at this many checks in a row is blocked: a read that waits
+#: for ever, as on a named pipe. A check every CHECK_SECONDS; a case at work spends CPU between any two.
+STALLED_CHECKS = 60
+CHECK_SECONDS = 1.0
+#: --subprocess only, a backstop for what the checks cannot see: generous, and not what finds a hang.
+BACKSTOP_SECONDS = 1800
 MAX_ERROR_LINE = 1000
 _CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f\x9b]")
 
@@ -48,8 +64,10 @@ class Case:
 
     what: str
     files: dict[str, bytes]
-    scene: str
+    scene: str  # the scene file opened, or the batch file
     extra_args: list[str] = field(default_factory=list)
+    fifos: list[str] = field(default_factory=list)  # named pipes made in the folder ("out.png": the output)
+    command: str = "render"  # or "batch": `lenslab batch FILE --dry-run`
 
 
 @dataclass
@@ -418,15 +436,234 @@ def cli_case(rng: random.Random) -> Case:
     return Case(f"cornell_box: {option} {value[:20]!r}", files, "scene.json", [option, value])
 
 
+# ---------------------------------------------------------------------------------------------------------
+# Batch files: one shot, one value of the wrong kind (TOML's dates and times too) or an output pattern that
+# makes no file name; read with --dry-run (the checks all happen before anything renders)
+# ---------------------------------------------------------------------------------------------------------
+_TOML_VALUES = ["1979-05-27", "07:32:00", "1979-05-27T07:32:00Z", "1979-05-27 07:32:00.5", "[1979-05-27, 2]",
+                "{from = 1979-05-27, to = 2, steps = 2}", "{from = 1, to = 07:32:00, steps = 2}",
+                "{from = 1, to = 2, steps = 1979-05-27}", "nan", "inf", "-inf", "1e400", _HUGE_INT_TEXT, '"abc"',
+                "true", "[]", "{}", '"f/0"', '"1/0"', "0", "-1", "[nan, 1]", '"\\u001b[2J"', '"\\u202e"',
+                "{x = 1979-05-27}", "[[1, 2]]", "0x10", "1_000"]
+_BATCH_KEYS = ["spp", "f_number", "width", "shutter", "name", "scene", "split", "defines", "iso", "focus_distance",
+               "exposure", "seed", "lens", "tone_map", "time_limit", "aperture_image", "focal_length", "nonsense"]
+_OUTPUT_PATTERNS = ["{index:c}.png", "x{index:c}.png", "{name}/{index}.png", "{index:>300}.png", "{index[0]}.png",
+                    "\\u202e{index}.png", "{spp:c}.png", "{scene}/../{index}.png", "{index:c}{index:c}.exr",
+                    "{f_number:c}.png", "{index:d}/{index:c}.png", "{lens}.png", "{missing}.png", "{}.png"]
+
+
+def batch_case(rng: random.Random) -> Case:
+    lines = ['[[shots]]', 'scene = "cornell_box"', 'output = "out/{index}.png"']
+    if rng.random() < 0.35:
+        pattern = rng.choice(_OUTPUT_PATTERNS)
+        lines[2] = f'output = "{pattern}"'
+        lines += ['spp = [1, 2, 47, 3]', f'name = "{rng.choice(["..", ".", "a/b", "ok"])}"',
+                  f'lens = "{rng.choice(["..", "85 mm f/1.4", "/"])}"']
+        what = f"output = {pattern!r}"
+    else:
+        key, value = rng.choice(_BATCH_KEYS), rng.choice(_TOML_VALUES)
+        lines.append(f"{key} = {value}")
+        what = f"{key} = {value[:30]}"
+    if rng.random() < 0.2:  # the same value in [defaults]
+        lines = ["[defaults]", lines[-1], *lines[:-1]]
+        what += " in [defaults]"
+    return Case(f"batch: {what}", {"shots.toml": ("\n".join(lines) + "\n").encode()}, "shots.toml", command="batch")
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Mitsuba .serialized meshes: two to a file, cut short, their zlib streams ended early, bytes flipped
+# ---------------------------------------------------------------------------------------------------------
+def _serialized_mesh(vertices, faces, body_cut: int | None = None, claim: tuple[int, int] | None = None) -> bytes:
+    """One mesh as Mitsuba writes it (version 4, float32, no normals): its header, then a zlib stream. ``body_cut``
+    ends the (complete, well-formed) stream early; ``claim`` puts other counts in it."""
+    counts = claim or (len(vertices), len(faces))
+    body = struct.pack("<I", 0x1000) + b"mesh\0" + struct.pack("<QQ", *counts)
+    body += b"".join(bytes(struct.pack("<fff", *v)) for v in vertices)
+    body += b"".join(bytes(struct.pack("<III", *f)) for f in faces)
+    return struct.pack("<HH", 0x041C, 4) + zlib.compress(body[:body_cut] if body_cut is not None else body)
+
+
+_TETRA = ([(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1)], [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)])
+_SQUARE = ([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], [(0, 1, 2), (0, 2, 3)])
+
+
+def _serialized_file(first: bytes, second: bytes) -> bytes:
+    return first + second + struct.pack("<QQI", 0, len(first), 2)
+
+
+_SERIALIZED_SCENE = ('<scene version="3.0.0"><sensor type="perspective"><float name="fov" value="40"/>'
+                     '<transform name="to_world"><lookat origin="0 0 5" target="0 0 0" up="0 1 0"/></transform>'
+                     '</sensor><emitter type="constant"/>'
+                     '<shape type="serialized"><string name="filename" value="m.serialized"/>'
+                     '<integer name="shape_index" value="0"/></shape>'
+                     '<shape type="serialized"><string name="filename" value="m.serialized"/>'
+                     '<integer name="shape_index" value="1"/></shape></scene>\n')
+
+
+def serialized_case(rng: random.Random) -> Case:
+    kind = rng.randrange(5)
+    whole = _serialized_file(_serialized_mesh(*_TETRA), _serialized_mesh(*_SQUARE))
+    if kind == 0:  # a complete zlib stream that holds less than its counts: the next mesh's bytes follow it
+        cut = rng.randrange(4, 120)
+        data, what = _serialized_file(_serialized_mesh(*_TETRA, body_cut=cut), _serialized_mesh(*_SQUARE)), \
+            f"mesh 0's stream ended after {cut} bytes"
+    elif kind == 1:
+        data = whole[:rng.randrange(len(whole))]
+        what = f"the file cut at byte {len(data)}"
+    elif kind == 2:
+        claim = (rng.choice([4, 5, 1000, 2**31]), rng.choice([4, 5, 1000, 2**40]))
+        data, what = _serialized_file(_serialized_mesh(*_TETRA, claim=claim), _serialized_mesh(*_SQUARE)), \
+            f"mesh 0 claims {claim[0]} vertices and {claim[1]} triangles"
+    else:
+        how, data = _corrupt_bytes(whole, rng)
+        what = f"the file {how}"
+    return Case(f"serialized: {what}", {"scene.xml": _SERIALIZED_SCENE.encode(), "m.serialized": data}, "scene.xml")
+
+
+# ---------------------------------------------------------------------------------------------------------
+# glTF: a textured quad whose material, texture, image, sampler or buffer fields hold the wrong type
+# ---------------------------------------------------------------------------------------------------------
+def _gltf_quad() -> dict:
+    import base64
+
+    positions = struct.pack("<12f", -1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0)
+    uvs = struct.pack("<8f", 0, 1, 1, 1, 1, 0, 0, 0)
+    indices = struct.pack("<6H", 0, 1, 2, 0, 2, 3)
+    blob = positions + uvs + indices
+    return {
+        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "indices": 2, "material": 0}]}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-1, -1, 0],
+                       "max": [1, 1, 0]},
+                      {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2"},
+                      {"bufferView": 2, "componentType": 5123, "count": 6, "type": "SCALAR"}],
+        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48},
+                        {"buffer": 0, "byteOffset": 48, "byteLength": 32},
+                        {"buffer": 0, "byteOffset": 80, "byteLength": 12}],
+        "buffers": [{"byteLength": len(blob),
+                     "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
+        "materials": [{"name": "Paint", "pbrMetallicRoughness": {
+            "baseColorFactor": [0.8, 0.2, 0.2, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.5,
+            "baseColorTexture": {"index": 0}}, "emissiveFactor": [0.0, 0.0, 0.0],
+            "extensions": {"KHR_materials_ior": {"ior": 1.5},
+                           "KHR_materials_emissive_strength": {"emissiveStrength": 1.0}}}],
+        "textures": [{"source": 0, "sampler": 0}], "samplers": [{"wrapS": 10497, "wrapT": 10497}],
+        "images": [{"uri": "label.png"}],
+    }
+
+
+_GLTF_PARTS = ("materials", "textures", "images", "samplers", "bufferViews", "buffers")
+
+
+def gltf_case(rng: random.Random) -> Case:
+    header = _gltf_quad()
+    if rng.random() < 0.2:
+        part = rng.choice(_GLTF_PARTS)
+        header[part] = _weird_json_value(rng)
+        what = f"{part} = {json.dumps(header[part], allow_nan=True)[:40]}"
+    else:
+        path, _ = rng.choice([p for p in _paths({k: header[k] for k in _GLTF_PARTS}) if p[0]])
+        parent = _parent(header, path)
+        parent[path[-1]] = _weird_json_value(rng)
+        what = f"{'.'.join(map(str, path))} = {json.dumps(parent[path[-1]], allow_nan=True)[:40]}"
+    files = _shipped_files("cornell_box")
+    doc = json.loads(files["scene.json"])
+    doc["nodes"].append({"name": "quad", "shape": {"type": "mesh", "file": "quad.gltf"}, "children": []})
+    files["scene.json"] = _native_text(doc)
+    files["quad.gltf"] = _native_text(header)
+    files["label.png"] = (REPO / "app/lenslab/validate/scenes/label.png").read_bytes()
+    return Case(f"glTF: {what}", files, "scene.json")
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Named pipes (FIFOs) where a file is read or written: refused at once, never waited on
+# ---------------------------------------------------------------------------------------------------------
+def fifo_case(rng: random.Random) -> Case:
+    files = _shipped_files("cornell_box")
+    doc = json.loads(files["scene.json"])
+    material = next(iter(doc["materials"]))
+    kind = rng.randrange(12)
+    if kind == 0:
+        doc["materials"][material]["albedo_texture"] = {"type": "image", "file": "pipe.png"}
+        what = "an image texture"
+    elif kind == 1:
+        doc["camera"]["aperture_image"] = "pipe.png"
+        what = "an aperture image"
+    elif kind == 2:
+        doc["environment"] = {"type": "map", "file": "pipe.png", "strength": 1.0}
+        what = "an environment map"
+    elif kind in (3, 4, 5):
+        name = ["pipe.obj", "pipe.ply", "pipe.gltf"][kind - 3]
+        doc["nodes"].append({"name": "pipe", "shape": {"type": "mesh", "file": name}, "children": []})
+        return Case(f"FIFO: a mesh file {name}", {**files, "scene.json": _native_text(doc)}, "scene.json",
+                    fifos=[name])
+    elif kind == 6:  # a glTF whose buffer, then whose image, is a named pipe
+        header = _gltf_quad()
+        if rng.random() < 0.5:
+            header["buffers"][0]["uri"] = "pipe.png"
+            what = "a glTF buffer"
+        else:
+            what = "a glTF image"
+        header["images"][0]["uri"] = "pipe.png"
+        files["quad.gltf"] = _native_text(header)
+        doc["nodes"].append({"name": "quad", "shape": {"type": "mesh", "file": "quad.gltf"}, "children": []})
+    elif kind == 7:  # an OBJ whose material library, or its map_Kd, is a named pipe
+        library = rng.choice(["pipe.mtl", "m.mtl"])
+        files["m.obj"] = (f"mtllib {library}\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl a\n"
+                          "f 1/1 2/2 3/3\n").encode()
+        files["m.mtl"] = b"newmtl a\nKd 1 1 1\nmap_Kd pipe.png\n"
+        doc["nodes"].append({"name": "obj", "shape": {"type": "mesh", "file": "m.obj"}, "children": []})
+        files["scene.json"] = _native_text(doc)
+        return Case(f"FIFO: an OBJ's {'library' if library == 'pipe.mtl' else 'map_Kd'}", files, "scene.json",
+                    fifos=["pipe.mtl", "pipe.png"])
+    elif kind == 8:
+        return Case("FIFO: the scene file", {}, "scene.json", fifos=["scene.json"])
+    elif kind == 9:
+        return Case("FIFO: the output (-o)", files, "scene.json", fifos=["out.png"])
+    elif kind == 10:
+        xml = _SERIALIZED_SCENE.replace('value="m.serialized"', 'value="pipe.serialized"', 1)
+        return Case("FIFO: a Mitsuba .serialized mesh", {"scene.xml": xml.encode(),
+                                                         "m.serialized": _serialized_file(_serialized_mesh(*_TETRA),
+                                                                                          _serialized_mesh(*_SQUARE))},
+                    "scene.xml", fifos=["pipe.serialized"])
+    else:
+        return Case("FIFO: the batch file", {}, "shots.toml", fifos=["shots.toml"], command="batch")
+    files["scene.json"] = _native_text(doc)
+    return Case(f"FIFO: {what}", files, "scene.json", fifos=["pipe.png"])
+
+
 def generate(count: int, seed: int) -> list[Case]:
     rng = random.Random(seed)
-    makers = [native_case] * 5 + [mitsuba_case] * 4 + [cli_case]
+    makers = [native_case] * 5 + [mitsuba_case] * 4 + [cli_case, batch_case, serialized_case, gltf_case, fifo_case]
     return [rng.choice(makers)(rng) for _ in range(count)]
 
 
 # ---------------------------------------------------------------------------------------------------------
 # Running a case and judging what came out
 # ---------------------------------------------------------------------------------------------------------
+@contextlib.contextmanager
+def fifo_read_as_empty(path: Path):
+    """A named pipe made at ``path`` for a test of a reader that must refuse it: should the reader open it anyway,
+    a writer (a thread, waiting for it) opens the other end and closes it at once, so that the reader's first
+    open and read end with an empty file rather than wait for ever. The test then fails on what it was told,
+    instead of hanging. Yields ``path``."""
+    import threading
+
+    os.mkfifo(path)
+
+    def answer() -> None:
+        os.close(os.open(path, os.O_WRONLY))  # returns once a reader has the pipe open
+
+    writer = threading.Thread(target=answer, name="fifo-answer", daemon=True)
+    writer.start()
+    try:
+        yield path
+    finally:
+        reader = os.open(path, os.O_RDONLY | os.O_NONBLOCK)  # lets a writer still waiting go
+        writer.join()
+        os.close(reader)
+
+
 def write_case(case: Case, folder: Path) -> Path:
     if folder.exists():
         shutil.rmtree(folder)
@@ -434,10 +671,14 @@ def write_case(case: Case, folder: Path) -> Path:
     for name, data in case.files.items():
         (folder / name).parent.mkdir(parents=True, exist_ok=True)
         (folder / name).write_bytes(data)
+    for name in case.fifos:
+        os.mkfifo(folder / name)
     return folder / case.scene
 
 
 def _arguments(case: Case, scene: Path, output: Path) -> list[str]:
+    if case.command == "batch":
+        return ["batch", str(scene), "--dry-run"]
     args = [str(scene), "--headless", "-o", str(output), *RENDER_ARGS]
     if case.extra_args:  # the case's own value of an option wins over the default one
         option = case.extra_args[0]
@@ -452,8 +693,120 @@ class _Hung(BaseException):
     pass
 
 
+_case_running = False  # SIGALRM from the watcher stops a case only while one runs
+
+
 def _raise_hung(signum, frame):
-    raise _Hung()
+    if _case_running:
+        raise _Hung()
+
+
+# The watcher: a small process beside this one, for the whole run, that judges each case by the work it does.
+# A thread cannot: a library blocked in C with the GIL held (OpenImageIO opening a named pipe) stops every
+# thread of the process. The watcher reads this process's CPU time from /proc; when a case spends more than
+# CASE_CPU_SECONDS, or none at STALLED_CHECKS checks in a row, it sends SIGALRM (a blocking call returns, and
+# _raise_hung stops the case) and opens the case's named pipes at the other end, so that a read or a write
+# waiting on one ends. Told "start<TAB>fifo<TAB>..." and "end" on its stdin; answers "end" with the verdict,
+# if any, then "ok".
+_WATCHER = r"""
+import os, select, signal, sys
+parent, check, stalled, budget = int(sys.argv[1]), float(sys.argv[2]), int(sys.argv[3]), float(sys.argv[4])
+tick = os.sysconf("SC_CLK_TCK")
+def cpu():
+    try:
+        with open(f"/proc/{parent}/stat") as stat:
+            fields = stat.read().rpartition(")")[2].split()
+        return (int(fields[11]) + int(fields[12])) / tick
+    except (OSError, ValueError, IndexError):
+        return None
+def release(paths):
+    for path in paths:
+        for flags in (os.O_WRONLY, os.O_RDONLY):
+            try:
+                os.close(os.open(path, flags | os.O_NONBLOCK))
+            except OSError:
+                pass
+active, fifos, first, last, still, verdict, pending = False, [], 0.0, None, 0, "", b""
+while True:
+    if select.select([0], [], [], check)[0]:
+        data = os.read(0, 65536)
+        if not data:
+            break
+        pending += data
+        while b"\n" in pending:
+            line, pending = pending.split(b"\n", 1)
+            words = line.decode().split("\t")
+            if words[0] == "start":
+                active, fifos, still, verdict = True, words[1:], 0, ""
+                first = last = cpu()
+            elif words[0] == "end":
+                active = False
+                os.write(1, (verdict + "\n" if verdict else "").encode() + b"ok\n")
+        continue
+    now = cpu() if active else None
+    if now is None or first is None:
+        continue
+    still = still + 1 if now == last else 0
+    last = now
+    if now - first > budget:
+        verdict = verdict or f"spent over {budget:g} s of CPU without ending (a loop without end?)"
+    elif still >= stalled:
+        verdict = verdict or f"did no work at {stalled} checks in a row (blocked on a read or a write?)"
+    if verdict:
+        os.kill(parent, signal.SIGALRM)
+        release(fifos)
+"""
+_watcher_process: subprocess.Popen | None = None
+_previous_handler = None  # SIGALRM's handler before the watcher started, put back by close_watcher
+
+
+def _watcher() -> subprocess.Popen:
+    """The watcher of this process, started on first use (with this process's SIGALRM handler)."""
+    global _watcher_process, _previous_handler
+    if _watcher_process is None or _watcher_process.poll() is not None:
+        previous = signal.signal(signal.SIGALRM, _raise_hung)  # stays until close_watcher: idle between cases
+        if _watcher_process is None:
+            _previous_handler = previous
+        _watcher_process = subprocess.Popen(
+            [sys.executable, "-c", _WATCHER, str(os.getpid()), str(CHECK_SECONDS), str(STALLED_CHECKS),
+             str(CASE_CPU_SECONDS)], stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
+    return _watcher_process
+
+
+def close_watcher() -> None:
+    """End the watcher (it also ends by itself when this process does) and put SIGALRM's handler back."""
+    global _watcher_process
+    if _watcher_process is not None:
+        _watcher_process.stdin.close()
+        _watcher_process.wait()  # it has answered every "end": no SIGALRM of its is on the way
+        _watcher_process.stdout.close()
+        _watcher_process = None
+        signal.signal(signal.SIGALRM, _previous_handler or signal.SIG_DFL)
+
+
+@contextlib.contextmanager
+def _watched(fifos: list[Path]):
+    """Run the block as one case under the watcher; yields a list that holds its verdict afterwards, if any."""
+    global _case_running
+    watcher = _watcher()
+    verdict: list[str] = []
+    watcher.stdin.write(("\t".join(["start", *map(str, fifos)]) + "\n").encode())
+    watcher.stdin.flush()
+    _case_running = True
+    try:
+        yield verdict
+    finally:
+        watcher.stdin.write(b"end\n")
+        watcher.stdin.flush()
+        while True:  # until the watcher has stopped watching: no SIGALRM comes after its "ok"
+            try:
+                line = watcher.stdout.readline().decode().strip()
+            except _Hung:  # the watcher's last word crossed the case's end
+                continue
+            if line == "ok" or not line and watcher.poll() is not None:
+                break
+            verdict.append(line)
+        _case_running = False
 
 
 @contextlib.contextmanager
@@ -482,52 +835,95 @@ def run_in_process(case: Case, folder: Path) -> Outcome:
     output = folder / "out.png"
     stderr = io.StringIO()
     start = time.perf_counter()
-    previous = signal.signal(signal.SIGALRM, _raise_hung)
-    signal.alarm(CASE_SECONDS)
+    verdict: list[str] = []
     try:
-        with contextlib.redirect_stderr(stderr), contextlib.redirect_stdout(io.StringIO()), _c_level_stderr(stderr):
+        with _watched([folder / name for name in case.fifos]) as verdict, contextlib.redirect_stderr(stderr), \
+                contextlib.redirect_stdout(io.StringIO()), _c_level_stderr(stderr):
             status = main(_arguments(case, scene, output))
     except _Hung:
-        return Outcome(case, None, stderr.getvalue(), time.perf_counter() - start, f"hung over {CASE_SECONDS} s")
+        return Outcome(case, None, stderr.getvalue(), time.perf_counter() - start,
+                       f"hung: {'; '.join(verdict) or 'stopped by the watcher'}")
     except BaseException as exc:  # noqa: BLE001 - anything escaping main is a traceback for the user
         import traceback
 
         return Outcome(case, None, stderr.getvalue() + "".join(traceback.format_exception(exc)[-6:]),
                        time.perf_counter() - start,
                        f"traceback: {type(exc).__name__}: {str(exc)[:200]}")
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, previous)
+    if verdict:  # it ended as the watcher stopped it
+        return Outcome(case, None, stderr.getvalue(), time.perf_counter() - start, f"hung: {'; '.join(verdict)}")
     return judge(Outcome(case, status, stderr.getvalue(), time.perf_counter() - start), output)
 
 
+def _cpu_seconds(pid: int) -> float | None:
+    """CPU time (user + system) of process ``pid`` so far, from /proc; None where it cannot be read."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rpartition(")")[2].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError):
+        return None
+
+
 def run_in_subprocess(case: Case, folder: Path) -> Outcome:
+    """The case as a user runs it, in a process of its own: stopped when it spends more than CASE_CPU_SECONDS of
+    CPU or none at STALLED_CHECKS checks in a row (read from /proc), or, as a backstop, after BACKSTOP_SECONDS."""
+    import tempfile
+
     scene = write_case(case, folder)
     output = folder / "out.png"
     start = time.perf_counter()
-    try:
-        done = subprocess.run([sys.executable, "-m", "lenslab", *_arguments(case, scene, output)],
-                              capture_output=True, text=True, errors="replace", timeout=CASE_SECONDS,
-                              env={**os.environ, "PYTHONPATH": str(REPO / "app")})
-    except subprocess.TimeoutExpired:
-        return Outcome(case, None, "", time.perf_counter() - start, f"hung over {CASE_SECONDS} s")
-    return judge(Outcome(case, done.returncode, done.stderr, time.perf_counter() - start), output)
+    with tempfile.TemporaryFile() as err:
+        process = subprocess.Popen([sys.executable, "-m", "lenslab", *_arguments(case, scene, output)],
+                                   stdout=subprocess.DEVNULL, stderr=err,
+                                   env={**os.environ, "PYTHONPATH": str(REPO / "app")})
+        verdict, last, still = "", None, 0
+        while True:
+            try:
+                process.wait(CHECK_SECONDS)
+                break
+            except subprocess.TimeoutExpired:
+                pass
+            cpu = _cpu_seconds(process.pid)
+            still = still + 1 if cpu is not None and cpu == last else 0
+            last = cpu
+            if cpu is not None and cpu > CASE_CPU_SECONDS:
+                verdict = f"spent over {CASE_CPU_SECONDS} s of CPU without ending (a loop without end?)"
+            elif still >= STALLED_CHECKS:
+                verdict = f"did no work at {STALLED_CHECKS} checks in a row (blocked on a read?)"
+            elif time.perf_counter() - start > BACKSTOP_SECONDS:
+                verdict = f"still running after {BACKSTOP_SECONDS} s"
+            if verdict:
+                process.kill()
+                process.wait()
+                break
+        err.seek(0)
+        stderr = err.read().decode("utf-8", "replace")
+    if verdict:
+        return Outcome(case, None, stderr, time.perf_counter() - start, f"hung: {verdict}")
+    return judge(Outcome(case, process.returncode, stderr, time.perf_counter() - start), output)
 
 
 def judge(outcome: Outcome, output: Path) -> Outcome:
     """Fill in ``outcome.problem``: what about the run broke the contract, if anything."""
     lines = outcome.stderr.splitlines()
+    case = outcome.case
+    error_prefix = "lenslab batch: error: " if case.command == "batch" else "lenslab: error: "
+    output_fifo = "out.png" in case.fifos
     if "Traceback (most recent call last)" in outcome.stderr:
         outcome.problem = "a traceback on stderr"
     elif any(_CONTROL.search(line) for line in lines):
         outcome.problem = "a control character on stderr"
     elif any(len(line) > MAX_ERROR_LINE for line in lines):  # the whole line, prefix included
         outcome.problem = f"a line over {MAX_ERROR_LINE} characters"
+    elif output_fifo and not _is_fifo(output):
+        outcome.problem = "the named pipe given as -o was replaced"
+    elif outcome.status == 0 and case.command == "batch":
+        outcome.problem = ""  # a dry run: every check passed, nothing to look at
     elif outcome.status == 0:
-        outcome.problem = _judge_image(output, expect_size=not outcome.case.extra_args)
+        outcome.problem = ("exit 0 with a named pipe as -o" if output_fifo else
+                           _judge_image(output, expect_size=not outcome.case.extra_args))
     else:
-        errors = [line for line in lines if line.startswith("lenslab: error: ")]
-        others = [line for line in lines if not line.startswith(("lenslab: error: ", "lenslab: warning: "))]
+        errors = [line for line in lines if line.startswith(error_prefix)]
+        others = [line for line in lines if not line.startswith((error_prefix, "lenslab: warning: "))]
         if len(errors) != 1 or others:
             outcome.problem = f"{len(errors)} error lines and {len(others)} other lines"
         elif "internal error" in errors[0]:
@@ -536,9 +932,16 @@ def judge(outcome: Outcome, output: Path) -> Outcome:
             outcome.problem = "the error names no file"
         elif errors[0].count(f"{output.parent / outcome.case.scene}: ") > 1:
             outcome.problem = "the scene file is named twice"
-        elif output.exists():
+        elif output.exists() and not output_fifo:
             outcome.problem = "an image was written although the render failed"
     return outcome
+
+
+def _is_fifo(path: Path) -> bool:
+    try:
+        return stat.S_ISFIFO(os.lstat(path).st_mode)
+    except OSError:
+        return False
 
 
 def _names_a_file(line: str, case: Case, folder: Path) -> bool:
@@ -591,6 +994,7 @@ def main(argv: list[str] | None = None) -> int:
                 last = outcome.stderr.strip().splitlines()[-1:] or [""]
                 print(f"[{index}] {case.what[:120]!r}: {outcome.problem or 'ok'} (exit {outcome.status}, "
                       f"{outcome.seconds:.1f} s)\n      {last[0][:300]!r}", flush=True)
+    close_watcher()
     slowest.sort(reverse=True)
     print(f"{args.cases} cases, {failures} broke the contract; slowest: "
           + "; ".join(f"{s:.1f} s {w[:60]!r}" for s, w in slowest[:3]))

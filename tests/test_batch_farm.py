@@ -38,6 +38,7 @@ def client(renderer):  # the renderer fixture skips where there is no GL at all
         yield client
 
 
+@pytest.mark.slow
 def test_shots_are_written_a_failure_is_reported_and_a_rerun_skips_them(tmp_path, client):
     (tmp_path / "broken.json").write_text('{"lenslab_scene": 1, "camera": {"f_number": "wide"}}')
     batch = write_batch(tmp_path, """
@@ -117,6 +118,7 @@ def test_a_time_limited_split_renders_disjoint_ranges_and_records_their_total(tm
     assert np.isfinite(image).all() and image.mean() > 0
 
 
+@pytest.mark.slow
 def test_a_worker_killed_mid_shot_is_replaced_and_the_batch_completes(tmp_path, renderer):
     from distributed import Client
 
@@ -145,6 +147,7 @@ def test_a_worker_killed_mid_shot_is_replaced_and_the_batch_completes(tmp_path, 
     assert metadata["lenslab:SamplesPerPixel"] == 600 and np.isfinite(image).all() and image.mean() > 0
 
 
+@pytest.mark.slow
 def test_the_command_renders_a_batch_writes_a_contact_sheet_and_exits_1_on_a_failed_shot(tmp_path, renderer):
     (tmp_path / "shots.toml").write_text("""
         contact_sheet = "sheet.png"
@@ -175,6 +178,7 @@ def test_the_command_renders_a_batch_writes_a_contact_sheet_and_exits_1_on_a_fai
     assert dry.returncode == 0 and "exists, skipped" in dry.stdout and "missing: " in dry.stdout
 
 
+@pytest.mark.slow
 def test_the_command_refuses_bad_arguments_in_one_line(tmp_path):
     for args, status, expected in (
         (["--scheduler", "tcp://x:8786", "--workers", "2"], 2, "--scheduler uses the cluster's own workers"),
@@ -201,6 +205,7 @@ def test_a_local_worker_leaves_ctrl_c_to_the_batch():
         assert list(own_client.run(os.getpid).values()) == [pid_before]  # the same process, not a replacement
 
 
+@pytest.mark.slow
 def test_ctrl_c_keeps_every_finished_shot_and_the_next_run_renders_the_rest(tmp_path, renderer):
     (tmp_path / "shots.toml").write_text(FOUR_SLOW_SHOTS)
     command = [sys.executable, "-m", "lenslab", "batch", str(tmp_path / "shots.toml"), "--workers", "1"]
@@ -226,6 +231,7 @@ def test_ctrl_c_keeps_every_finished_shot_and_the_next_run_renders_the_rest(tmp_
     assert f"skipped {written[0].stem}" in again.stderr and len(list(tmp_path.glob("*.exr"))) == 4
 
 
+@pytest.mark.slow
 def test_the_command_uses_a_running_cluster(tmp_path, client):
     (tmp_path / "shots.toml").write_text("""
         [[shots]]
@@ -244,3 +250,18 @@ def test_the_command_uses_a_running_cluster(tmp_path, client):
                                  env={**os.environ, "DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT": "2s"})
     assert unreachable.returncode == 1 and "Traceback" not in unreachable.stderr, unreachable.stderr
     assert len(unreachable.stderr.strip().splitlines()) == 1 and "cannot reach a Dask scheduler" in unreachable.stderr
+
+
+@pytest.mark.parametrize("address", ["ucx://x", "foo://x:8786"])
+def test_a_scheduler_address_dask_cannot_connect_over_is_one_usage_line(tmp_path, capsys, address):
+    """ucx:// is a protocol Dask knows but cannot use without UCX-Py: its connector could not even be made, and
+    the batch ended in a traceback."""
+    from lenslab.cli import main
+
+    (tmp_path / "s.toml").write_text('[[shots]]\nscene = "cornell_box"\noutput = "s.png"\n')
+    status = main(["batch", str(tmp_path / "s.toml"), "--scheduler", address])
+    err = capsys.readouterr().err
+    assert status == 2 and err.count("\n") == 1 and "Traceback" not in err, err
+    assert err.startswith(f"lenslab batch: error: --scheduler {address}: this installation of Dask cannot connect "
+                          "over that protocol (")
+    assert "tcp://" in err and not (tmp_path / "s.png").exists()

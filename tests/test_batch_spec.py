@@ -309,3 +309,53 @@ def test_an_output_name_no_file_system_can_hold_is_refused(tmp_path):
 def test_a_scene_name_too_long_for_the_file_system_is_a_scene_not_found(tmp_path):
     shots = batch(tmp_path, f'[[shots]]\nscene = "{"x" * 300}"\noutput = "a.png"\n')  # no Errno 36 while reading
     assert shots.shots[0].scene == "x" * 300
+
+
+@pytest.mark.parametrize("value, expected", [
+    ("1979-05-27", "shot 1: spp: expected a whole number, not a date (1979-05-27)"),
+    ("07:32:00", "shot 1: spp: expected a whole number, not a time (07:32:00)"),
+    ("1979-05-27T07:32:00Z", "shot 1: spp: expected a whole number, not a date and time (1979-05-27T07:32:00+00:00)"),
+    ("[1, 1979-05-27]", "shot 1: spp: expected a whole number, not a date (1979-05-27)"),
+    ("{from = 1, to = 8, steps = 07:32:00}", "shot 1: spp.steps: expected a whole number from 1 to 10000, not a time"),
+])
+def test_a_toml_date_or_time_as_a_value_is_one_line(tmp_path, value, expected):
+    """TOML has dates and times of its own, which JSON (the messages' way of showing a value) has no text for."""
+    assert expected in error(tmp_path, f'[[shots]]\nscene = "cornell_box"\noutput = "a.png"\nspp = {value}\n')
+
+
+@pytest.mark.parametrize("shot, expected", [
+    ('output = "{index:c}.png"\n', r"output: '{index:c}.png': a field makes '\x01', which is no part of a file name"),
+    ('output = "{spp:c}.png"\nspp = [48, 47]\n', r"a field makes '/', which is no part of a file name"),
+    ('output = "{name}/{index}.png"\nname = ".."\n', "a field makes '..', which is no part of a file name"),
+    ('output = "\\u202e{index}.png"\n', r"output: '\u202e1.png' is not a name a terminal or a folder shows as it is"),
+])
+def test_an_output_pattern_that_makes_no_file_name_is_refused(tmp_path, shot, expected):
+    """{index:c} once wrote a file named "\\x01.png"; a value's "/" or ".." would put the image in another folder."""
+    message = error(tmp_path, '[[shots]]\nscene = "cornell_box"\n' + shot)
+    assert expected in message
+    assert list(tmp_path.iterdir()) == [tmp_path / "shots.toml"]
+
+
+def test_output_patterns_that_make_names_still_do(tmp_path):
+    shots = batch(tmp_path, '[[shots]]\nscene = "cornell_box"\noutput = "renders/{index:03d}_{name}.png"\n'
+                            'name = "a/b"\nspp = [1, 2]\n')
+    assert [shot.output.relative_to(tmp_path).as_posix() for shot in shots.shots] == [
+        "renders/001_a_b.png", "renders/002_a_b.png"]
+
+
+def test_a_batch_file_that_is_a_named_pipe_is_refused_not_waited_on(tmp_path):
+    from tests.malformed_inputs import fifo_read_as_empty
+
+    with fifo_read_as_empty(tmp_path / "shots.toml") as pipe, pytest.raises(BatchError) as caught:
+        read_batch(pipe)
+    assert str(caught.value) == f"{pipe}: cannot read (a named pipe (FIFO), not a regular file)"
+
+
+def test_an_output_that_is_a_named_pipe_is_refused_not_skipped_or_replaced(tmp_path):
+    import os
+    import stat
+
+    os.mkfifo(tmp_path / "a.png")
+    message = error(tmp_path, '[[shots]]\nscene = "cornell_box"\noutput = "a.png"\n')
+    assert f"shot 1: output: {tmp_path / 'a.png'}: a named pipe (FIFO), not a regular file" in message
+    assert stat.S_ISFIFO(os.lstat(tmp_path / "a.png").st_mode)

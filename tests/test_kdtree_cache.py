@@ -164,3 +164,51 @@ def test_trees_and_mitsubas_references_share_the_users_cache_folder(tmp_path, mo
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
     assert kdtree_cache.cache_dir() == tmp_path / "lenslab" / "kdtrees"
     assert default_cache_dir() == tmp_path / "lenslab" / "validate"
+
+
+def test_a_write_that_fails_on_a_full_disk_leaves_no_partial_file(tmp_path, monkeypatch):
+    """np.savez on a full disk creates its file and then fails: the 0-byte ``.partial.npz`` it left was never
+    cleaned (eviction counts bytes, and it has none)."""
+    import errno
+
+    def full_disk(file, **arrays):
+        open(file, "wb").close()  # as a real write does: the file is made, then its first block is refused
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(kdtree_cache.np, "savez", full_disk)
+    tree = cached(random_triangles(500), tmp_path)
+    assert tree.node_count > 1 and not tree.from_cache  # the render goes on
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_an_interrupted_write_takes_its_partial_file_with_it(tmp_path, monkeypatch):
+    def interrupted(file, **arrays):
+        open(file, "wb").close()
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(kdtree_cache.np, "savez", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        cached(random_triangles(500), tmp_path)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_partial_files_of_writers_that_are_gone_are_swept(tmp_path):
+    """A writer killed mid-write (SIGKILL, a power cut) runs no clean-up: the next write sweeps what it left,
+    and never a partial file of a writer still running."""
+    import os
+    import subprocess
+    import sys
+    import time
+
+    child = subprocess.Popen([sys.executable, "-c", "pass"])
+    child.wait()  # a process number no process has now
+    dead = tmp_path / f".{'a' * 40}.{child.pid}.partial.npz"
+    alive = tmp_path / f".{'b' * 40}.{os.getppid()}.partial.npz"
+    old = tmp_path / f".{'c' * 40}.{os.getppid()}.partial.npz"  # another machine's, say: its age tells
+    for path in (dead, alive, old):
+        path.write_bytes(b"")
+    then = time.time() - 2 * 3600
+    os.utime(old, (then, then))
+    cached(random_triangles(500), tmp_path)
+    assert not dead.exists() and not old.exists() and alive.exists()
+    assert len(list(tmp_path.glob("*.npz"))) == 2  # the tree written, and the live writer's partial file

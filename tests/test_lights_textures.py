@@ -311,3 +311,29 @@ def test_lights_chosen_by_what_reaches_the_point_agree_with_lights_chosen_by_pow
     assert np.allclose(quadrants(by_power_reference), quadrants(at_point_reference), rtol=0.02)
     error = lambda image: np.mean((image - at_point_reference) ** 2)  # noqa: E731
     assert error(at_point) < 0.1 * error(by_power)
+
+
+@pytest.mark.parametrize("diameter", [1e-200, 5e-324, 1e-7])
+def test_a_sun_too_small_to_be_a_disk_is_refused_not_divided_by_zero(tmp_path, diameter):
+    """1e-200 degrees squared in the disk's solid angle is 0 in floating point: a ZeroDivisionError, shown as an
+    internal error. Between 0 (a point at infinity) and SMALLEST_SUN_DEG the disk's radiance leaves float32."""
+    import json
+
+    from lenslab.scene.io.native import load_scene
+    from lenslab.scene.lights import SMALLEST_SUN_DEG
+    from lenslab.scene.scene import SceneError
+
+    sun = SunLight("tiny", direction=(0, 1, 0), angular_diameter_deg=diameter)
+    with pytest.raises(ValueError, match=f"sun 'tiny': angular_diameter_deg {diameter:g} is too small to be a disk: "
+                                         f"give 0 \\(a point at infinity, sharp shadows\\) or at least 1e-06"):
+        sun.radiance()
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps({"lenslab_scene": 2, "lights": [{"type": "sun", "name": "tiny",
+                                                                 "angular_diameter_deg": diameter}]}))
+    with pytest.raises(SceneError, match=rf"lights\[0\]\.angular_diameter_deg: {json.dumps(diameter)} is too small: "
+                                         rf"give 0 or at least 1e-06"):
+        load_scene(path)
+    point = SunLight("point", irradiance=(2.0, 3.0, 4.0), angular_diameter_deg=0.0)
+    assert point.radiance() == (2.0, 3.0, 4.0)  # 0 stays a delta light
+    smallest = SunLight("smallest", irradiance=(1e9,) * 3, angular_diameter_deg=SMALLEST_SUN_DEG).radiance()
+    assert np.isfinite(np.float32(smallest)).all()  # the smallest disk's radiance is within float32

@@ -9,6 +9,7 @@ from __future__ import annotations
 import contextlib
 import io
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -22,13 +23,38 @@ pytestmark = pytest.mark.gl
 CORNELL = Path(__file__).resolve().parent.parent / "scenes" / "cornell_box" / "scene.json"
 
 
-def test_a_seeded_run_of_malformed_inputs_meets_the_contract(tmp_path):
+def _seeded_run(count: int, seed: int, folder: Path) -> None:
+    """``count`` cases of the generator, each in this process; a hang is found from the work a case does (the
+    harness's watcher), never from the clock, so a machine busy with other work makes the run slower, not red."""
     failures = []
-    for index, case in enumerate(malformed_inputs.generate(300, seed=2026)):
-        outcome = malformed_inputs.run_in_process(case, tmp_path / "case")
-        if outcome.problem:
-            failures.append(f"[{index}] {case.what[:100]!r}: {outcome.problem}: {outcome.stderr.strip()[-300:]!r}")
-    assert not failures, f"{len(failures)} of 300 cases broke the contract:\n" + "\n".join(failures)
+    try:
+        for index, case in enumerate(malformed_inputs.generate(count, seed=seed)):
+            outcome = malformed_inputs.run_in_process(case, folder / "case")
+            if outcome.problem:
+                failures.append(f"[{index}] {case.what[:100]!r}: {outcome.problem}: "
+                                f"{outcome.stderr.strip()[-300:]!r}")
+    finally:
+        malformed_inputs.close_watcher()
+    assert not failures, f"{len(failures)} of {count} cases broke the contract:\n" + "\n".join(failures)
+
+
+def test_a_seeded_run_of_malformed_inputs_meets_the_contract(tmp_path):
+    _seeded_run(300, 2026, tmp_path)
+
+
+@pytest.mark.slow
+def test_a_long_seeded_run_of_malformed_inputs_meets_the_contract(tmp_path):
+    _seeded_run(3000, 11, tmp_path)
+
+
+def test_the_seeded_run_covers_every_class_of_input():
+    """The default run meets each kind of case at least a few times: batch values (TOML dates among them),
+    truncated .serialized meshes, glTF fields of the wrong type, named pipes read and written."""
+    whats = [case.what for case in malformed_inputs.generate(300, seed=2026)]
+    for prefix in ("batch: ", "serialized: ", "glTF: ", "FIFO: "):
+        assert sum(what.startswith(prefix) for what in whats) >= 5, prefix
+    assert any(what.startswith("batch: ") and re.search(r"\d{4}-\d\d-\d\d|\d\d:\d\d:\d\d", what) for what in whats)
+    assert any(what.startswith("serialized: mesh 0's stream ended") for what in whats)
 
 
 def _run(*args: str) -> tuple[int, str]:
@@ -252,8 +278,9 @@ def test_what_an_image_library_prints_from_c_stays_off_stderr(tmp_path):
     done = subprocess.run([sys.executable, "-m", "lenslab", "cornell_box", "--headless", "-o", tmp_path / "out.png",
                            "--aperture-image", image, "--spp", "1", "--width", "8", "--height", "8"],
                           capture_output=True, text=True, timeout=120)
-    assert done.returncode == 1 and done.stderr.count("\n") == 1, done.stderr
-    assert done.stderr.startswith("lenslab: error: ") and f"{image}: cannot read the image" in done.stderr
+    # A usage error: the option named a file that is no image (it is read as the option is parsed).
+    assert done.returncode == 2 and done.stderr.count("\n") == 1, done.stderr
+    assert done.stderr.startswith(f"lenslab: error: argument --aperture-image: {image}: cannot read the image")
 
 
 def test_a_batch_s_names_reach_the_terminal_escaped(tmp_path, capsys):
@@ -318,6 +345,7 @@ def test_includes_of_includes_are_counted(tmp_path, monkeypatch):
     assert "<include>: more than 500 includes in all (includes of includes multiply)" in line
 
 
+@pytest.mark.slow
 def test_a_scheduler_that_never_answers_is_given_up_on(tmp_path, capsys):
     """A server that accepts the connection and says nothing: Dask's handshake has no deadline of its own."""
     import socket
@@ -336,3 +364,114 @@ def test_a_scheduler_that_never_answers_is_given_up_on(tmp_path, capsys):
     err = capsys.readouterr().err
     assert status == 1 and err.count("\n") == 1, err
     assert f"cannot reach a Dask scheduler at {address} (no answer as a Dask scheduler within 1 s)" in err
+
+
+# -- the minimal cases of the classes the fuzzer found running the real command --------------------------------
+def _gltf_scene(tmp_path: Path, edit) -> Path:
+    header = malformed_inputs._gltf_quad()
+    edit(header)
+    (tmp_path / "quad.gltf").write_text(json.dumps(header))
+    (tmp_path / "label.png").write_bytes((CORNELL.parent.parent.parent / "app/lenslab/validate/scenes/label.png")
+                                         .read_bytes())
+    return _cornell(tmp_path, lambda doc: _add_node(doc, {"type": "mesh", "file": "quad.gltf"}))
+
+
+@pytest.mark.parametrize("edit, expected", [
+    (lambda h: h["materials"][0]["pbrMetallicRoughness"].update(baseColorFactor=0.5),
+     "materials[0].pbrMetallicRoughness.baseColorFactor: expected a list of 4 numbers, not 0.5"),
+    (lambda h: h["materials"][0]["pbrMetallicRoughness"].update(metallicFactor=None),
+     "materials[0].pbrMetallicRoughness.metallicFactor: expected a number, not null"),
+    (lambda h: h.update(images={"0": {"uri": "label.png"}}),
+     'images: expected a list, not {"0": {"uri": "label.png"}}'),
+    (lambda h: h["materials"][0].update(emissiveFactor=[1, 2e30, 0]),
+     "materials[0].emissiveFactor: 2e+30 is too large (the most any value may be is 1e+30)"),
+    (lambda h: h["textures"][0].update(sampler=3), "textures[0].sampler: 3 points past the file's 1 samplers"),
+    (lambda h: h["images"][0].update(uri=7), "images[0].uri: expected a string, not 7"),
+])
+def test_a_gltf_field_of_the_wrong_type_is_named(tmp_path, edit, expected):
+    """Each of these once reached the material mapping and ended as "internal error"."""
+    scene = _gltf_scene(tmp_path, edit)
+    line = _one_error(*_render(scene, tmp_path))
+    assert f"{tmp_path / 'quad.gltf'}: {expected}" in line and "internal error" not in line
+
+
+def test_a_well_formed_gltf_quad_renders(tmp_path):
+    status, stderr = _render(_gltf_scene(tmp_path, lambda header: None), tmp_path)
+    assert status == 0 and "error" not in stderr, stderr
+
+
+@pytest.mark.parametrize("statement, expected", [
+    ("map_Kd -s nan nan t.png", "map_Kd -s nan nan t.png: not a finite number"),  # once rendered black, silently
+    ("map_Kd -o 1e31 0 t.png", "map_Kd -o 1e31 0 t.png: 1e+31 is too large (the most any value may be is 1e+30)"),
+    ("Kd 2e30 0.5 0.5", "Kd 2e30 0.5 0.5: 2e+30 is too large (the most any value may be is 1e+30)"),
+])
+def test_an_mtl_number_that_is_not_finite_or_too_large_is_refused(tmp_path, statement, expected):
+    (tmp_path / "m.obj").write_text("mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl a\n"
+                                    "f 1/1 2/2 3/3\n")
+    (tmp_path / "m.mtl").write_text(f"newmtl a\n{statement}\n")
+    (tmp_path / "t.png").write_bytes(_png_claiming(1, 1))
+    scene = _cornell(tmp_path, lambda doc: _add_node(doc, {"type": "mesh", "file": "m.obj"}))
+    line = _one_error(*_render(scene, tmp_path))
+    assert f"m.mtl: material 'a': {expected}" in line
+
+
+def test_every_format_refuses_a_number_past_the_same_bound(tmp_path):
+    """Native JSON, Mitsuba XML, MTL and glTF all stop at limits.LARGEST_NUMBER (1e30), in the same words: a
+    Mitsuba radiance of 1e308 once put infinities in the light tables, and an MTL or glTF one was taken too."""
+    folders = [tmp_path / name for name in "abcd"]
+    for folder in folders:
+        folder.mkdir()
+    scenes = [_cornell(folders[0], lambda doc: doc["nodes"][0]["transform"].update(translate=[1.5e30, 0, 0]))]
+    (folders[1] / "scene.xml").write_text('<scene version="3.0.0"><shape type="sphere"><emitter type="area">'
+                                          '<rgb name="radiance" value="1.5e30"/></emitter></shape></scene>')
+    scenes.append(folders[1] / "scene.xml")
+    (folders[2] / "m.obj").write_text("mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n")
+    (folders[2] / "m.mtl").write_text("newmtl a\nKe 1.5e30 1 1\n")
+    scenes.append(_cornell(folders[2], lambda doc: _add_node(doc, {"type": "mesh", "file": "m.obj"})))
+    scenes.append(_gltf_scene(folders[3], lambda h: h["materials"][0].update(emissiveFactor=[1.5e30, 0, 0])))
+    lines = [_one_error(*_render(scene, folder)) for scene, folder in zip(scenes, folders)]
+    assert all(re.search(r"1\.5e\+?30'? is too large \(the most any value may be is 1e\+30\)", line)
+               for line in lines), lines
+
+
+@pytest.mark.parametrize("kind", ["an image texture", "a glTF buffer", "a glTF image", "an aperture image",
+                                  "an environment map", "a mesh file pipe.obj", "the scene file", "the batch file"])
+def test_a_named_pipe_is_refused_at_once_wherever_a_file_is_read(tmp_path, kind):
+    """A FIFO where a texture or a glTF's buffer belongs once blocked the render for ever. The case runs under the
+    harness's watcher, which would stop it (and say so) were it still waiting on the pipe."""
+    rng = __import__("random").Random(0)
+    case = next(c for c in iter(lambda: malformed_inputs.fifo_case(rng), None) if c.what == f"FIFO: {kind}")
+    try:
+        outcome = malformed_inputs.run_in_process(case, tmp_path / "case")
+    finally:
+        malformed_inputs.close_watcher()
+    assert not outcome.problem, f"{outcome.problem}: {outcome.stderr}"
+    assert "a named pipe (FIFO), not a regular file" in outcome.stderr
+
+
+def test_the_one_reader_of_user_files_refuses_what_is_not_a_regular_file(tmp_path):
+    from lenslab.image_files import NotARegularFile, check_regular_file, open_file, read_file_bytes
+
+    (tmp_path / "plain.txt").write_bytes(b"bytes")
+    assert read_file_bytes(tmp_path / "plain.txt") == b"bytes"
+    with open_file(tmp_path / "plain.txt") as file:
+        assert file.read(2) == b"by"
+    check_regular_file(tmp_path / "absent")  # what is not there is for the reader to say
+    with malformed_inputs.fifo_read_as_empty(tmp_path / "pipe") as pipe:
+        for read in (read_file_bytes, open_file, check_regular_file):
+            with pytest.raises(NotARegularFile) as caught:
+                read(pipe)
+            assert str(caught.value) == f"{pipe}: a named pipe (FIFO), not a regular file"
+            assert caught.value.filename == str(pipe)
+            assert caught.value.strerror == "a named pipe (FIFO), not a regular file"
+    for path, what in ((tmp_path, "a folder"), (Path("/dev/zero"), "a character device")):  # /dev/zero never ends
+        with pytest.raises(NotARegularFile, match=f"^{re.escape(str(path))}: {what}, not a regular file$"):
+            read_file_bytes(path)
+
+
+def test_a_toml_date_in_a_batch_file_is_one_line_from_the_command(tmp_path, capsys):
+    (tmp_path / "b.toml").write_text('[[shots]]\nscene = "cornell_box"\noutput = "a.png"\nspp = 1979-05-27\n')
+    assert main(["batch", str(tmp_path / "b.toml"), "--dry-run"]) == 1
+    err = capsys.readouterr().err
+    assert err == (f"lenslab batch: error: {tmp_path / 'b.toml'}, shot 1: spp: expected a whole number, not a date "
+                   "(1979-05-27)\n")

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import logging
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -744,3 +745,55 @@ def test_a_top_level_sampler_referred_to_by_the_sensor_is_used_without_a_warning
     assert scene.render.spp == 9 and scene.render.sampler == "sobol"
     assert 'sampler "stratified" is rendered with' in only(warnings, "stratified")
     assert len(warnings) == 1
+
+
+@pytest.mark.parametrize("transform", [
+    '<matrix value="0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0"/>',  # once rendered, every pixel lost, with exit 0
+    '<matrix value="0 0 0 1 0 0 0 2 0 0 0 3 0 0 0 1"/>',  # a position, and nothing to look along
+    '<scale value="1 1 0"/>',  # +Z flattened
+    '<matrix value="1 0 0 0 0 0 1 0 0 0 1 0 0 0 0 1"/>',  # +Y and +Z onto one line
+])
+def test_a_sensor_to_world_that_gives_no_view_is_refused(tmp_path, transform):
+    body = (f'<sensor type="perspective"><transform name="to_world">{transform}</transform>'
+            f'{BOX_FILM.format(w=8, h=8)}</sensor><shape type="sphere"/>')
+    with pytest.raises(SceneError, match=r"scene\.xml: line 3: <sensor type=\"perspective\">: to_world gives the "
+                                         r"camera no direction to look in or no up"):
+        load(tmp_path, body)
+
+
+@pytest.mark.parametrize("element, value", [
+    ('<rgb name="radiance" value="{}"/>', "1e308"),  # finite here, infinite in the float32 light tables
+    ('<rgb name="radiance" value="1 {} 1"/>', "2e30"),
+    ('<float name="radiance" value="{}"/>', "-1e31"),
+    ('<spectrum name="radiance" value="400:1 700:{}"/>', "1e40"),
+])
+def test_a_number_beyond_the_largest_any_scene_holds_is_refused_as_native_scenes_do(tmp_path, element, value):
+    from lenslab.limits import LARGEST_NUMBER
+
+    body = camera_xml() + f'<shape type="sphere"><emitter type="area">{element.format(value)}</emitter></shape>'
+    with pytest.raises(SceneError, match=re.escape(f"'{value}' is too large (the most any value may be is "
+                                                   f"{LARGEST_NUMBER:g})")):
+        load(tmp_path, body)
+    bound = "-1e30" if value.startswith("-") else "1e30"  # the bound itself is a number a scene may hold
+    scene, _ = load(tmp_path, camera_xml() + f'<shape type="sphere"><emitter type="area">{element.format(bound)}'
+                                             "</emitter></shape>")
+    assert len(scene.nodes) == 1
+
+
+def test_a_nan_in_a_sampled_spectrum_is_refused(tmp_path):
+    body = (camera_xml() + '<shape type="sphere"><emitter type="area">'
+            '<spectrum name="radiance" value="400:1 700:nan"/></emitter></shape>')
+    with pytest.raises(SceneError, match="'nan' is not a finite number"):
+        load(tmp_path, body)
+
+
+@pytest.mark.parametrize("shape, expected", [
+    ('<shape type="sphere"><float name="radius" value="-1"/></shape>', "a sphere's radius must be positive, not -1"),
+    ('<shape type="sphere"><float name="radius" value="0"/></shape>', "a sphere's radius must be positive, not 0"),
+    ('<shape type="cylinder"><float name="radius" value="-0.5"/></shape>',
+     "a cylinder's radius must be positive, not -0.5"),
+])
+def test_a_radius_that_is_not_positive_is_refused(tmp_path, shape, expected):
+    """A negative sphere radius was read as its absolute value without a word."""
+    with pytest.raises(SceneError, match=re.escape(f'line 4: <shape type="{shape.split(chr(34))[1]}">: {expected}')):
+        load(tmp_path, camera_xml() + "\n" + shape)

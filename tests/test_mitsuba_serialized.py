@@ -108,6 +108,7 @@ def test_the_first_mesh_needs_no_table_as_in_mitsuba(tmp_path):
         read_serialized(path, 1)
 
 
+@pytest.mark.slow  # a comparison with Mitsuba 3: the full validation
 def test_mitsuba_reads_the_same_meshes(tmp_path):
     """Mitsuba 3's own reader, on the same files: positions, indices, normals, texture coordinates (v flipped)."""
     mi = pytest.importorskip("mitsuba", reason="Mitsuba 3 is not installed (pip install 'lenslab[validate]')")
@@ -299,3 +300,54 @@ def test_truncated_and_flipped_files_never_raise_anything_else(tmp_path):
                 assert str(exc).startswith(str(path)) and "\n" not in str(exc)
             else:
                 assert mesh.vertices.shape[1] == 3 and mesh.faces.shape[1] == 3
+
+
+def test_a_stream_that_ends_before_its_counts_is_cut_short_not_an_endless_loop(tmp_path, monkeypatch):
+    """A mesh whose zlib stream is whole but holds less than its counts, followed by the next mesh: zlib keeps the
+    bytes after the stream's end in ``unconsumed_tail`` for ever, and the reader once asked for them again without
+    end. Every call to inflate must take input or give output: counted here, bounded by the file's size."""
+    body = struct.pack("<I", 0x1000) + b"mesh\0" + struct.pack("<QQ", 4, 4) + np.zeros(12, "<f4").tobytes()
+    short = struct.pack("<HH", 0x041C, 4) + zlib.compress(body[:40])  # the stream ends in the positions
+    path = tmp_path / "early.serialized"
+    path.write_bytes(short + mesh_stream(**SQUARE) + struct.pack("<QQI", 0, len(short), 2))
+    calls = []
+    real = zlib.decompressobj
+
+    class Counted:
+        def __init__(self):
+            self._inner = real()
+
+        def decompress(self, data, limit=0):
+            calls.append(len(data))
+            assert len(calls) <= path.stat().st_size, "inflation that takes no input and gives no output"
+            return self._inner.decompress(data, limit)
+
+        def __getattr__(self, name):
+            return getattr(self._inner, name)
+
+    monkeypatch.setattr(mitsuba_serialized.zlib, "decompressobj", Counted)
+    with pytest.raises(MeshLoadError, match=r"early\.serialized: mesh 0 is cut short \(in its positions\)"):
+        read_serialized(path, 0)
+    assert read_serialized(path, 1).faces.shape == (2, 3)  # the mesh after it reads as written
+
+
+def test_every_early_end_of_either_mesh_s_stream_is_one_line(tmp_path):
+    """A stream ended early at every byte of the body, in a file of two meshes: a MeshLoadError naming the file."""
+    body = (struct.pack("<I", 0x1000) + b"mesh\0" + struct.pack("<QQ", 4, 4) + np.zeros(12, "<f4").tobytes()
+            + np.asarray(TETRA["faces"], "<u4").tobytes())
+    path = tmp_path / "early.serialized"
+    for cut in range(len(body)):
+        first = struct.pack("<HH", 0x041C, 4) + zlib.compress(body[:cut])
+        path.write_bytes(first + mesh_stream(**SQUARE) + struct.pack("<QQI", 0, len(first), 2))
+        with pytest.raises(MeshLoadError) as caught:
+            read_serialized(path, 0)
+        assert str(caught.value).startswith(f"{path}: ") and "\n" not in str(caught.value)
+
+
+def test_a_named_pipe_is_refused_not_waited_on(tmp_path):
+    from tests.malformed_inputs import fifo_read_as_empty
+
+    with fifo_read_as_empty(tmp_path / "pipe.serialized") as pipe, \
+            pytest.raises(MeshLoadError, match=r"pipe\.serialized: cannot read mesh \(a named pipe \(FIFO\), not a "
+                                               r"regular file\)"):
+        read_serialized(pipe)

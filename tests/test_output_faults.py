@@ -416,6 +416,7 @@ def test_a_command_called_in_process_leaves_the_callers_signal_handlers_alone(re
     assert {stop: signal.getsignal(stop) for stop in before} == before
 
 
+@pytest.mark.slow
 @POSIX_ONLY
 @pytest.mark.gl
 def test_a_batch_stopped_by_sigterm_keeps_its_written_shots_and_says_so(renderer, tmp_path):
@@ -499,3 +500,32 @@ def test_a_time_limit_up_before_the_first_pass_says_so_at_once(renderer, tmp_pat
     assert lines[notice[0]] == ("lenslab: warning: the time limit (0.001 s) is up before every pixel has a sample: "
                                 "finishing the first pass (65,536 samples) before stopping")
     assert "the first pass was finished" in lines[notice[0] + 1] and lines[-1].startswith("wrote ")
+
+
+# -- what is at the output's name ------------------------------------------------------------------------------
+@pytest.mark.gl
+def test_an_output_that_is_a_named_pipe_is_refused_and_left_as_it_is(renderer, tmp_path, capsys):
+    """-o onto a named pipe once replaced it with the image (the rename does not ask what it replaces)."""
+    import stat
+
+    pipe = tmp_path / "out.png"
+    os.mkfifo(pipe)
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", pipe, *SMALL)
+    assert status == 1 and err == (f"lenslab: error: {pipe}: a named pipe (FIFO), not a regular file: LensLab writes "
+                                   "only where no file is or over a regular file (name another output)\n")
+    assert stat.S_ISFIFO(os.lstat(pipe).st_mode) and leftovers(tmp_path) == ["out.png"]
+    with pytest.raises(WriteFailed, match="a named pipe"):  # the writers themselves refuse it too
+        write_image(pipe, noise(8, 8))
+    assert stat.S_ISFIFO(os.lstat(pipe).st_mode)
+
+
+def test_a_device_node_or_a_folder_is_no_output(tmp_path):
+    from lenslab.atomic import check_output_file, check_output_folder
+
+    with pytest.raises(WriteFailed, match=r"^/dev/null: a character device, not a regular file"):
+        check_output_folder("/dev/null")  # refused before anything is made in /dev
+    with pytest.raises(WriteFailed, match=r": a folder, not a regular file"):
+        check_output_file(tmp_path)
+    check_output_file(tmp_path / "absent.png")  # nothing there, or a file: the write may go ahead
+    (tmp_path / "old.png").write_bytes(b"old")
+    check_output_file(tmp_path / "old.png")

@@ -404,3 +404,21 @@ def test_readme_documents_every_key():
         for f in fields(cls):
             if f.init and f.name != "_":
                 assert f"`{f.name}`" in readme, f.name
+
+
+def test_a_named_pipe_among_the_users_lenses_is_refused_not_waited_on(isolated_user_dir):
+    from tests.malformed_inputs import fifo_read_as_empty
+
+    (isolated_user_dir / "lenses").mkdir(parents=True)
+    with fifo_read_as_empty(isolated_user_dir / "lenses" / "pipe.json") as pipe:
+        with pytest.raises(PresetError, match=r"pipe\.json.*named pipe"):
+            load_lens_presets()
+    assert pipe.name == "pipe.json"
+
+
+def test_an_option_given_an_integer_past_the_float_range_is_refused_in_one_line():
+    from lenslab.scene.options import OPTIONS
+
+    blades = OPTIONS["aperture_blades"]
+    with pytest.raises(ValueError, match=r"^aperture_blades 999999\.\.\. \(400 digits\) is out of range \[0, "):
+        blades.check(int("9" * 400))

@@ -31,6 +31,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Callable, Iterator
 
+from lenslab.image_files import not_a_file
 from lenslab.limits import format_bytes
 
 TEMPORARY_PREFIX = ".lenslab-"
@@ -80,14 +81,26 @@ def _create_temporary(path: Path) -> Path:
     return Path(name)
 
 
+def check_output_file(path: str | os.PathLike) -> None:
+    """Raise WriteFailed, naming ``path``, where something other than a regular file is there (links followed):
+    a named pipe, a device node, a socket, a folder. The rename that puts a finished file in place would replace
+    it (a FIFO a reader waits on, /dev/null ...): a write goes where nothing is, or over a regular file only."""
+    other = not_a_file(path)
+    if other is not None:
+        raise WriteFailed(path, f"{other}: LensLab writes only where no file is or over a regular file "
+                                "(name another output)")
+
+
 def check_output_folder(path: str | os.PathLike, estimated_bytes: int = 0) -> None:
     """Raise WriteFailed, naming ``path`` and the problem in one line, if ``path`` cannot be written now: its folder
-    is missing or a file, refuses a new file, or has less free space than ``estimated_bytes``. For a caller about
+    is missing or a file, refuses a new file, or has less free space than ``estimated_bytes``; or something other
+    than a regular file is at ``path`` (check_output_file: a named pipe, a device node). For a caller about
     to spend minutes making the file (a render), so that it fails before the work, not after.
 
     The folder is asked by doing what the writer will do: a temporary file of ours is made there and removed
     (permission bits say nothing for root, nor for a read-only mount, an ACL or a full inode table)."""
     path = Path(path)
+    check_output_file(path)
     folder = path.parent
     if folder.exists() and not folder.is_dir():
         raise WriteFailed(path, f"{folder} is a file, not a folder")
@@ -218,6 +231,7 @@ def atomic_path(path: str | os.PathLike, *, before_rename: Callable[[], None] | 
     can stop the write but the rename failing. The command line ignores its stop signals there, so a Ctrl-C that
     comes as the file appears cannot be reported as "nothing was written"."""
     path = Path(path)
+    check_output_file(path)  # never renamed over a named pipe or a device node
     remove_stale_temporaries(path.parent)
     tmp = _create_temporary(path)
     _writing.add(tmp.name)

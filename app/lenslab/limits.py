@@ -8,6 +8,7 @@ user gets one line naming what is too big rather than a crash deep inside numpy 
 
 from __future__ import annotations
 
+import math
 import os
 import resource
 
@@ -15,6 +16,18 @@ import resource
 #: The largest magnitude any number of a scene may have (a coordinate, a colour, a setting): past it a number
 #: measures nothing, and float32 on the GPU would make it infinite or swallow every smaller one.
 LARGEST_NUMBER = 1e30
+
+
+def number_problem(value: float) -> str | None:
+    """Why a number read from a file cannot be a scene's, in the words every reader uses ("nan is not a finite
+    number", "1e+308 is too large (the most any value may be is 1e+30)"); None where it can be. The one bound
+    for every format: native JSON, Mitsuba XML, MTL and glTF values alike."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return f"{value} is not a finite number"
+    if abs(value) > LARGEST_NUMBER:  # exact for an integer of any length: no conversion to float can overflow
+        shown = f"a {len(str(abs(value)))}-digit number" if isinstance(value, int) else f"{value:g}"
+        return f"{shown} is too large (the most any value may be is {LARGEST_NUMBER:g})"
+    return None
 
 
 class SceneTooLarge(RuntimeError):

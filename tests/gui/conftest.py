@@ -1,7 +1,9 @@
 """Fixtures for the studio's tests: pytest-qt on the offscreen platform, the render worker on llvmpipe.
 
-Windows render tiny images (64 x 48) so that the whole GUI suite stays well under a minute on two cores.
-Every window is closed at the end of its test, and the test fails if its render thread did not stop.
+Windows render tiny images (64 x 48); every window is closed at the end of its test, and the test fails if its
+render thread did not stop. The studio's tests are the slow tier (docs/testing.md) but for its smoke tests,
+marked ``smoke``: the window opens on a scene and renders, the camera panel edits and undoes, an export is
+written, the scene's events reach the widgets.
 """
 
 from __future__ import annotations
@@ -14,6 +16,15 @@ pytest.importorskip("PySide6")
 pytest.importorskip("pytestqt")
 
 SMALL = (64, 48)
+
+
+@pytest.hookimpl(tryfirst=True)  # before -m deselects: the marks must be on the items by then
+def pytest_collection_modifyitems(config, items):
+    """Every studio test not marked ``smoke`` is in the slow tier."""
+    here = __import__("pathlib").Path(__file__).parent
+    for item in items:
+        if here in item.path.parents and item.get_closest_marker("smoke") is None:
+            item.add_marker(pytest.mark.slow)
 
 
 @pytest.fixture

@@ -18,6 +18,7 @@ def stops_moved(before: float, after: float) -> float:
     return 2 * math.log2(after / before)
 
 
+@pytest.mark.smoke
 @pytest.mark.parametrize("scale, fraction", [("third", 1 / 3), ("half", 1 / 2), ("full", 1.0)])
 def test_one_key_press_is_one_step_of_the_chosen_scale(window, settings, scale, fraction):
     panel = window.camera_panel
@@ -35,6 +36,7 @@ def test_one_key_press_is_one_step_of_the_chosen_scale(window, settings, scale, 
     assert window.doc.scene.camera.f_number == pytest.approx(before)
 
 
+@pytest.mark.smoke
 def test_focus_nearer_than_the_lens_is_refused_and_a_longer_lens_moves_it_out(window, qtbot):
     panel = window.camera_panel
     messages = []
@@ -60,6 +62,7 @@ def test_focus_nearer_than_the_lens_is_refused_and_a_longer_lens_moves_it_out(wi
     assert (window.doc.scene.camera.focal_length_mm, window.doc.scene.camera.focus_distance_m) == (50.0, 0.25)
 
 
+@pytest.mark.smoke
 def test_the_new_controls_edit_the_camera_and_undo(window, tmp_path):
     panel = window.camera_panel
     cam = window.doc.scene.camera
@@ -83,6 +86,7 @@ def test_the_new_controls_edit_the_camera_and_undo(window, tmp_path):
     assert window.doc.scene.camera == cam
 
 
+@pytest.mark.smoke
 def test_a_missing_aperture_image_keeps_the_stop_and_says_why(window, tmp_path):
     import OpenImageIO as oiio
 

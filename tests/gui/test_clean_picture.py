@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import dataclasses
 
+import pytest
+
 from PySide6.QtCore import QObject, Signal
 
 from lenslab.gui.render_loop import Frame, WorkNote
@@ -89,6 +91,7 @@ def test_the_work_banner_says_a_paused_picture_is_behind_and_goes_once_the_pictu
     qtbot.waitUntil(lambda: banner.text is None, timeout=5000)
 
 
+@pytest.mark.smoke
 def test_the_render_loop_notes_each_step_of_a_scene_load_in_order(gl_available, small_scene):
     from lenslab.gui.render_loop import RenderLoop, SceneEdit
     from lenslab.render.tracer import SCENE_STAGES, Renderer

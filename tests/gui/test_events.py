@@ -7,6 +7,8 @@ import pytest
 
 from lenslab.scene.events import EventEmitter, SceneChange, SceneEvents
 
+pytestmark = pytest.mark.smoke  # in the quick tier (docs/testing.md)
+
 
 def test_emitter_calls_connected_callbacks_in_order_and_can_block():
     emitter = EventEmitter()

@@ -21,6 +21,7 @@ def test_the_denoise_checkbox_is_off_by_default_and_reaches_the_request(window, 
     assert dialog.request().denoise is True
 
 
+@pytest.mark.smoke
 def test_a_denoised_export_writes_the_noisy_image_and_the_guides_as_layers(qtbot, window, tmp_path):
     import OpenImageIO as oiio
 

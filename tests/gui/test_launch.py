@@ -8,6 +8,8 @@ import textwrap
 
 import pytest
 
+pytestmark = pytest.mark.smoke  # in the quick tier (docs/testing.md)
+
 
 def test_headless_render_never_imports_qt(tmp_path):
     out = tmp_path / "x.png"

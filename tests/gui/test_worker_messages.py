@@ -28,6 +28,8 @@ from lenslab.gui.render_loop import (
 from lenslab.scene.camera import ThinLensCamera
 from lenslab.scene.scene import RenderSettings, Scene
 
+pytestmark = pytest.mark.smoke  # in the quick tier (docs/testing.md)
+
 
 class RecordedEvents:
     """A LoopEvents that keeps every report as (name, *arguments)."""

@@ -122,6 +122,7 @@ def _cluster_client(args):
     from lenslab.batch.farm import local_cluster
 
     if args.scheduler:
+        _check_scheduler_address(args.scheduler)
         # How long to try is Dask's own setting (distributed.comm.timeouts.connect, e.g. the environment's
         # DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT=5s).
         try:
@@ -130,9 +131,35 @@ def _cluster_client(args):
             # MemoryError: a server that is not Dask's answered, and its first bytes were read as a frame's length
             raise OSError(f"cannot reach a Dask scheduler at {args.scheduler} ({exc}): is `dask scheduler` "
                           "running there, and is the address its own?") from None
+        except Exception as exc:  # noqa: BLE001 - a comm library failing in its own way: still one line
+            raise OSError(f"cannot reach a Dask scheduler at {args.scheduler} ({type(exc).__name__}: {exc})") from None
     workers = args.workers or max(1, len(args.devices))
     cluster = local_cluster(workers)
     return cluster, Client(cluster)
+
+
+def _check_scheduler_address(address: str) -> None:
+    """Refuse, as a usage error, an address whose protocol this installation of Dask cannot connect over: one it
+    does not know (``foo://``), or one it knows and cannot use (``ucx://`` without UCX-Py, whose connector Dask
+    cannot even make)."""
+    from distributed.comm import registry
+    from distributed.comm.addressing import parse_address
+
+    try:
+        scheme, _ = parse_address(address, strict=False)
+        registry.get_backend(scheme).get_connector()
+    except Exception as exc:  # noqa: BLE001 - each comm backend fails in its own way; one line says which
+        usable = []
+        for name, backend in registry.backends.items():
+            try:
+                backend.get_connector()
+            except Exception:  # noqa: BLE001
+                continue
+            if name != "inproc":  # within one process: no farm
+                usable.append(f"{name}://")
+        reason = str(exc).splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise CliError(f"--scheduler {address}: this installation of Dask cannot connect over that protocol "
+                       f"({reason}); it can over {', '.join(usable)}", EXIT_USAGE) from None
 
 
 def _connect(client_class, address: str):

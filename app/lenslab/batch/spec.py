@@ -21,6 +21,7 @@ renders: a batch that would fail at its fortieth shot fails at once.
 
 from __future__ import annotations
 
+import datetime
 import difflib
 import itertools
 import json
@@ -31,6 +32,8 @@ import string
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from lenslab.atomic import check_output_file
+from lenslab.image_files import read_file_bytes
 from lenslab.limits import LARGEST_NUMBER
 from lenslab.render.film import EXPORT_SUFFIXES
 from lenslab.scene.options import OLD_NAMES, OPTIONS, SCENE_OPTIONS
@@ -83,10 +86,12 @@ def read_batch(path: str | Path) -> Batch:
     """Read and check a batch file (.toml or .json); BatchError on any problem."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_file_bytes(path).decode("utf-8")  # a named pipe or a device is refused, not waited on
     except FileNotFoundError:
         raise BatchError(f"{path}: no such batch file") from None
-    except (OSError, UnicodeDecodeError) as exc:
+    except OSError as exc:
+        raise BatchError(f"{path}: cannot read ({exc.strerror or exc})") from None
+    except UnicodeDecodeError as exc:
         raise BatchError(f"{path}: cannot read ({exc})") from None
     return parse_batch(text, path)
 
@@ -214,7 +219,11 @@ def _scalar(key: str, value, where: str):
 
 
 def _shown(value) -> str:
-    text = json.dumps(value) if not isinstance(value, str) else repr(value)
+    if isinstance(value, (datetime.date, datetime.time)):  # TOML's own kinds of value, which JSON has no text for
+        kind = ("a date and time" if isinstance(value, datetime.datetime) else
+                "a date" if isinstance(value, datetime.date) else "a time")
+        return f"{kind} ({value.isoformat()})"  # short: said whole
+    text = json.dumps(value, default=str) if not isinstance(value, str) else repr(value)
     return text if len(text) <= 40 else text[:37] + "..."
 
 
@@ -296,6 +305,10 @@ def _shot(number: int, index: int, values: dict, swept: list[str], folder: Path,
     output = folder / _output_name(values, index, where)
     if output.suffix.lower() not in EXPORT_SUFFIXES:
         raise BatchError(f"{where}: output: {output.name} must be an .exr or a .png")
+    try:
+        check_output_file(output)  # a named pipe or a device node there: never "exists, skipped", never replaced
+    except OSError as exc:
+        raise BatchError(f"{where}: output: {exc}") from None
     # Named by the user (with the swept settings added), or else by its file, which is unique.
     name = values["name"] + (f" {_describe(values, swept)}" if swept else "") if "name" in values else output.stem
     if "aperture_image" in values:  # relative to the batch file, as the outputs are
@@ -343,10 +356,21 @@ class _OutputFormatter(string.Formatter):
 
             value = format_shutter(value).removesuffix(" s")
         if isinstance(value, float) and not format_spec:
-            return f"{value:g}"
-        if isinstance(value, str):
-            return re.sub(r"[^A-Za-z0-9.+-]+", "_", value).strip("_")
-        return super().format_field(value, format_spec)
+            text = f"{value:g}"
+        elif isinstance(value, str):
+            text = re.sub(r"[^A-Za-z0-9.+-]+", "_", value).strip("_")
+        else:
+            text = super().format_field(value, format_spec)
+        # A value makes part of one name: never a character a name cannot show ({index:c} of 1 is "\x01"), a
+        # separator that would put the file in another folder ({index:c} of 47 is "/"), or a name of a folder.
+        if not text.isprintable() or any(sep in text for sep in ("/", "\\")) or text in (".", ".."):
+            raise _FieldMakesNoName(f"a field makes {ascii(text)}, which is no part of a file name (it must be "
+                                    "printable, without / or \\, and not . or ..)")
+        return text
+
+
+class _FieldMakesNoName(ValueError):
+    """A field of an output pattern whose value, formatted, cannot be part of a file's name."""
 
 
 class _ShutterTime(float):
@@ -369,14 +393,20 @@ def _output_name(values: dict, index: int, where: str) -> str:
     except UnicodeEncodeError:  # a lone surrogate ("\ud800" in JSON): no file system can hold it
         raise BatchError(f"{where}: output: {template!r} is not text a file name can hold") from None
     try:
-        return _OutputFormatter().format(template, **fields)
+        name = _OutputFormatter().format(template, **fields)
     except KeyError as exc:
         name = exc.args[0]
         problem = (f"this shot sets no {name}" if name in _KINDS else
                    f"unknown field {{{name}}}{_did_you_mean(str(name), [*_KINDS, 'index'])}")
         raise BatchError(f"{where}: output: '{template}' names {{{name}}}, but {problem}") from None
+    except _FieldMakesNoName as exc:
+        raise BatchError(f"{where}: output: '{template}': {exc}") from None
     except (ValueError, IndexError, TypeError, AttributeError) as exc:  # {index[0]}, {f_number.real.x}
         raise BatchError(f"{where}: output: '{template}' is not a valid name pattern ({exc})") from None
+    if not name.isprintable():  # a format character (U+202E turns the name's text around): no name shows it
+        raise BatchError(f"{where}: output: {ascii(name)} is not a name a terminal or a folder shows as it is "
+                         "(it holds characters that are not printable)")
+    return name
 
 
 def _check_outputs(shots: list[Shot], path: Path) -> None:

@@ -28,6 +28,8 @@ from dataclasses import MISSING, fields
 from pathlib import Path
 from typing import Any, Iterable, Mapping
 
+from lenslab.image_files import read_file_bytes
+
 __all__ = [
     "PresetError",
     "FieldError",
@@ -119,7 +121,7 @@ def preset_dirs(
 def read_json(path: Path) -> Any:
     """Parse one JSON file; any failure becomes a PresetError naming the file."""
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_file_bytes(path).decode("utf-8")  # a named pipe refused, not waited on
     except UnicodeDecodeError as exc:
         raise PresetError(path, None, f"not UTF-8 text ({exc.reason})") from exc
     except OSError as exc:

@@ -91,6 +91,36 @@ def kdtree(prim_bounds: np.ndarray, *, triangles: np.ndarray | None = None, fold
     return tree
 
 
+_PARTIAL = ".partial.npz"  # ".<key>.<pid>.partial.npz": a tree being written by process <pid>
+#: A partial file this old has lost its writer, wherever that ran: no tree takes an hour to write.
+_ORPHANED_AFTER_SECONDS = 3600
+
+
+def _remove_orphaned_partials(folder: Path) -> None:
+    """Remove the partial files of writers that no longer run on this machine, or that are older than any write
+    takes (a writer of another machine sharing the folder). Best effort: what cannot be removed stays."""
+    now = time.time()
+    try:
+        partials = [entry for entry in folder.glob(f".*{_PARTIAL}") if entry.is_file()]
+    except OSError:
+        return
+    for entry in partials:
+        pid_text = entry.name[: -len(_PARTIAL)].rpartition(".")[2]
+        try:
+            orphaned = now - entry.stat().st_mtime > _ORPHANED_AFTER_SECONDS
+            if not orphaned and pid_text.isdigit() and int(pid_text) != os.getpid():
+                try:
+                    os.kill(int(pid_text), 0)
+                except ProcessLookupError:
+                    orphaned = True
+                except OSError:  # EPERM: another user's process, alive
+                    pass
+            if orphaned:
+                entry.unlink()
+        except OSError:
+            continue
+
+
 def _budget(prim_count: int, options: dict) -> int:
     memory = options.get("memory_bytes")
     return reference_budget(prim_count, memory if memory is not None else bsp.available_memory_bytes())
@@ -119,10 +149,11 @@ def _read(path: Path, start: float) -> KdTree | None:
 
 
 def _write(path: Path, tree: KdTree) -> None:
-    """Write atomically (a reader never sees half a file); a folder that cannot be written is skipped."""
+    """Write atomically (a reader never sees half a file); a folder that cannot be written is skipped. A write
+    that fails (a full disk, a quota) or is interrupted takes its partial file with it."""
+    partial = path.with_name(f".{path.stem}.{os.getpid()}{_PARTIAL}")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        partial = path.with_name(f".{path.stem}.{os.getpid()}.partial.npz")
         ints = {name: value for name, value in tree.params.items() if isinstance(value, (int, np.integer))}
         texts = {name: value for name, value in tree.params.items() if isinstance(value, str)}
         floats = {name: float(value) for name, value in tree.params.items() if name not in ints and name not in texts}
@@ -134,12 +165,19 @@ def _write(path: Path, tree: KdTree) -> None:
                  float_param_values=np.array(list(floats.values()), np.float64),
                  str_param_names=np.array(list(texts), dtype=str), str_param_values=np.array(list(texts.values()), dtype=str))
         os.replace(partial, path)
-    except OSError:
-        return
+    except BaseException as exc:
+        try:
+            partial.unlink(missing_ok=True)
+        except OSError:
+            pass
+        if not isinstance(exc, OSError):
+            raise
 
 
 def _evict(folder: Path, keep: Path) -> None:
-    """Delete the least recently used trees until the folder holds at most MAX_CACHE_BYTES."""
+    """Delete the least recently used trees until the folder holds at most MAX_CACHE_BYTES, and the partial files
+    of writers that are gone (killed mid-write: they ran no clean-up)."""
+    _remove_orphaned_partials(folder)
     try:
         files = [(entry, entry.stat()) for entry in folder.glob("*.npz")]
     except OSError:

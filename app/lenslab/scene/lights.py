@@ -14,6 +14,11 @@ from lenslab.scene.textures import Texture
 RGB = tuple[float, float, float]
 Vec3 = tuple[float, float, float]
 
+#: The smallest angular diameter (degrees) of a sun that is a disk; 0 is a point at infinity. Between them the
+#: disk's radiance (irradiance over pi sin^2 of its angular radius) leaves the range of float32 on the GPU, and
+#: then of Python's floats (1e-200 degrees: a division by zero); from here on it stays within both.
+SMALLEST_SUN_DEG = 1e-6
+
 
 @dataclass
 class Light:
@@ -39,7 +44,8 @@ class SunLight(Light):
     type_name: ClassVar[str] = "sun"
     direction: Vec3 = field(default=(0.3, 1.0, 0.2), metadata={"nonzero_vector": True})
     irradiance: RGB = field(default=(3.0, 3.0, 3.0), metadata={"range": (0.0, 1e9)})
-    angular_diameter_deg: float = field(default=0.53, metadata={"range": (0.0, 30.0)})
+    angular_diameter_deg: float = field(default=0.53, metadata={"range": (0.0, 30.0),
+                                                                "zero_or_at_least": SMALLEST_SUN_DEG})
 
     def unit_direction(self) -> tuple[float, float, float]:
         n = math.sqrt(sum(c * c for c in self.direction))
@@ -49,9 +55,11 @@ class SunLight(Light):
 
     def radiance(self) -> RGB:
         """Radiance of the disk: irradiance over the cosine-weighted solid angle pi sin^2(theta_max)."""
-        theta = math.radians(self.angular_diameter_deg) / 2
-        if theta == 0:
+        if self.angular_diameter_deg == 0:
             return self.irradiance  # a delta light: the irradiance itself is what is carried
+        if not abs(self.angular_diameter_deg) >= SMALLEST_SUN_DEG:
+            raise ValueError(sun_size_problem(self))
+        theta = math.radians(self.angular_diameter_deg) / 2
         return tuple(e / (math.pi * math.sin(theta) ** 2) for e in self.irradiance)
 
 
@@ -114,6 +122,12 @@ class SpotLight(Light):
         if cutoff - beam < 1e-6:  # a hard edge: the plain cone
             return 2.0 * math.pi * (1.0 - math.cos(cutoff))
         return 2.0 * math.pi * (1.0 - (math.sin(cutoff) - math.sin(beam)) / (cutoff - beam))
+
+
+def sun_size_problem(sun: SunLight) -> str:
+    """The words for a sun whose angular diameter is neither 0 nor at least SMALLEST_SUN_DEG."""
+    return (f"sun '{sun.name}': angular_diameter_deg {sun.angular_diameter_deg:g} is too small to be a disk: give 0 "
+            f"(a point at infinity, sharp shadows) or at least {SMALLEST_SUN_DEG:g}")
 
 
 def _unit(vector, what: str) -> np.ndarray:

@@ -13,6 +13,8 @@ file's number or string, or from Python. Problems are ValueErrors of one line na
 
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -102,18 +104,29 @@ class Option:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise ValueError(f"{self.name}: expected a number, not {value!r}")
         if self.kind is int:
-            if value != int(value):
+            if isinstance(value, float) and (not math.isfinite(value) or value != int(value)):
                 raise ValueError(f"{self.name}: expected a whole number, not {value!r}")
             value = int(value)
         else:
-            value = float(value)
+            try:
+                value = float(value)
+            except OverflowError:  # an integer past the float range: out of every range
+                pass
         low, high = self.range
         if not low <= value <= high:  # also refuses NaN
-            raise ValueError(f"{self.name} {value:g} is out of range [{format_bound(low)}, {format_bound(high)}]")
+            raise ValueError(f"{self.name} {_shown(value)} is out of range [{format_bound(low)}, {format_bound(high)}]")
         reason = self.refuse(value) if self.refuse is not None else ""
         if reason:
-            raise ValueError(f"{self.name} {value:g}: {reason}")
+            raise ValueError(f"{self.name} {_shown(value)}: {reason}")
         return value
+
+
+def _shown(value: float) -> str:
+    """A number as a message shows it; an integer of any size (past the float range, ``{:g}`` overflows) cut short."""
+    if isinstance(value, int):
+        digits = str(value)
+        return digits if len(digits) <= 16 else f"{digits[:6]}... ({len(digits.lstrip('-'))} digits)"
+    return f"{value:g}"
 
 
 def format_bound(value: float) -> str:

@@ -7,6 +7,7 @@ import os
 from pathlib import Path
 from typing import Callable
 
+from lenslab.image_files import not_a_file
 from lenslab.messages import describe_os_error
 from lenslab.resources import scenes_dir
 from lenslab.scene.io.native import SCENE_SUFFIX, load_scene
@@ -57,6 +58,8 @@ def resolve_scene_path(text: str | os.PathLike) -> Path:
     shipped = scenes_dir() / str(text) / SCENE_FILE_NAME
     if os.path.isfile(shipped):
         return shipped
+    if not os.path.isdir(path) and not_a_file(path):  # a named pipe, a device: refused, not waited on
+        raise SceneError(f"{path}: {not_a_file(path)}")
     if os.path.isdir(path):
         raise SceneError(f"{path}: a folder with no {SCENE_FILE_NAME} in it (name the scene file itself, or a "
                          f"scene's folder)")

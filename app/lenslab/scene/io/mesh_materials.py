@@ -61,7 +61,8 @@ from pathlib import Path
 import numpy as np
 
 from lenslab.color import srgb_to_linear
-from lenslab.image_files import read_pixels
+from lenslab.image_files import check_regular_file, not_a_file, read_file_bytes, read_pixels
+from lenslab.limits import number_problem
 from lenslab.scene.io.meshes import LoadedMesh, MeshLoadError, MeshPart, check_geometry, smooth_normals
 from lenslab.scene.io.mitsuba_serialized import read_serialized
 from lenslab.scene.io.text_meshes import TextMeshPiece, read_ascii_ply, read_obj
@@ -83,8 +84,8 @@ def load_parts(path: Path, smooth: bool = True, shape_index: int = 0) -> LoadedM
     """The mesh file as parts, one per material it uses; cached by path, modification times, ``smooth`` and
     ``shape_index`` (which mesh of a Mitsuba .serialized file; other files hold one, and take only 0)."""
     path = Path(path)
-    if not os.path.isfile(path):
-        raise MeshLoadError(f"{path}: mesh file not found")
+    if not os.path.isfile(path):  # a named pipe or a device is refused, not waited on
+        raise MeshLoadError(f"{path}: {not_a_file(path) or 'mesh file not found'}")
     if shape_index and path.suffix.lower() != ".serialized":
         raise MeshLoadError(f"{path}: shape_index {shape_index}: only a Mitsuba .serialized file holds several "
                             "meshes (this file's is 0)")
@@ -322,6 +323,12 @@ def read_image_bytes(data: bytes, suffix: str) -> np.ndarray:
         os.unlink(name)
 
 
+def _not_there(path: Path) -> str:
+    """Why a file a material names cannot be read: "not found", or "is a named pipe (FIFO), not a regular file"."""
+    other = not_a_file(path)
+    return "not found" if other is None else f"is {other}"
+
+
 def _rgb3(pixels: np.ndarray) -> np.ndarray:
     return np.repeat(pixels[..., :1], 3, axis=2) if pixels.shape[2] < 3 else pixels[..., :3]
 
@@ -397,8 +404,13 @@ def _mtl_without_effect(key: str, keys: dict[str, tuple[str, str]]) -> bool:
 
 def parse_texture_statement(value: str) -> tuple[str, tuple[float, float], list[str]]:
     """``[-options] file`` -> (file, tiles from -s, options that were not applied)."""
+    return _texture_statement(value)[:3]
+
+
+def _texture_statement(value: str) -> tuple[str, tuple[float, float], list[str], list[float]]:
+    """parse_texture_statement's reading, and the numbers of its -o, -s and -t options (to be checked)."""
     tokens = value.split()
-    tiles, ignored, i = (1.0, 1.0), [], 0
+    tiles, ignored, i, numbers = (1.0, 1.0), [], 0, []
     while i < len(tokens) and tokens[i].lower() in MTL_TEXTURE_OPTIONS:
         written, option = tokens[i], tokens[i].lower()
         i += 1
@@ -407,6 +419,7 @@ def parse_texture_statement(value: str) -> tuple[str, tuple[float, float], list[
             while i < len(tokens) and len(args) < 3 and _floats(tokens[i]):
                 args.append(float(tokens[i]))
                 i += 1
+            numbers += args
         else:
             args = tokens[i:i + MTL_TEXTURE_OPTIONS[option]]
             i += MTL_TEXTURE_OPTIONS[option]
@@ -418,24 +431,42 @@ def parse_texture_statement(value: str) -> tuple[str, tuple[float, float], list[
             continue
         else:
             ignored.append(f"{written} {' '.join(_fmt(a) if isinstance(a, float) else a for a in args)}".strip())
-    return " ".join(tokens[i:]), tiles, ignored
+    return " ".join(tokens[i:]), tiles, ignored, numbers
 
 
 def _check_mtl_numbers(library: Path, material: str, keys: dict[str, tuple[str, str]]) -> None:
-    """Refuse a statement the mapping reads whose numbers are not finite (Ke nan, Kd 1e999): one would reach
-    the renderer as a material that makes every pixel it touches NaN, or silently be taken as zero."""
+    """Refuse a statement the mapping reads whose numbers are not finite (Ke nan, Kd 1e999, map_Kd -s nan nan)
+    or beyond the bound of every scene's numbers (limits.LARGEST_NUMBER): one would reach the renderer as a
+    material or a texture that makes every pixel it touches NaN, or silently be taken as zero."""
     for key, (written, value) in keys.items():
-        if key in MTL_HANDLED and not key.startswith("map_") and key != "newmtl":
-            if any(not math.isfinite(number) for number in _floats(value)):
+        if key not in MTL_HANDLED or key == "newmtl":
+            continue
+        for number in _texture_statement(value)[3] if key.startswith("map_") else _floats(value):
+            if not math.isfinite(number):
                 raise MeshLoadError(f"{library}: material '{material}': {written} {value}: not a finite number")
+            if number_problem(number):
+                raise MeshLoadError(f"{library}: material '{material}': {written} {value}: {number_problem(number)}")
+
+
+def _checked_resolver_class():
+    """trimesh's resolver of the files beside a mesh (an OBJ's textures, a glTF's buffers and images), refusing
+    a named pipe, a device or a folder (image_files.NotARegularFile) before trimesh opens it and waits."""
+    import trimesh
+
+    class Checked(trimesh.resolvers.FilePathResolver):
+        def get(self, name: str) -> bytes:
+            for candidate in (name.strip(), name.strip().lstrip("/"), os.path.split(name)[-1]):  # as trimesh tries
+                check_regular_file(os.path.join(self.parent, candidate))
+            return super().get(name)
+
+    return Checked
 
 
 def _all_libraries_resolver(path: Path, libraries: bytes):
     """A trimesh resolver that answers every request for an MTL file with ``libraries`` (all the OBJ's material
     libraries, joined), and any other (a texture) from the OBJ's folder."""
-    import trimesh
 
-    class AllLibraries(trimesh.resolvers.FilePathResolver):
+    class AllLibraries(_checked_resolver_class()):
         def get(self, name: str) -> bytes:
             if name.strip().lower().endswith(".mtl"):
                 return libraries
@@ -466,7 +497,7 @@ class ObjMaterials:
         self.definitions: dict[str, tuple[dict[str, tuple[str, str]], Path]] = {}  # name -> (keys, MTL folder)
         self._mapped: dict[str, Mapped] = {}
         self._library_files: list[Path] = []
-        text = path.read_bytes()
+        text = read_file_bytes(path)
         # None for a small file, or one outside the compiled reader's subset: trimesh reads those.
         self._compiled_reading = read_obj(text) if len(text) >= TEXT_COMPILED_MIN_BYTES else None
         libraries = self._compiled_reading.libraries if self._compiled_reading else _mtllib_statements(text)
@@ -478,11 +509,11 @@ class ObjMaterials:
         for name in names:
             library = self.path.parent / name.replace("\\", "/")
             if not os.path.isfile(library):
-                self.notes.add_file(f"material library '{name}' not found ({library}): its materials render "
-                                    "with the node's material or the default grey")
+                self.notes.add_file(f"material library '{name}' {_not_there(library)} ({library}): "
+                                    "its materials render with the node's material or the default grey")
                 continue
             self._library_files.append(library)
-            for material, keys in parse_mtl(library.read_text("utf-8", "replace")).items():
+            for material, keys in parse_mtl(read_file_bytes(library).decode("utf-8", "replace")).items():
                 _check_mtl_numbers(library, material, keys)
                 self.definitions.setdefault(material, (keys, library.parent))
 
@@ -493,7 +524,8 @@ class ObjMaterials:
             return _text_scene(self._compiled_reading.pieces, self.path)
         # trimesh reads only the first library an OBJ names; handed all of them as one, it names every material
         # the faces use, as the compiled reader does.
-        resolver = _all_libraries_resolver(self.path, b"\n".join(library.read_bytes() for library in self._library_files))
+        resolver = _all_libraries_resolver(self.path, b"\n".join(read_file_bytes(library)
+                                                                  for library in self._library_files))
         return trimesh.load(str(self.path), process=False, force="scene", resolver=resolver)
 
     def material_for(self, geometry) -> Mapped | None:
@@ -577,7 +609,8 @@ class ObjMaterials:
         path = Path(file.replace("\\", "/"))
         path = path if path.is_absolute() else folder / path
         if not os.path.isfile(path):
-            note(f"{written} texture file '{file}' not found ({path}): it renders as a magenta checkerboard")
+            note(f"{written} texture file '{file}' {_not_there(path)} ({path}): it renders as a "
+                 "magenta checkerboard")
         return ImageTexture(file=str(path), color_space=color_space, tiles=tiles)
 
 
@@ -610,10 +643,126 @@ def _gltf_without_effect(extension: str, values) -> bool:
     neutral = GLTF_NEUTRAL.get(extension)
     if neutral is None or not isinstance(values, dict):
         return False
-    at_default = all(np.allclose(values.get(key, default), default) for key, default in neutral.items())
+    try:
+        at_default = all(np.allclose(values.get(key, default), default) for key, default in neutral.items())
+    except (TypeError, ValueError):  # a factor that is no number: not known to be off, so reported as ignored
+        return False
     if extension == "KHR_materials_specular":  # neutral factors of 1: a texture still changes things
         return at_default and not any(key.endswith("Texture") for key in values)
     return at_default
+
+
+# What the material mapping reads of a glTF, and the JSON type each must have (glTF 2.0's schema): a file with
+# a number where a list belongs, a null factor or an object of images is refused in one line naming the field,
+# before anything is read from it. "info": a textureInfo; ("numbers", n): a list of n numbers.
+_TEXTURE_INFO = {"index": "index", "texCoord": "index", "extensions": dict, "scale": "number", "strength": "number"}
+_GLTF_MATERIAL = {
+    "name": str, "alphaMode": str, "doubleSided": bool, "emissiveFactor": ("numbers", 3), "extensions": dict,
+    "normalTexture": _TEXTURE_INFO, "occlusionTexture": _TEXTURE_INFO, "emissiveTexture": _TEXTURE_INFO,
+    "pbrMetallicRoughness": {"baseColorFactor": ("numbers", 4), "metallicFactor": "number",
+                             "roughnessFactor": "number", "baseColorTexture": _TEXTURE_INFO,
+                             "metallicRoughnessTexture": _TEXTURE_INFO},
+}
+_GLTF_EXTENSIONS = {
+    "KHR_materials_transmission": {"transmissionFactor": "number", "transmissionTexture": _TEXTURE_INFO},
+    "KHR_materials_ior": {"ior": "number"},
+    "KHR_materials_emissive_strength": {"emissiveStrength": "number"},
+    "KHR_materials_volume": {"attenuationDistance": "number", "attenuationColor": ("numbers", 3),
+                             "thicknessFactor": "number"},
+}
+_GLTF_LISTS = {  # top-level arrays: what each entry holds, and which other array each index points into
+    "materials": (_GLTF_MATERIAL, {}),
+    "textures": ({"source": "index", "sampler": "index", "extensions": dict}, {"source": "images",
+                                                                                "sampler": "samplers"}),
+    "samplers": ({"wrapS": "index", "wrapT": "index"}, {}),
+    "images": ({"uri": str, "mimeType": str, "bufferView": "index"}, {"bufferView": "bufferViews"}),
+    "bufferViews": ({"buffer": "index", "byteOffset": "index", "byteLength": "index"}, {"buffer": "buffers"}),
+    "buffers": ({"uri": str}, {}),
+}
+_GLTF_REQUIRED = {"bufferViews": ("buffer", "byteLength")}
+_JSON_TYPE_NAMES = {str: "a string", bool: "true or false", dict: "an object", "number": "a number",
+                    "index": "a whole number of 0 or more"}
+
+
+def _gltf_value_problem(value, kind) -> str | None:
+    """Why ``value`` is not of ``kind`` (see _GLTF_MATERIAL), or None."""
+    if isinstance(kind, dict):
+        if not isinstance(value, dict):
+            return f"expected an object, not {_json_shown(value)}"
+        return None
+    if isinstance(kind, tuple):
+        count = kind[1]
+        if not isinstance(value, list) or len(value) != count:
+            return f"expected a list of {count} numbers, not {_json_shown(value)}"
+        for item in value:
+            problem = _gltf_value_problem(item, "number")
+            if problem:
+                return problem
+        return None
+    if kind in ("number", "index"):
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            return f"expected {_JSON_TYPE_NAMES[kind]}, not {_json_shown(value)}"
+        if kind == "index" and (not isinstance(value, int) or value < 0):
+            return f"expected {_JSON_TYPE_NAMES[kind]}, not {_json_shown(value)}"
+        return number_problem(value)
+    if not isinstance(value, kind) or (kind is not bool and isinstance(value, bool)):
+        return f"expected {_JSON_TYPE_NAMES[kind]}, not {_json_shown(value)}"
+    return None
+
+
+def _json_shown(value) -> str:
+    text = json.dumps(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def _gltf_fields_problem(table: dict, fields: dict, where: str) -> str | None:
+    for key, kind in fields.items():
+        if key not in table:
+            continue
+        problem = _gltf_value_problem(table[key], kind)
+        if problem is None and isinstance(kind, dict):
+            problem = _gltf_fields_problem(table[key], kind, f"{where}.{key}")
+            if problem:
+                return problem
+        if problem:
+            return f"{where}.{key}: {problem}"
+    return None
+
+
+def _gltf_problem(header) -> str | None:
+    """The first field of a glTF's JSON that the material mapping reads and that has the wrong type, a number
+    that is not finite or beyond limits.LARGEST_NUMBER, or an index past the array it points into, as
+    "materials[0].pbrMetallicRoughness.baseColorFactor: expected a list of 4 numbers, not 0.5"; None if none."""
+    if not isinstance(header, dict):
+        return f"expected a glTF object at the top, not {_json_shown(header)}"
+    for name in _GLTF_LISTS:
+        if not isinstance(header.get(name, []), list):
+            return f"{name}: expected a list, not {_json_shown(header[name])}"
+    for name, (fields, points_into) in _GLTF_LISTS.items():
+        for i, entry in enumerate(header.get(name, [])):
+            where = f"{name}[{i}]"
+            if not isinstance(entry, dict):
+                return f"{where}: expected an object, not {_json_shown(entry)}"
+            problem = _gltf_fields_problem(entry, fields, where)
+            if problem:
+                return problem
+            missing = [key for key in _GLTF_REQUIRED.get(name, ()) if key not in entry]
+            if missing:
+                return f"{where}: no {missing[0]} (glTF requires one)"
+            for key, target in points_into.items():
+                count = len(header.get(target, []))
+                if key in entry and entry[key] >= count:
+                    return f"{where}.{key}: {entry[key]} points past the file's {count} {target}"
+            extensions = entry.get("extensions")
+            for extension, values in (extensions.items() if isinstance(extensions, dict) else ()):
+                if extension in _GLTF_EXTENSIONS or name == "textures":
+                    if not isinstance(values, dict):
+                        return f"{where}.extensions.{extension}: expected an object, not {_json_shown(values)}"
+                    problem = _gltf_fields_problem(values, _GLTF_EXTENSIONS.get(extension, {"source": "index"}),
+                                                   f"{where}.extensions.{extension}")
+                    if problem:
+                        return problem
+    return None
 
 
 def split_glb(data: bytes) -> tuple[dict, bytes | None]:
@@ -634,6 +783,14 @@ def split_glb(data: bytes) -> tuple[dict, bytes | None]:
     return header, binary
 
 
+def _base64(payload: str, index: int, what: str = "image") -> bytes:
+    """The bytes of a data URI's base64 payload; OSError (an unreadable image or buffer) where it is not base64."""
+    try:
+        return base64.b64decode(payload)
+    except ValueError as exc:
+        raise OSError(f"{what} {index}: its data URI is not base64 ({exc})") from None
+
+
 def join_glb(header: dict, binary: bytes | None) -> bytes:
     text = json.dumps(header).encode("utf-8")
     text += b" " * (-len(text) % 4)
@@ -647,14 +804,17 @@ def join_glb(header: dict, binary: bytes | None) -> bytes:
 class GltfMaterials:
     def __init__(self, path: Path, notes: Notes):
         self.path, self.notes = path, notes
-        data = path.read_bytes()
+        data = read_file_bytes(path)
         try:
             if data[:4] == b"glTF":
                 self.header, self.binary = split_glb(data)
             else:
                 self.header, self.binary = json.loads(data.decode("utf-8")), None
-        except (ValueError, struct.error, UnicodeDecodeError) as exc:
+        except (ValueError, struct.error, UnicodeDecodeError, RecursionError) as exc:
             raise MeshLoadError(f"{path}: cannot read glTF ({exc})") from None
+        problem = _gltf_problem(self.header)
+        if problem is not None:
+            raise MeshLoadError(f"{path}: {problem}")
         self.materials = self.header.get("materials", [])
         self._mapped: dict[int, Mapped] = {}
         self._textures: dict[tuple, Texture | None] = {}
@@ -669,10 +829,11 @@ class GltfMaterials:
             data, file_type = join_glb(header, self.binary), "glb"
         else:
             data, file_type = json.dumps(header).encode("utf-8"), "gltf"
+        checked = _checked_resolver_class()
         try:
-            resolver = trimesh.resolvers.FilePathResolver(str(self.path), allow_anywhere=True)
+            resolver = checked(str(self.path), allow_anywhere=True)
         except TypeError:  # trimesh before allow_anywhere
-            resolver = trimesh.resolvers.FilePathResolver(str(self.path))
+            resolver = checked(str(self.path))
         return trimesh.load(io.BytesIO(data), file_type=file_type, resolver=resolver, process=False, force="scene")
 
     def material_for(self, geometry) -> Mapped | None:
@@ -832,9 +993,12 @@ class GltfMaterials:
                 if "uri" in image:
                     head, _, payload = image["uri"].partition(",")
                     suffix = MIME_SUFFIX.get(head[5:].split(";")[0], suffix)
-                    data = base64.b64decode(payload) if head.endswith(";base64") else urllib.parse.unquote_to_bytes(payload)
-                else:
+                    data = (_base64(payload, image_index) if head.endswith(";base64")
+                            else urllib.parse.unquote_to_bytes(payload))
+                elif "bufferView" in image:
                     data = self._buffer_view(image["bufferView"])
+                else:
+                    raise OSError(f"image {image_index} has neither a uri nor a bufferView")
                 self._pixels[image_index] = read_image_bytes(data, suffix)
         return self._pixels[image_index]
 
@@ -845,9 +1009,9 @@ class GltfMaterials:
         if uri is None:
             data = self.binary or b""
         elif uri.startswith("data:"):
-            data = base64.b64decode(uri.partition(",")[2])
+            data = _base64(uri.partition(",")[2], view["buffer"], "buffer")
         else:
-            data = (self.path.parent / urllib.parse.unquote(uri)).read_bytes()
+            data = read_file_bytes(self.path.parent / urllib.parse.unquote(uri))
         start = view.get("byteOffset", 0)
         return data[start: start + view["byteLength"]]
 
@@ -858,7 +1022,7 @@ class GltfMaterials:
         if path is None or os.path.isfile(path):
             return None
         uri = self.header["images"][image_index]["uri"]
-        note(f"{role} texture file '{uri}' not found ({path}): {fallback}")
+        note(f"{role} texture file '{uri}' {_not_there(path)} ({path}): {fallback}")
         return path
 
     def _colour_texture(self, info: dict, factor, role: str, note) -> Texture | None:

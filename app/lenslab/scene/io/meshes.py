@@ -13,6 +13,7 @@ import numpy as np
 
 from dataclasses import dataclass, field
 
+from lenslab.image_files import not_a_file
 from lenslab.limits import LARGEST_NUMBER
 from lenslab.scene.materials import Material
 from lenslab.scene.shapes import TriangleMesh
@@ -112,7 +113,7 @@ def load_mesh(path: Path, smooth: bool = True, shape_index: int = 0) -> Triangle
     It is read as a scene reads it (load_mesh_parts): a PLY with texture coordinates once needed PIL here."""
     path = Path(path)
     if not os.path.isfile(path):
-        raise MeshLoadError(f"{path}: mesh file not found")
+        raise MeshLoadError(f"{path}: {not_a_file(path) or 'mesh file not found'}")
     return join_parts([part.mesh for part in load_mesh_parts(path, smooth, shape_index).parts])
 
 

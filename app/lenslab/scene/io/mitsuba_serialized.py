@@ -39,6 +39,7 @@ from typing import BinaryIO
 
 import numpy as np
 
+from lenslab.image_files import open_file
 from lenslab.limits import available_memory_bytes, format_bytes
 from lenslab.scene.io.meshes import MeshLoadError
 from lenslab.scene.shapes import TriangleMesh
@@ -59,7 +60,7 @@ def read_serialized(path: Path | str, shape_index: int = 0) -> TriangleMesh:
     if shape_index < 0:
         raise MeshLoadError(f"{path}: shape_index {shape_index} is negative")
     try:
-        with open(path, "rb") as file:
+        with open_file(path) as file:  # a named pipe or a device is refused, not waited on
             size = os.fstat(file.fileno()).st_size
             version = _header(file, 0, size, path)
             start = 0 if shape_index == 0 else _offset(file, size, version, shape_index, path)
@@ -196,15 +197,25 @@ class _Inflated:
             self._ready += out
 
     def _step(self, limit: int) -> bytes | None:
-        """At most ``limit`` more bytes (perhaps none yet); None where the stream or the file has ended."""
-        if not self._tail and not self._zlib.eof and not self._file_ended:
+        """At most ``limit`` more bytes (perhaps none yet); None where the stream or the file has ended.
+
+        Every call that returns bytes has inflated some or taken compressed bytes from the file, so the loops
+        above end within the file's size: a call that would do neither (a stream that ends before its counts
+        are met, with bytes after it, which zlib leaves in ``unconsumed_tail`` for ever) is the end."""
+        if self._zlib.eof:  # bytes after the stream's end belong to the next mesh or the table, not to this one
+            self._tail = b""
+            return None
+        read = False
+        if not self._tail and not self._file_ended:
             self._tail = self._file.read(_CHUNK)
             self._file_ended = len(self._tail) < _CHUNK
+            read = bool(self._tail)
+        before = len(self._tail)
         try:
             out = self._zlib.decompress(self._tail, limit)
         except zlib.error as exc:
             raise MeshLoadError(f"{self._where} is damaged ({exc})") from None
-        self._tail = self._zlib.unconsumed_tail
-        if not out and not self._tail and (self._zlib.eof or self._file_ended):
+        self._tail = b"" if self._zlib.eof else self._zlib.unconsumed_tail
+        if not out and not read and len(self._tail) >= before:  # no progress: nothing more will come
             return None
         return out

@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from lenslab.image_files import not_found
 from lenslab.limits import LARGEST_NUMBER
 from lenslab.scene.materials import Material
 from lenslab.scene.shapes import Cylinder
@@ -101,7 +102,7 @@ def read_bitmap(imp: "MitsubaImporter", node: "XNode") -> ImageTexture:
         raise node.error('a bitmap needs a "filename"')
     path = imp.resolve_file(node, filename)
     if not os.path.isfile(path):
-        imp.warn(node, f"texture file not found: {path}; LensLab shows a magenta checkerboard in its place")
+        imp.warn(node, f"{not_found('texture file', path)}; LensLab shows a magenta checkerboard in its place")
     return ImageTexture(file=imp.scene_relative_path(path), color_space="linear" if raw else "auto", wrap=wrap_mode,
                         filter=filter_type, **_texture_fields(imp, node, matrix))
 

@@ -16,6 +16,7 @@ import re
 
 import numpy as np
 
+from lenslab.limits import LARGEST_NUMBER
 from lenslab.scene.transform import Transform
 
 RGB = tuple[float, float, float]
@@ -176,12 +177,20 @@ def nearest_similarity(m: np.ndarray) -> np.ndarray:
 _SPLIT = re.compile(r"[\s,]+")
 
 
+class NumberTooLarge(ValueError):
+    """A number that reads, but beyond limits.LARGEST_NUMBER: said as it is, not as a number that did not parse."""
+
+
 def parse_number(text: str) -> float:
     """One number of a scene file. Mitsuba would take "nan" or "inf" as well; nothing in a scene has a use
-    for them, and one would reach the GPU as a pixel that never converges, so they are refused here."""
+    for them, and one would reach the GPU as a pixel that never converges, so they are refused here; so is a
+    number beyond the bound of every scene's numbers (limits.LARGEST_NUMBER, as native scenes): a radiance of
+    1e308 is finite in Python and infinite in the float32 light tables."""
     value = float(text)
     if not math.isfinite(value):
         raise ValueError(f"'{text.strip()}' is not a finite number")
+    if abs(value) > LARGEST_NUMBER:
+        raise NumberTooLarge(f"'{text.strip()}' is too large (the most any value may be is {LARGEST_NUMBER:g})")
     return value
 
 
@@ -241,7 +250,7 @@ def parse_spectrum(text: str) -> list[tuple[float, float]] | float:
         if item.count(":") != 1:
             raise ValueError(f"'{item}' is not a wavelength:value pair")
         w, v = item.split(":")
-        pairs.append((float(w), float(v)))
+        pairs.append((parse_number(w), parse_number(v)))
     pairs.sort()
     if len(pairs) < 2:
         raise ValueError("a sampled spectrum needs at least two wavelength:value pairs")

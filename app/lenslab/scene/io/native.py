@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from lenslab.atomic import atomic_path
+from lenslab.image_files import not_found, read_file_bytes
 from lenslab.limits import LARGEST_NUMBER
 from lenslab.scene.materials import MATERIAL_TYPES, Material
 from lenslab.scene.scene import ENVIRONMENT_TYPES, Environment, Node, Scene, SceneError
@@ -86,6 +87,8 @@ def _read_number(value: Any, kind: type, path: str, meta: dict) -> float | int:
             raise _Invalid(path, f"{_describe(value)} is out of range [{lo:g}, {hi:g}]")
     if meta.get("nonzero") and value == 0:
         raise _Invalid(path, "must not be zero")
+    if "zero_or_at_least" in meta and 0 < abs(value) < meta["zero_or_at_least"]:  # a sun too small to be a disk
+        raise _Invalid(path, f"{_describe(value)} is too small: give 0 or at least {meta['zero_or_at_least']:g}")
     return int(value) if kind is int else float(value)
 
 
@@ -181,7 +184,7 @@ def _check_references(scene: Scene) -> None:
                 if not mesh_path.is_absolute():
                     mesh_path = scene.base_dir() / mesh_path
                 if not os.path.isfile(mesh_path):
-                    raise _Invalid(_join(_join(node_path, "shape"), "file"), f"mesh file not found: {mesh_path}")
+                    raise _Invalid(_join(_join(node_path, "shape"), "file"), not_found("mesh file", mesh_path))
             visit(node.children, _join(node_path, "children"))
 
     visit(scene.nodes, "nodes")
@@ -226,10 +229,12 @@ def scene_from_dict(data: Any, source_path: Path | None = None) -> Scene:
 def load_scene(path: str | os.PathLike) -> Scene:
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_file_bytes(path).decode("utf-8")  # a named pipe or a device is refused, not waited on
     except FileNotFoundError:
         raise SceneError(f"{path}: no such scene file") from None
-    except (OSError, UnicodeDecodeError) as exc:
+    except OSError as exc:
+        raise SceneError(f"{path}: cannot read ({exc.strerror or exc})") from None
+    except UnicodeDecodeError as exc:
         raise SceneError(f"{path}: cannot read ({exc})") from None
     try:
         data = json.loads(text)

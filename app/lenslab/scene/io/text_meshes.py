@@ -24,6 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
+from lenslab.image_files import read_file_bytes
+
 
 @dataclass(frozen=True)
 class TextMeshPiece:
@@ -129,7 +131,7 @@ def read_ascii_ply(path: Path) -> TextMeshPiece | None:
     compiled = _compiled()
     if compiled is None:
         return None
-    raw = Path(path).read_bytes()
+    raw = read_file_bytes(path)
     header_end = raw.find(b"end_header")
     if not raw.startswith(b"ply") or header_end < 0:
         return None
