@@ -49,6 +49,7 @@ def render(renderer, scene, spp, specialise):
     return image
 
 
+@pytest.mark.slow  # compiles the general kernel: minutes on llvmpipe with a cold shader cache
 @pytest.mark.parametrize("name", SHIPPED)
 def test_specialised_and_general_kernels_render_the_same_image(renderer, name):
     # The same seed draws the same random numbers in both kernels, so the images agree pixel by pixel up to
@@ -97,6 +98,7 @@ def test_a_scene_renders_flat_only_when_its_tree_saves_little_and_it_is_small():
     assert not renders_flat(crowded, 0)
 
 
+@pytest.mark.slow  # compiles the general kernel: minutes on llvmpipe with a cold shader cache
 def test_cut_outs_and_spheres_render_the_same_flat_as_through_the_tree(renderer):
     from tests.test_material_layers import facing_a_square
     from lenslab.scene.materials import Mask

@@ -38,6 +38,7 @@ def _seeded_run(count: int, seed: int, folder: Path) -> None:
     assert not failures, f"{len(failures)} of {count} cases broke the contract:\n" + "\n".join(failures)
 
 
+@pytest.mark.slow  # its scenes compile dozens of kernel variants: minutes on llvmpipe with a cold shader cache
 def test_a_seeded_run_of_malformed_inputs_meets_the_contract(tmp_path):
     _seeded_run(300, 2026, tmp_path)
 

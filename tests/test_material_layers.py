@@ -203,6 +203,7 @@ def test_materials_nested_too_deep_are_refused_by_name(tmp_path):
         MaterialTable([material], TextureTable(base_dir=tmp_path), ["deep"])
 
 
+@pytest.mark.slow  # compiles the general kernel: minutes on llvmpipe with a cold shader cache
 def test_specialised_and_general_kernels_agree_on_layered_materials(renderer):
     blend = Blend(first=Mask(material=Diffuse((0.7, 0.2, 0.2)), opacity=0.6),
                   second=Conductor(roughness=0.5, distribution="beckmann"), weight=0.4)
