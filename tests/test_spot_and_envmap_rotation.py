@@ -213,6 +213,7 @@ def test_spots_share_next_event_estimation_fairly_by_power_or_at_the_point(rende
         assert image.mean(axis=(0, 1)) == pytest.approx(expected.mean(axis=(0, 1)), rel=0.01)
 
 
+@pytest.mark.slow  # compiles the general kernel: minutes on llvmpipe with a cold shader cache
 def test_a_scene_with_a_spot_compiles_a_kernel_with_spots_that_matches_the_general_one(renderer):
     spot = SpotLight("spot", position=(0.0, 1.5, 0.0), intensity=(3.0,) * 3, cutoff_angle_deg=25.0)
     scene = floor_scene([spot], resolution=16)
