@@ -51,26 +51,30 @@ def _kind(mode: int) -> str:
     return next((kind for test, kind in _NOT_REGULAR if test(mode)), "not a file")
 
 
-def check_regular_file(path: str | os.PathLike) -> None:
-    """Raise NotARegularFile where ``path`` exists and is anything but a regular file (links followed), before a
-    library opens it by name. A path that does not exist, or cannot be asked after, passes: the reader's own
-    error says so, as it always has."""
+def _other_kind_at(path: str | os.PathLike) -> str | None:
+    """What is at ``path`` ("a named pipe (FIFO)") when it exists and is anything but a regular file (links
+    followed); None for a regular file, or a path that does not exist or cannot be asked after (missing, no
+    access, a name too long, a NUL in it): the reader's own error says so, as it always has."""
     try:
         mode = os.stat(path).st_mode
-    except (OSError, ValueError):  # missing, no access, a name too long, a NUL in it: the reader tells
-        return
-    if not stat.S_ISREG(mode):
-        raise NotARegularFile(path, _kind(mode))
+    except (OSError, ValueError):
+        return None
+    return None if stat.S_ISREG(mode) else _kind(mode)
+
+
+def check_regular_file(path: str | os.PathLike) -> None:
+    """Raise NotARegularFile where ``path`` exists and is anything but a regular file, before a library opens it
+    by name."""
+    kind = _other_kind_at(path)
+    if kind is not None:
+        raise NotARegularFile(path, kind)
 
 
 def not_a_file(path: str | os.PathLike) -> str | None:
     """What is at ``path`` when it is something other than a regular file ("a named pipe (FIFO), not a regular
     file"); None where it is a regular file or nothing at all."""
-    try:
-        mode = os.stat(path).st_mode
-    except (OSError, ValueError):
-        return None
-    return None if stat.S_ISREG(mode) else f"{_kind(mode)}, not a regular file"
+    kind = _other_kind_at(path)
+    return None if kind is None else f"{kind}, not a regular file"
 
 
 def not_found(what: str, path: str | os.PathLike) -> str:

@@ -36,7 +36,7 @@ from lenslab.gui.panel_scroll import PanelScroll
 from lenslab.gui.wheel_guard import guard_wheels
 from lenslab.gui.widgets import ColorEdit, IntEdit, NumberEdit, Section, VectorEdit, hint
 from lenslab.scene.editing import file_reference, screen_drag_rate
-from lenslab.scene.fields import range_holding
+from lenslab.scene.fields import control_bounds, range_holding
 from lenslab.scene.lights import LIGHT_TYPES, Light
 from lenslab.scene.materials import MATERIAL_TYPES, Diffuse, Material
 from lenslab.scene.textures import TEXTURE_TYPES, Texture
@@ -401,7 +401,7 @@ class PropertyEditor(QWidget):
     def _make_editor(self, target, path, annotation, value, meta) -> FieldEditor | None:
         # What the control offers (a field's "controls", else its "range"), widened to show a scene's value beyond
         # it as it is: a control limits what it offers, never what a scene holds.
-        lo, hi = meta.get("controls", meta.get("range", (-1e6, 1e6)))
+        lo, hi = control_bounds(meta, (-1e6, 1e6))
         if isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value):
             lo, hi = range_holding(lo, hi, value)
         origin = typing.get_origin(annotation)

@@ -182,20 +182,21 @@ _SAME_STOP_REL_TOL = 1e-3
 def is_valid_f_number(n: float) -> bool:
     """True when ``n`` is an f-number a scene may hold: a finite number in :data:`F_NUMBER_RANGE` (f/0.13 is one;
     the studio's controls offer :data:`F_NUMBER_CONTROL_RANGE`)."""
-    try:
-        n = float(n)
-    except (TypeError, ValueError):
-        return False
-    return F_NUMBER_RANGE[0] <= n <= F_NUMBER_RANGE[1]
+    return _number_within(n, F_NUMBER_RANGE)
 
 
 def is_offered_f_number(n: float) -> bool:
     """True when ``n`` lies in what the controls offer and a lens may mark, :data:`F_NUMBER_CONTROL_RANGE`."""
+    return _number_within(n, F_NUMBER_CONTROL_RANGE)
+
+
+def _number_within(n, bounds: tuple[float, float]) -> bool:
+    """Whether ``n`` is a number in [low, high] (NaN is in no range)."""
     try:
         n = float(n)
     except (TypeError, ValueError):
         return False
-    return MIN_F_NUMBER <= n <= MAX_F_NUMBER
+    return bounds[0] <= n <= bounds[1]
 
 
 def _checked(n: float) -> float:

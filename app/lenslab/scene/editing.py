@@ -314,18 +314,12 @@ def _rounded(v, digits: int) -> tuple[float, ...]:
 
 
 # -- the camera ---------------------------------------------------------------------------------------------------
-def closest_focus(camera, lens=None) -> float:
-    """The nearest focus distance (in the camera's reference) the camera can set: the thin lens's limit, and a
-    mounted lens's marked minimum (which is from the sensor plane); the camera's own check."""
-    return camera.closest_focus_with(lens)
-
-
 def camera_changes_keeping_focus(camera, lens=None, **changes) -> dict:
     """``changes`` to the camera, plus the focus moved out to the closest the new camera can focus if it was
     nearer (a longer focal length or a lens with a farther minimum cannot focus as close): the camera stays one
     the renderer can draw, and the user sees why in the focus field."""
     changed = dataclasses.replace(camera, **changes)
-    closest = closest_focus(changed, lens)
+    closest = changed.closest_focus_with(lens)
     if changed.focus_distance_m < closest:
         changes = {**changes, "focus_distance_m": math.ceil(closest * 1e4) / 1e4}
     return changes

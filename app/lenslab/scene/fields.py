@@ -36,8 +36,13 @@ def declared_choices(cls: type, field_name: str) -> tuple[str, ...]:
 def control_range(cls: type, field_name: str) -> tuple:
     """(low, high) the studio's controls offer for a numeric field of ``cls``: its ``"controls"`` metadata, else
     its declared range."""
-    meta = _metadata(cls, field_name)
-    return tuple(meta["controls"] if "controls" in meta else meta["range"])
+    return control_bounds(_metadata(cls, field_name))
+
+
+def control_bounds(metadata, default: tuple | None = None) -> tuple:
+    """(low, high) a control offers for a field with this metadata: its ``"controls"``, else its ``"range"``, else
+    ``default``."""
+    return tuple(metadata.get("controls", metadata.get("range", default)))
 
 
 def range_holding(low: float, high: float, value: float) -> tuple[float, float]:

@@ -16,7 +16,6 @@ from lenslab.gui.widgets import DragSlider, NumberEdit, hint, log_to_slider, sli
 from lenslab.optics import LensPreset, format_distance
 from lenslab.scene.camera import ThinLensCamera
 from lenslab.scene.editable import CAMERA
-from lenslab.scene.editing import closest_focus
 from lenslab.scene.fields import control_range
 
 if TYPE_CHECKING:
@@ -27,7 +26,7 @@ FOCUS_RANGE = (0.05, 200.0)
 
 def focus_limits_for(cam: ThinLensCamera, lens: LensPreset | None) -> tuple[float, float]:
     """The focus distances the camera (and its lens) can set, in its reference."""
-    return closest_focus(cam, lens), FOCUS_RANGE[1]
+    return cam.closest_focus_with(lens), FOCUS_RANGE[1]
 
 
 class FocusSection(CameraSection):

@@ -58,8 +58,9 @@ def resolve_scene_path(text: str | os.PathLike) -> Path:
     shipped = scenes_dir() / str(text) / SCENE_FILE_NAME
     if os.path.isfile(shipped):
         return shipped
-    if not os.path.isdir(path) and not_a_file(path):  # a named pipe, a device: refused, not waited on
-        raise SceneError(f"{path}: {not_a_file(path)}")
+    other = None if os.path.isdir(path) else not_a_file(path)
+    if other:  # a named pipe, a device: refused, not waited on
+        raise SceneError(f"{path}: {other}")
     if os.path.isdir(path):
         raise SceneError(f"{path}: a folder with no {SCENE_FILE_NAME} in it (name the scene file itself, or a "
                          f"scene's folder)")

@@ -444,8 +444,9 @@ def _check_mtl_numbers(library: Path, material: str, keys: dict[str, tuple[str, 
         for number in _texture_statement(value)[3] if key.startswith("map_") else _floats(value):
             if not math.isfinite(number):
                 raise MeshLoadError(f"{library}: material '{material}': {written} {value}: not a finite number")
-            if number_problem(number):
-                raise MeshLoadError(f"{library}: material '{material}': {written} {value}: {number_problem(number)}")
+            problem = number_problem(number)
+            if problem:
+                raise MeshLoadError(f"{library}: material '{material}': {written} {value}: {problem}")
 
 
 def _checked_resolver_class():
