@@ -1,4 +1,4 @@
-// The thin-lens camera (docs/architecture.md, "The camera"). Mirrors the host's
+// The thin-lens camera (docs/architecture.md, "The camera"), and the real lens's dispatch (real_lens.glsl). Mirrors the host's
 // CameraFrame.rays (app/lenslab/scene/camera.py); glsl/camera_probe.comp and tests/test_camera_rays.py compare them.
 //
 // The camera looks down its local -Z. A pinhole ray through the image point (x, y) has the direction
@@ -72,14 +72,24 @@ vec2 sample_aperture_image(vec2 u) {
     return vec2(2.0 * x / float(cols) - 1.0, 1.0 - 2.0 * y / float(rows));
 }
 
-// pixel_sample: continuous pixel coordinates, (0,0) at the top-left corner of the image. `weight`: 0 where the
-// barrel blocks the ray, else the aperture sample's weight (1 but for rounded blades).
-Ray camera_ray(vec2 pixel_sample, vec2 u_lens, out float weight) {
+#include "real_lens.glsl"
+
+// pixel_sample: continuous pixel coordinates, (0,0) at the top-left corner of the image. `colour_weight`: 0 where
+// the barrel or the glass blocks the ray, else the aperture sample's weight (1 but for rounded blades and a real
+// lens), per colour channel (a dispersive real lens traces each sample at one channel's wavelength).
+Ray camera_ray(vec2 pixel_sample, vec2 u_lens, out vec3 colour_weight) {
     vec2 ndc = vec2(2.0 * pixel_sample.x / float(image_size.x) - 1.0,
                     1.0 - 2.0 * pixel_sample.y / float(image_size.y));
+    if (lens_surface_count > 0) {  // traced through the glass, in the camera's frame (mm), then to the world
+        Ray local = real_lens_ray(ndc, u_lens, colour_weight);
+        Ray ray;
+        ray.o = cam_position + cam_to_world * (local.o * 0.001);
+        ray.d = normalize(cam_to_world * local.d);
+        return ray;
+    }
     vec3 pinhole_dir = vec3(ndc * cam_tan_half_fov, -1.0);
     vec3 focus_point = pinhole_dir * cam_focus_distance;
-    weight = 1.0;
+    float weight = 1.0;
     vec2 lens;
     if (cam_aperture_kind == APERTURE_BLADES) lens = sample_polygon(u_lens, cam_blades, cam_blade_rotation);
     else if (cam_aperture_kind == APERTURE_ROUNDED_BLADES) lens = sample_rounded_blades(u_lens, weight);
@@ -91,5 +101,6 @@ Ray camera_ray(vec2 pixel_sample, vec2 u_lens, out float weight) {
     Ray ray;
     ray.o = cam_position + cam_to_world * origin;
     ray.d = normalize(cam_to_world * (focus_point - origin));
+    colour_weight = vec3(weight);
     return ray;
 }

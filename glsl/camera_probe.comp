@@ -11,7 +11,7 @@ layout(local_size_x = LOCAL_SIZE_X) in;
 
 // In, one vec4 per item: (pixel x, pixel y, lens u, lens v), pixels as in camera_ray().
 layout(std430, binding = PROBE_IN_BINDING) readonly buffer ProbeIn { vec4 probe_in[]; };
-// Out, two vec4 per item: (origin, weight), (direction, 0).
+// Out, three vec4 per item: (origin, red weight), (direction, green weight), (blue weight, 0, 0, 0).
 layout(std430, binding = PROBE_OUT_BINDING) writeonly buffer ProbeOut { vec4 probe_out[]; };
 
 uniform int item_count;
@@ -20,8 +20,9 @@ void main() {
     int i = int(gl_GlobalInvocationID.x);
     if (i >= item_count) return;
     vec4 item = probe_in[i];
-    float weight;
+    vec3 weight;
     Ray ray = camera_ray(item.xy, item.zw, weight);
-    probe_out[2 * i] = vec4(ray.o, weight);
-    probe_out[2 * i + 1] = vec4(ray.d, 0.0);
+    probe_out[3 * i] = vec4(ray.o, weight.r);
+    probe_out[3 * i + 1] = vec4(ray.d, weight.g);
+    probe_out[3 * i + 2] = vec4(weight.b, 0.0, 0.0, 0.0);
 }

@@ -97,11 +97,12 @@ void main() {
     for (int k = 0; k < sample_count; k++) {
         Sampler sampler = sampler_start(pixel, sample_start + uint(k), seed);
         vec4 u = sample4(sampler);  // pixel position and lens position, jointly stratified
-        float lens_weight;  // 0 where the lens barrel blocks the ray (cat's-eye bokeh, optical vignetting)
+        vec3 lens_weight;  // 0 where the lens barrel or the glass blocks the ray (cat's eye, vignetting)
         Ray ray = camera_ray(vec2(pixel) + 0.5 + pixel_offset(u.xy), u.zw, lens_weight);
-        vec3 l = lens_weight > 0.0 ? lens_weight * path_radiance(ray, sampler) : vec3(0.0);
+        bool through = max_component(lens_weight) > 0.0;
+        vec3 l = through ? lens_weight * path_radiance(ray, sampler) : vec3(0.0);
 #if HAS_FEATURE_BUFFERS
-        if (lens_weight > 0.0) {  // a ray the barrel blocks shows no surface: it is not counted
+        if (through) {  // a ray the barrel blocks shows no surface: it is not counted
             albedo_sum += vec4(feature_albedo, 1.0);
             normal_sum.xyz += feature_normal;
         }

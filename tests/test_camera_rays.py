@@ -120,14 +120,16 @@ def shader_rays(renderer, camera, width, height, items, *, with_weights=False):
     table = ApertureTable(ctx)
     table.bind(frame.aperture)
     source = ctx.buffer(np.asarray(items, np.float32).tobytes())
-    result = ctx.buffer(reserve=len(items) * 32)
+    result = ctx.buffer(reserve=len(items) * 48)
     source.bind_to_storage_buffer(PROBE_IN_BINDING)
     result.bind_to_storage_buffer(PROBE_OUT_BINDING)
     program.run((len(items) + PROBE_GROUP_SIZE - 1) // PROBE_GROUP_SIZE, 1, 1)
-    out = np.frombuffer(result.read(), np.float32).reshape(-1, 2, 4).copy()
+    out = np.frombuffer(result.read(), np.float32).reshape(-1, 3, 4).copy()
     source.release()
     result.release()
     table.release()
+    if with_weights == "colour":  # (N, 3): a real lens weighs each channel
+        return out[:, 0, :3], out[:, 1, :3], np.stack([out[:, 0, 3], out[:, 1, 3], out[:, 2, 0]], axis=-1)
     if with_weights:
         return out[:, 0, :3], out[:, 1, :3], out[:, 0, 3]
     return out[:, 0, :3], out[:, 1, :3]

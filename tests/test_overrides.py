@@ -56,7 +56,7 @@ def test_a_lens_mounts_its_focal_length_aperture_range_and_iris():
 
 
 @pytest.mark.parametrize("bad, message", [
-    ({"lens": "400mm"}, "no lens preset called '400mm' (there are: 14 mm f/2.8, "),
+    ({"lens": "400mm"}, "no lens preset called '400mm' (there are: 10 mm f/4 fisheye, 14 mm f/2.8, "),
     ({"lens": "85mm f1.4", "f_number": 1.2}, "f/1.2 is not on the lens '85 mm f/1.4'"),
     ({"lens": "24-70 mm f/2.8", "focal_length": 85}, "focal_length 85 mm is not on the lens '24-70 mm f/2.8'"),
 ])

@@ -1,22 +1,32 @@
-"""Lens presets: primes and zooms with their aperture range and iris, one JSON file each.
+"""Lens presets: primes and zooms with their aperture range and iris, one file each.
 
 A lens preset limits what the camera panel offers (focal length, f-number)
 and tells the renderer the shape of the aperture: ``aperture_blades`` straight
 (or rounded) blades make polygonal bokeh, 0 means a circular stop.
+
+Two kinds share the lens list. A thin-lens preset (a JSON file of the keys below) sets the thin-lens camera's
+controls. A real lens (a prescription: our TOML or JSON with ``surfaces``, or pbrt's ``.dat``; see
+optics/prescription.py) is traced through its glass, and its focal length and widest aperture come from the glass
+(docs/lenses.md).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
+from pathlib import Path
 from dataclasses import KW_ONLY, dataclass, field
-from typing import Iterable, Sequence
+from typing import TYPE_CHECKING, Iterable, Sequence
 
 from .presetfiles import FieldError, PresetError, build_preset, merge_by_name, preset_dirs, read_json
 from .stops import MAX_F_NUMBER, MIN_F_NUMBER, Scale, exact_f_number, is_offered_f_number
 # A lens preset is a control (the studio mounts it): it marks stops and focal lengths within the controls' ranges,
 # not everything a scene may hold (stops.F_NUMBER_RANGE, thinlens.FOCAL_LENGTH_RANGE_MM).
 from .thinlens import FOCAL_LENGTH_CONTROL_RANGE_MM
+
+if TYPE_CHECKING:  # prescription.py takes the iris's limits from here
+    from .prescription import LensPrescription
 
 __all__ = ["LensPreset", "LENSES_DIR", "MAX_APERTURE_BLADES", "find_lens", "load_lens_presets"]
 
@@ -58,6 +68,16 @@ class LensPreset:
     min_focus_distance_m: float | None = None
     #: Free text shown as a tooltip.
     description: str = field(default="", compare=False)
+    #: A real lens's glass, traced by the renderer (None: a thin-lens preset).
+    prescription: LensPrescription | None = None
+    #: A real lens read from a file named by its path (not found by name in a presets folder): that path, which a
+    #: camera mounting it records as its ``real_lens``.
+    source_file: str = field(default="", compare=False)
+
+    @property
+    def is_real(self) -> bool:
+        """Traced through its glass, rather than a thin lens with controls."""
+        return self.prescription is not None
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name.strip():
@@ -172,12 +192,19 @@ class LensPreset:
 
     def mount(self, focal_length_mm: float, f_number: float) -> dict[str, object]:
         """The camera settings this lens gives a camera set to ``focal_length_mm`` and ``f_number``: the focal
-        length and aperture kept within what the lens can do, and the lens's iris (as ThinLensCamera's fields)."""
-        return {"focal_length_mm": self.clamp_focal_length(focal_length_mm),
-                "f_number": self.clamp_f_number(f_number),
-                "aperture_blades": self.aperture_blades,
-                "blade_rotation_deg": self.blade_rotation_deg,
-                "blade_curvature": self.blade_roundness}
+        length and aperture kept within what the lens can do, and the lens's iris (as ThinLensCamera's fields).
+        A real lens also names itself as the camera's ``real_lens`` and sets aside the thin lens's stand-ins for
+        what its glass does (squeeze, barrel clipping, an aperture image); a thin-lens preset takes a real lens
+        off."""
+        settings = {"focal_length_mm": self.clamp_focal_length(focal_length_mm),
+                    "f_number": self.clamp_f_number(f_number),
+                    "aperture_blades": self.aperture_blades,
+                    "blade_rotation_deg": self.blade_rotation_deg,
+                    "blade_curvature": self.blade_roundness,
+                    "real_lens": (self.source_file or self.name) if self.is_real else ""}
+        if self.is_real:
+            settings.update(anamorphic_squeeze=1.0, barrel_clipping=0.0, aperture_image="", pinhole=False)
+        return settings
 
 
 _KINDS = {
@@ -195,8 +222,33 @@ _KINDS = {
 
 
 def read_lens_file(path) -> LensPreset:
-    """One lens from one JSON file (PresetError naming file and key on any problem)."""
+    """One lens from one file: a thin-lens preset's JSON, or a real lens's prescription (PresetError naming file
+    and key on any problem)."""
+    from .prescription import is_prescription_file, read_prescription_file
+
+    if is_prescription_file(path):
+        try:
+            return real_lens_preset(read_prescription_file(path))
+        except ValueError as exc:
+            raise PresetError(path, "surfaces", str(exc)) from None
     return build_preset(LensPreset, read_json(path), _KINDS, path)
+
+
+def real_lens_preset(prescription: LensPrescription) -> LensPreset:
+    """The lens-list entry of a real lens: its focal length and widest aperture from its glass (the marked
+    f-number where its source gives one: an f/2 lens is sold and set as f/2 even where paraxial optics says
+    f/2.03; its stop cannot open further than the glass allows)."""
+    from .real_lenses import system_for
+
+    system = system_for(prescription)
+    widest = prescription.published_f_number or round(system.widest_f_number, 2)
+    return LensPreset(prescription.name, focal_length_mm=system.efl, widest_f_number=widest,
+                      narrowest_f_number=max(widest, prescription.narrowest_f_number),
+                      aperture_blades=prescription.aperture_blades,
+                      blade_rotation_deg=prescription.blade_rotation_deg,
+                      blade_roundness=prescription.blade_roundness,
+                      min_focus_distance_m=prescription.min_focus_distance_m,
+                      description=prescription.description or prescription.source, prescription=prescription)
 
 
 def _read_lens_dir(folder) -> list[LensPreset]:
@@ -204,7 +256,8 @@ def _read_lens_dir(folder) -> list[LensPreset]:
     seen: dict[str, object] = {}
     # Sorted so that the result does not depend on the file system; dot files
     # are editor backups and lock files, not presets.
-    for path in sorted(folder.glob("*.json")):
+    files = [path for pattern in ("*.json", "*.toml", "*.dat") for path in folder.glob(pattern)]
+    for path in sorted(files):
         if path.name.startswith("."):
             continue
         lens = read_lens_file(path)
@@ -246,6 +299,11 @@ def find_lens(name: str, lenses: Sequence[LensPreset] | None = None) -> LensPres
     slashes do not matter), or else the one lens whose name begins so: "85mm" is the 85 mm f/1.4 while only one
     85 mm lens is installed. A ValueError that lists the lenses there are when none is called that, or the
     candidates when the beginning fits several."""
+    from .real_lenses import names_a_file
+
+    if names_a_file(name) and lenses is None:  # a prescription file named on the command line or in a scene
+        path = Path(name).expanduser()
+        return dataclasses.replace(read_lens_file(path), source_file=str(path.resolve()))
     lenses = load_lens_presets() if lenses is None else lenses
     wanted = _lens_key(name)
     keyed = [(_lens_key(lens.name), lens) for lens in lenses]

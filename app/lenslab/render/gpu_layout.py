@@ -14,6 +14,8 @@ import math
 
 from lenslab import color as _color
 from lenslab.optics.aperture import APERTURE_KINDS, ROUNDED_BLADE_BINS as _ROUNDED_BLADE_BINS
+from lenslab.optics.lens_system import PUPIL_BINS as _PUPIL_BINS
+from lenslab.optics.prescription import MAX_SURFACES as _MAX_LENS_SURFACES
 from lenslab.render import film as _film
 
 # -- Materials: MATERIAL_ROWS vec4 rows per material (scene/materials/base.py describes them; packed through
@@ -123,6 +125,10 @@ APERTURE_ROUNDED_BLADES = APERTURE_KINDS["rounded_blades"]
 APERTURE_IMAGE = APERTURE_KINDS["image"]
 APERTURE_TABLE_UNIT = 0
 ROUNDED_BLADE_BINS = _ROUNDED_BLADE_BINS
+# A real lens (glsl/real_lens.glsl): at most MAX_LENS_SURFACES surfaces (optics/prescription.py refuses more), and
+# the exit pupil's table in PUPIL_BINS radial bins (optics/lens_system.py).
+MAX_LENS_SURFACES = _MAX_LENS_SURFACES
+PUPIL_BINS = _PUPIL_BINS
 
 
 def glsl_defines() -> dict[str, int | str]:

@@ -29,7 +29,7 @@ from lenslab.render.instancing import INSTANCE_MIN_TRIANGLES, GroupCache
 from lenslab.render.denoise import MAX_MEMORY_MB
 from lenslab.render.features import GENERAL, KernelFeatures, scene_features
 from lenslab.render.gpu_layout import (ACCUMULATION_BINDING, APERTURE_TABLE_UNIT, DISPLAY_BINDING, FEATURE_ROWS,
-                                      FEATURES_BINDING, SHADING_ROWS,
+                                      FEATURES_BINDING, MAX_LENS_SURFACES, SHADING_ROWS,
                                       SPLAT_IMAGE_BINDING, TONE_MAP_CLAMP, TONE_MAP_FILMIC, TONE_MAP_REINHARD)
 from lenslab.limits import SceneTooLarge, available_memory_bytes, format_bytes
 from lenslab.render.sobol import glsl_array_literal
@@ -240,6 +240,36 @@ def camera_uniforms(frame: CameraFrame) -> dict[str, object]:
         "cam_aperture_image_size": (int(cols), int(rows)),
         "aperture_table": APERTURE_TABLE_UNIT,
         "image_size": (frame.width, frame.height),
+        **real_lens_uniforms(frame),
+    }
+
+
+def real_lens_uniforms(frame: CameraFrame) -> dict[str, object]:
+    """glsl/real_lens.glsl's uniforms: the lens's surfaces where they stand at this focus, their indices at each
+    channel's wavelength, the stop and the exit pupil's table (lens_surface_count 0: the thin lens)."""
+    setting = frame.real_lens
+    if setting is None:
+        return {"lens_surface_count": 0}
+    system = setting.system
+    count = len(system.radius)
+    vertex_z = system.vertex_z(setting.shift)
+    surfaces = [(float(system.radius[k]), float(vertex_z[k]), float(system.aperture_radius[k]), 0.0)
+                for k in range(count)] + [(0.0, 0.0, 0.0, 0.0)] * (MAX_LENS_SURFACES - count)
+    iors = [tuple(float(n) for n in row) for row in system.channel_iors()] + [(1.0, 1.0, 1.0)] * (
+        MAX_LENS_SURFACES - count)
+    depth = setting.sensor_z - setting.rear_z
+    return {
+        "lens_surface_count": count,
+        "lens_surfaces": surfaces,
+        "lens_iors": iors,
+        "lens_dispersive": int(system.dispersive),
+        "lens_stop_radius": float(setting.stop_radius),
+        "lens_sensor_z": float(setting.sensor_z),
+        "lens_rear_z": float(setting.rear_z),
+        "lens_film_half": (float(frame.film_mm[0] / 2.0), float(frame.film_mm[1] / 2.0)),
+        "lens_film_radius": float(setting.film_radius_mm),
+        "lens_weight_scale": float(1.0 / (depth * depth * setting.ideal_irradiance)),
+        "lens_pupil": [tuple(float(v) for v in box) for box in setting.pupil_bounds],
     }
 
 

@@ -26,7 +26,9 @@ from lenslab.optics.aperture import Aperture
 from lenslab.optics.dof import COC_DIAGONAL_DIVISOR, DepthOfField
 from lenslab.optics.exposure import EXPOSURE_MODES, ISO_RANGE, SHUTTER_RANGE_S, exposure_scale
 from lenslab.optics.framing import SENSOR_FITS, imaged_area_mm
+from lenslab.optics.lens_system import LensSetting, LensSystem
 from lenslab.optics.lenses import MAX_APERTURE_BLADES, LensPreset
+from lenslab.optics.real_lenses import lens_setting, real_lens_system
 from lenslab.optics.sensors import SENSOR_SIDE_RANGE_MM
 from lenslab.optics.stops import F_NUMBER_CONTROL_RANGE, F_NUMBER_RANGE
 from lenslab.optics.thinlens import (FOCAL_LENGTH_CONTROL_RANGE_MM, FOCAL_LENGTH_RANGE_MM, FOCUS_DISTANCE_RANGE_M,
@@ -98,6 +100,25 @@ class ThinLensCamera:
     shutter_s: float = field(default=1.0 / 125.0, metadata={"range": SHUTTER_RANGE_S, "doc": "seconds"})
     resolution: tuple[int, int] = field(default=(640, 480), metadata={"range": (1, MAX_IMAGE_SIDE)})
     pinhole: bool = field(default=False, metadata={"doc": "an ideal pinhole: everything sharp, the f-number ignored"})
+    real_lens: str = field(default="", metadata={
+        "doc": "a lens traced through its glass: a real lens preset's name or a prescription file (.toml, .json, "
+               "pbrt's .dat; relative to the scene); empty: the thin lens (docs/lenses.md)"})
+
+    # -- the real lens ------------------------------------------------------------------------------------
+    def lens_system(self) -> LensSystem | None:
+        """The real lens this camera traces its rays through, or None for the thin lens. Its focal length is the
+        glass's (``focal_length_mm`` holds it for the readouts); its sensor sits at its rear focal point at
+        infinity focus, one focal length behind ``position``, and it focuses by moving forward."""
+        return real_lens_system(self.real_lens) if self.real_lens else None
+
+    def _real_focal_length_mm(self) -> float:
+        return self.lens_system().efl
+
+    def _real_focus_from_sensor_mm(self) -> float:
+        """The focus distance from the sensor, mm, in whichever reference it is given (the lens reference of a
+        real lens is ``position``, one focal length ahead of the sensor)."""
+        distance = float(self.focus_distance_m) * MM_PER_M
+        return distance + (self._real_focal_length_mm() if self.focus_from == "lens" else 0.0)
 
     # -- derived quantities -------------------------------------------------------------------------------
     @property
@@ -107,11 +128,16 @@ class ThinLensCamera:
 
     @property
     def lens_radius(self) -> float:
+        """The entrance pupil's radius, metres (a thin lens's radius; a real lens's, paraxially)."""
+        if self.real_lens:
+            return lens_radius_m(self._real_focal_length_mm(), self.f_number)
         return 0.0 if self.pinhole else lens_radius_m(self.focal_length_mm, self.f_number)
 
     @property
     def plane_of_focus_m(self) -> float:
         """Distance from the lens to the plane in focus, metres (what the renderer needs)."""
+        if self.real_lens:
+            return (self._real_focus_from_sensor_mm() - self._real_focal_length_mm()) / MM_PER_M
         if self.focus_from == "lens" or self.pinhole:  # a pinhole has everything sharp: no plane to work out
             return float(self.focus_distance_m)
         return object_distance_m(self.focal_length_mm, self.focus_distance_m)
@@ -119,7 +145,11 @@ class ThinLensCamera:
     @property
     def image_distance_mm(self) -> float:
         """Distance from the lens to the sensor, mm: the image distance of the plane of focus (focus breathing), or
-        one focal length (framing held, as pbrt and Mitsuba)."""
+        one focal length (framing held, as pbrt and Mitsuba). A real lens: its focal length and the distance it
+        has moved forward to focus (paraxially; the renderer refines it by tracing)."""
+        if self.real_lens:
+            system = self.lens_system()
+            return system.efl + system.paraxial_shift_for(self._real_focus_from_sensor_mm())
         if not self.focus_breathing or self.pinhole:
             return float(self.focal_length_mm)
         return image_distance_mm(self.focal_length_mm, self.plane_of_focus_m)
@@ -129,7 +159,12 @@ class ThinLensCamera:
         """The nearest focus distance this camera's lens can set, in its own reference (thin-lens limit): life
         size, the sensor two focal lengths behind the lens and the plane of focus two ahead, whichever reference
         the distance is read in. With the sensor held at one focal length (pbrt's and Mitsuba's camera, no
-        breathing) the plane of focus may be anywhere: no sensor moves to follow it."""
+        breathing) the plane of focus may be anywhere: no sensor moves to follow it. A real lens reaches life size
+        too, where it has moved one focal length forward (paraxially)."""
+        if self.real_lens:
+            system = self.lens_system()
+            shift = system.efl if self.focus_from == "lens" else 0.0
+            return (system.closest_focus_mm - shift) / MM_PER_M
         if self.pinhole or (self.focus_from == "lens" and not self.focus_breathing):
             return FOCUS_DISTANCE_RANGE_M[0]
         return closest_focus_m(self.focal_length_mm, self.focus_from)
@@ -141,6 +176,8 @@ class ThinLensCamera:
         if lens is None or lens.min_focus_distance_m is None or self.pinhole:
             return closest
         marked = float(lens.min_focus_distance_m)
+        if self.real_lens and self.focus_from == "lens":  # position is one focal length ahead of the sensor
+            return max(closest, marked - self._real_focal_length_mm() / MM_PER_M)
         if self.focus_from == "lens":  # the plane of focus that reading puts the sensor behind
             marked = object_distance_m(self.focal_length_mm, max(marked, 4.0 * self.focal_length_mm / MM_PER_M))
         return max(closest, marked)
@@ -157,6 +194,10 @@ class ThinLensCamera:
             where = "" if self.focus_from == "sensor" else f" (the plane of focus {closest:.4g} m from the lens)"
             return CameraValueError("focus_distance_m", distance, f"{reference} is nearer than the {lens.name} "
                                     f"lens's minimum focus of {lens.min_focus_distance_m:g} m from the sensor{where}")
+        if self.real_lens:
+            return CameraValueError("focus_distance_m", distance, f"{reference} is nearer than the "
+                                    f"{self.lens_system().name} can focus: at least {closest:.4g} m, where the "
+                                    "image is life size")
         return CameraValueError("focus_distance_m", distance, f"{reference} is nearer than any "
                                 f"{self.focal_length_mm:g} mm lens can focus: at least {closest:.4g} m, where the "
                                 "image is life size")
@@ -166,6 +207,8 @@ class ThinLensCamera:
         the view axis, sharp: the value click-to-focus sets."""
         if self.focus_from == "lens":
             return float(depth_m)
+        if self.real_lens:  # the sensor is one focal length behind position, whatever the focus
+            return float(depth_m) + self._real_focal_length_mm() / MM_PER_M
         return sensor_distance_m(self.focal_length_mm, depth_m)
 
     def imaged_area_mm(self, width: int | None = None, height: int | None = None) -> tuple[float, float]:
@@ -247,10 +290,33 @@ class ThinLensCamera:
         with ``lens`` mounted: the checks the field ranges cannot make alone."""
         if self.aperture_blades in (1, 2):
             raise ValueError("aperture_blades must be 0 (round) or at least 3")
+        if self.real_lens:
+            self._validate_real_lens()
         problem = self.focus_problem(lens)
         if problem is not None:
             raise problem
         self.basis()
+
+    def _validate_real_lens(self) -> None:
+        try:
+            system = self.lens_system()
+        except ValueError as exc:
+            raise CameraValueError("real_lens", self.real_lens, f"cannot be mounted: {exc}") from None
+        widest = system.marked_f_number
+        if self.f_number < widest * (1 - 1e-3):
+            raise CameraValueError("f_number", self.f_number, f"is wider than the {system.name} opens: "
+                                   f"f/{widest:g} at most")
+        # The thin lens's stand-ins for what glass does: a real lens's glass does it (cat's eye, its own stop).
+        for name, idle in (("anamorphic_squeeze", 1.0), ("barrel_clipping", 0.0), ("aperture_image", ""),
+                           ("pinhole", False)):
+            if getattr(self, name) != idle:
+                raise CameraValueError(name, getattr(self, name), f"applies to the thin lens only; the "
+                                       f"{system.name} is traced through its glass (set real_lens to \"\" first)")
+
+    def real_lens_setting(self, film_mm: tuple[float, float], base_dir: Path | None = None) -> LensSetting:
+        """The real lens at this camera's f-number and focus, making an image of ``film_mm`` of sensor."""
+        return lens_setting(self.lens_system(), self.f_number, self._real_focus_from_sensor_mm(), film_mm,
+                            0.5 * math.hypot(*film_mm), self.aperture(base_dir))
 
     def frame(self, width: int | None = None, height: int | None = None, *,
               base_dir: Path | None = None) -> "CameraFrame":
@@ -266,6 +332,14 @@ class ThinLensCamera:
             raise ValueError(f"an image needs at least one pixel each way, not {width} x {height}")
         right, up, back = self.basis()
         film_w, film_h = self.imaged_area_mm(width, height)
+        if self.real_lens:
+            setting = self.real_lens_setting((film_w, film_h), base_dir)
+            v = setting.image_distance_mm
+            return CameraFrame(position=np.asarray(self.position, dtype=float), right=right, up=up, back=back,
+                               tan_half_fov=(film_w / (2.0 * v), film_h / (2.0 * v)), lens_radius=self.lens_radius,
+                               focus_distance=self.plane_of_focus_m, aperture=setting.aperture,
+                               barrel_clipping=0.0, film_mm=(film_w, film_h), image_distance_mm=v, width=width,
+                               height=height, real_lens=setting)
         v = self.image_distance_mm
         return CameraFrame(position=np.asarray(self.position, dtype=float), right=right, up=up, back=back,
                            tan_half_fov=(film_w / (2.0 * v), film_h / (2.0 * v)), lens_radius=self.lens_radius,
@@ -286,8 +360,10 @@ class ThinLensCamera:
         film_w = max(export_w, export_h * aspect) * (1.0 + 2.0 * margin)
         film_h = film_w / aspect
         v = frame.image_distance_mm
+        # A real lens's pupil table reaches as far as the viewport's film: made again for it.
+        setting = self.real_lens_setting((film_w, film_h), base_dir) if self.real_lens else None
         return dataclasses.replace(frame, tan_half_fov=(film_w / (2.0 * v), film_h / (2.0 * v)),
-                                   film_mm=(film_w, film_h), gate_mm=(export_w, export_h))
+                                   film_mm=(film_w, film_h), gate_mm=(export_w, export_h), real_lens=setting)
 
 
 @dataclass(frozen=True, eq=False)
@@ -320,6 +396,8 @@ class CameraFrame:
     # The export's frame (mm of film) where this image shows more than it (a viewport's view_frame); None: the
     # image is the export's frame.
     gate_mm: tuple[float, float] | None = None
+    # A real lens at this frame's focus and f-number (its rays come from tracing its glass); None: the thin lens.
+    real_lens: LensSetting | None = None
 
     @property
     def gate_pixels(self) -> tuple[float, float, float, float]:
@@ -386,6 +464,8 @@ class CameraFrame:
         """Unit world directions (N, 3) of the rays through the lens centre and the image points ``pixels``
         (N, 2), in continuous pixel coordinates."""
         local = self._pinhole_local(pixels)
+        if self.real_lens is not None:  # the chief rays: through the centre of the stop
+            return self.rays(pixels)[1]
         directions = local @ self.to_world.T
         return directions / np.linalg.norm(directions, axis=-1, keepdims=True)
 
@@ -393,8 +473,17 @@ class CameraFrame:
         """World origins and unit directions (each (N, 3)) of the camera rays through image points ``pixels``
         (N, 2). ``lens_samples`` (N, 2) in [0, 1) choose each ray's point on the aperture, as the renderer's
         sampler does; without them every ray leaves the lens centre (the pinhole rays). ``with_weights`` adds
-        each ray's weight (N,): 0 where the barrel blocks it, else the aperture sample's weight."""
+        each ray's weight (N,): 0 where the barrel blocks it, else the aperture sample's weight.
+
+        A real lens's rays are traced through its glass (:meth:`LensSetting.rays`, glsl/real_lens.glsl): without
+        lens samples they are its chief rays, leaving the front element; their weights are (N, 3), one per colour
+        channel (a dispersive lens traces each sample at one channel's wavelength)."""
         pixels = np.asarray(pixels, dtype=float).reshape(-1, 2)
+        if self.real_lens is not None:
+            origins, directions, weights = self.real_lens.rays(pixels, self.width, self.height, lens_samples)
+            origins = self.position + (origins / MM_PER_M) @ self.to_world.T
+            directions = directions @ self.to_world.T
+            return (origins, directions, weights) if with_weights else (origins, directions)
         focus = self._pinhole_local(pixels) * self.focus_distance
         lens = np.zeros_like(focus)
         weights = np.ones(len(pixels))

@@ -1,0 +1,532 @@
+"""A real lens, element by element: its paraxial constants, rays traced through its glass, focusing, and the exit
+pupil the camera samples (docs/lenses.md; Kolb, Mitchell and Hanrahan 1995; pbrt-v4's RealisticCamera).
+
+**Coordinates.** Lengths in millimetres, in the camera's own frame: it looks down -z, so light from the scene
+travels towards +z and the sensor lies at the largest z. The sensor plane is at ``z = efl`` and the lens's rear
+principal point, at infinity focus, at ``z = 0``: where a thin lens of the same focal length would sit, so that a
+scene framed through the thin lens keeps its framing through the glass. Focusing moves the whole lens forward
+(unit focusing) by ``shift`` mm; the sensor stays where it is.
+
+**Surfaces** are spheres (a radius of 0 is the aperture stop, a flat opening), listed from the front element to
+the rear; ``ior[i]`` is the medium behind surface ``i``. A ray is lost where it misses a sphere, lands outside a
+surface's clear aperture or the stop's opening, or is totally reflected inside the glass.
+
+**Colour.** A glass with an Abbe number disperses: its index at a wavelength follows a two-term Cauchy formula fitted
+to n_d and V_d (:func:`dispersed_ior`). The renderer traces each camera sample at one of three wavelengths, one per
+colour channel (:data:`CHANNEL_WAVELENGTHS_NM`); a lens without Abbe numbers is traced once, achromatic.
+
+glsl/real_lens.glsl mirrors :meth:`LensSetting.rays` step by step; tests/test_real_lens.py runs both on the same
+numbers, and tests/reference_lens.py is an independent tracer the optics here are checked against.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from .aperture import Aperture, sample_concentric_disk
+from .prescription import LensPrescription
+from .pupil_trace import rays_through
+
+__all__ = ["CHANNEL_WAVELENGTHS_NM", "LensSystem", "LensSetting", "PUPIL_BINS", "dispersed_ior"]
+
+#: The Fraunhofer lines the Abbe number is defined on, nm: V_d = (n_d - 1) / (n_F - n_C).
+D_LINE_NM, F_LINE_NM, C_LINE_NM = 587.56, 486.13, 656.27
+#: The wavelength each colour channel's camera samples are traced at, nm: the dominant wavelengths of the sRGB
+#: (Rec. 709) primaries, so that a fringe has the colour the channel shows.
+CHANNEL_WAVELENGTHS_NM = (612.0, 549.0, 465.0)
+#: Radial bins of the exit-pupil table, from the centre of the image to its corner (pbrt-v4 uses 64).
+PUPIL_BINS = 64
+#: Rear-plane points per side of the grid each bin's pupil is found with, and film positions across each bin.
+PUPIL_GRID = 48
+PUPIL_FILM_STEPS = 3
+
+
+def dispersed_ior(n_d: float, abbe: float | None, wavelength_nm) -> np.ndarray | float:
+    """The index of a glass at ``wavelength_nm`` from its index at the d line and its Abbe number, by Cauchy's
+    n = A + B / lambda^2 with n(d) = n_d and n(F) - n(C) = (n_d - 1) / V_d. No Abbe number: no dispersion."""
+    if abbe is None or n_d == 1.0:
+        return np.full(np.shape(wavelength_nm), float(n_d)) if np.ndim(wavelength_nm) else float(n_d)
+    b = (n_d - 1.0) / abbe / (F_LINE_NM ** -2 - C_LINE_NM ** -2)
+    a = n_d - b * D_LINE_NM ** -2
+    return a + b * np.asarray(wavelength_nm, dtype=float) ** -2
+
+
+@dataclass(frozen=True)
+class Paraxial:
+    """First-order constants of a lens at infinity focus, from a paraxial (y, n u) trace at the d line, mm."""
+
+    efl: float  # effective focal length
+    back_focal: float  # rear vertex to the rear focal point
+    front_focal: float  # front focal point to the front vertex
+    track: float  # front vertex to rear vertex
+    entrance_pupil_z: float  # from the front vertex (positive: behind it)
+    entrance_pupil_diameter: float  # of the full stop
+
+    @property
+    def f_number(self) -> float:
+        """The widest aperture the glass allows: focal length over the entrance pupil's diameter."""
+        return self.efl / self.entrance_pupil_diameter
+
+
+def _refract(d: np.ndarray, normal: np.ndarray, eta: np.ndarray | float) -> tuple[np.ndarray, np.ndarray]:
+    """Snell's law for unit directions ``d`` (N, 3) at unit normals facing against them; ``eta`` = n_in / n_out.
+    Returns the refracted directions and which rays were not totally reflected."""
+    cos_in = -np.einsum("ij,ij->i", d, normal)
+    sin2_out = eta * eta * np.maximum(0.0, 1.0 - cos_in * cos_in)
+    ok = sin2_out <= 1.0
+    cos_out = np.sqrt(np.maximum(0.0, 1.0 - sin2_out))
+    eta = np.asarray(eta)[..., None] if np.ndim(eta) else eta
+    out = eta * d + (eta * cos_in - cos_out)[:, None] * normal
+    return out, ok
+
+
+class LensSystem:
+    """A lens prescription made ready to trace: vertex positions, indices, paraxial constants, focusing."""
+
+    def __init__(self, prescription: LensPrescription):
+        self.prescription = prescription
+        surfaces = prescription.surfaces
+        self.radius = np.array([s.radius_mm for s in surfaces], float)
+        self.thickness = np.array([s.thickness_mm for s in surfaces], float)
+        self.ior_d = np.array([s.ior for s in surfaces], float)
+        self.abbe = [s.abbe for s in surfaces]
+        self.aperture_radius = np.array([s.aperture_mm / 2.0 for s in surfaces], float)
+        self.stop = prescription.stop_index
+        # Vertex positions from the front vertex (the last surface's own thickness is the film distance, which the
+        # paraxial rear focus replaces).
+        self.vertex_from_front = np.concatenate([[0.0], np.cumsum(self.thickness[:-1])])
+
+    @property
+    def name(self) -> str:
+        return self.prescription.name
+
+    @property
+    def dispersive(self) -> bool:
+        return any(a is not None for a in self.abbe)
+
+    def ior(self, wavelength_nm: float = D_LINE_NM) -> np.ndarray:
+        """The index behind each surface at ``wavelength_nm``."""
+        return np.array([float(dispersed_ior(n, v, wavelength_nm)) for n, v in zip(self.ior_d, self.abbe)])
+
+    def channel_iors(self) -> np.ndarray:
+        """(surfaces, 3): each surface's index at each channel's wavelength (all three alike without dispersion)."""
+        if not self.dispersive:
+            return np.repeat(self.ior_d[:, None], 3, axis=1)
+        return np.stack([self.ior(w) for w in CHANNEL_WAVELENGTHS_NM], axis=1)
+
+    # -- first order ---------------------------------------------------------------------------------------
+    def _paraxial_trace(self, y: float, nu: float, ior: np.ndarray) -> tuple[float, float, list[float]]:
+        """A paraxial ray (height y, reduced angle n u) from the front to the rear vertex's plane; the heights
+        at each surface."""
+        n_before, heights = 1.0, []
+        for i, (radius, n_after) in enumerate(zip(self.radius, ior)):
+            heights.append(y)
+            power = 0.0 if radius == 0.0 else (n_after - n_before) / radius
+            nu = nu - y * power
+            if i < len(self.radius) - 1:
+                y = y + self.thickness[i] * nu / n_after
+            n_before = n_after
+        return y, nu, heights
+
+    @cached_property
+    def paraxial(self) -> Paraxial:
+        ior = self.ior_d
+        y, nu, _ = self._paraxial_trace(1.0, 0.0, ior)  # a ray from infinity at unit height
+        if nu == 0.0:
+            raise ValueError(f"lens '{self.name}' has no power: it is afocal, it cannot form an image")
+        efl = -1.0 / nu
+        back_focal = -y / nu
+        # The front focal distance from a ray traced backwards: reverse the lens (radii negated, order reversed).
+        reversed_system = _reversed(self)
+        yr, nur, _ = reversed_system._paraxial_trace(1.0, 0.0, reversed_system.ior_d)
+        front_focal = -yr / nur
+        track = float(self.vertex_from_front[-1])
+        # The entrance pupil: the stop's image in the glass in front of it; a paraxial ray from the stop's centre
+        # traced forwards out of the front gives its position, one from the stop's rim its size.
+        pupil_z, pupil_diameter = self._entrance_pupil()
+        return Paraxial(efl=efl, back_focal=back_focal, front_focal=front_focal, track=track,
+                        entrance_pupil_z=pupil_z, entrance_pupil_diameter=pupil_diameter)
+
+    def _entrance_pupil(self) -> tuple[float, float]:
+        """Position (from the front vertex, + behind it) and diameter of the stop's paraxial image through the
+        glass in front of it. Paraxial rays are linear in (y, n u): a ray entering at height y with slope u
+        crosses the stop at y h_a + u h_b, h_a and h_b the heights of the rays (1, 0) and (0, 1). The chief ray
+        (stop height 0) crosses the axis at z = h_b / h_a; a beam parallel to the axis fills the stop at
+        height r_stop / h_a."""
+        _, _, unit_height = self._paraxial_trace(1.0, 0.0, self.ior_d)
+        _, _, unit_slope = self._paraxial_trace(0.0, 1.0, self.ior_d)
+        h_a, h_b = unit_height[self.stop], unit_slope[self.stop]
+        return float(h_b / h_a), float(2.0 * self.aperture_radius[self.stop] / abs(h_a))
+
+    @property
+    def efl(self) -> float:
+        return self.paraxial.efl
+
+    @property
+    def widest_f_number(self) -> float:
+        """The f-number of the full stop, paraxially: focal length over the entrance pupil's diameter."""
+        return self.paraxial.f_number
+
+    @property
+    def marked_f_number(self) -> float:
+        """The widest f-number the lens is set to: as its source marks it (an f/2 design is f/2 even where
+        paraxial optics says f/2.03; the stop opens no further than the glass allows), else the glass's own."""
+        return self.prescription.published_f_number or round(self.widest_f_number, 2)
+
+    def stop_radius_for(self, f_number: float) -> float:
+        """The stop's radius, mm, that gives ``f_number``: the stop scales, the rest of the glass stays."""
+        return float(self.aperture_radius[self.stop] * min(1.0, self.widest_f_number / f_number))
+
+    def vertex_z(self, shift: float = 0.0) -> np.ndarray:
+        """Each surface's vertex, camera z in mm, with the lens moved ``shift`` mm forward from infinity focus."""
+        rear = self.efl - self.paraxial.back_focal - shift
+        return rear - (self.vertex_from_front[-1] - self.vertex_from_front)
+
+    # -- focusing ------------------------------------------------------------------------------------------
+    @property
+    def hiatus_to_focal_points(self) -> float:
+        """Front focal point to rear focal point at infinity focus, mm."""
+        p = self.paraxial
+        return p.front_focal + p.track + p.back_focal
+
+    @property
+    def closest_focus_mm(self) -> float:
+        """The nearest object distance (from the sensor) unit focusing can reach, paraxially: life size, where
+        the lens has moved one focal length forward."""
+        return self.hiatus_to_focal_points + 2.0 * self.efl
+
+    def paraxial_shift_for(self, distance_mm: float) -> float:
+        """How far the lens moves forward to focus on a point ``distance_mm`` in front of the sensor: Newton's
+        x x' = f^2 with x' = shift (the rear focal point leaves the sensor by it) and x the object's distance
+        from the front focal point."""
+        if not math.isfinite(distance_mm):
+            return 0.0
+        f, span = self.efl, distance_mm - self.hiatus_to_focal_points
+        disc = span * span - 4.0 * f * f
+        if disc < 0.0:
+            raise ValueError(f"{distance_mm / 1000.0:g} m from the sensor is nearer than the {self.name} "
+                             f"can focus ({self.closest_focus_mm / 1000.0:.4g} m)")
+        return 0.5 * (span - math.sqrt(disc))
+
+    def setting(self, f_number: float, focus_distance_mm: float, film_mm: tuple[float, float], *,
+                aperture: Aperture | None = None, film_radius_mm: float | None = None) -> "LensSetting":
+        """The lens set to ``f_number`` and focused on ``focus_distance_mm`` from the sensor (found by tracing:
+        the paraxial shift refined to the smallest spot at this aperture), making an image of ``film_mm``."""
+        stop_radius = self.stop_radius_for(f_number)
+        shift = self.best_focus_shift(focus_distance_mm, stop_radius)
+        return LensSetting(self, f_number=float(f_number), shift=shift, stop_radius=stop_radius,
+                           aperture=aperture or Aperture(), film_mm=film_mm,
+                           film_radius_mm=film_radius_mm or 0.5 * math.hypot(*film_mm))
+
+    def best_focus_shift(self, distance_mm: float, stop_radius: float, rays: int = 24) -> float:
+        """The shift that images a point on the axis ``distance_mm`` from the sensor into the smallest (RMS)
+        spot on the sensor, through a stop of ``stop_radius``: the paraxial shift, refined by golden section over
+        real rays through the pupil (spherical aberration moves the best focus off the paraxial one)."""
+        paraxial = self.paraxial_shift_for(distance_mm)
+        # A fan of rays from the point on the axis across the entrance pupil (d line), one plane is enough: the
+        # point is on the axis.
+        heights = (np.arange(rays) + 0.5) / rays
+        span = max(0.02 * self.efl, 0.01)
+
+        def spot(shift: float) -> float:
+            z = self.vertex_z(shift)
+            origin_z = self.efl - distance_mm if math.isfinite(distance_mm) else None
+            pupil_z = z[0] + self.paraxial.entrance_pupil_z
+            pupil_r = 0.5 * self.paraxial.entrance_pupil_diameter * stop_radius / self.aperture_radius[self.stop]
+            target = np.stack([heights * pupil_r, np.zeros(rays), np.full(rays, pupil_z)], axis=-1)
+            if origin_z is None:
+                origins = target - np.array([0.0, 0.0, 1.0]) * 10.0 * self.efl
+                directions = np.tile([0.0, 0.0, 1.0], (rays, 1))
+            else:
+                origins = np.tile([0.0, 0.0, origin_z], (rays, 1))
+                directions = target - origins
+                directions /= np.linalg.norm(directions, axis=-1, keepdims=True)
+            o, d, ok = trace_from_scene(self, origins, directions, shift, stop_radius, self.ior_d)
+            if ok.sum() < 2:
+                return math.inf
+            t = (self.efl - o[ok, 2]) / d[ok, 2]
+            x = o[ok, 0] + t * d[ok, 0]
+            w = heights[ok]  # each ray stands for a ring of the pupil: weight by its radius
+            return float(np.sum(w * x * x) / np.sum(w))
+
+        low, high = paraxial - span, paraxial + span
+        ratio = (math.sqrt(5.0) - 1.0) / 2.0
+        a, b = high - ratio * (high - low), low + ratio * (high - low)
+        fa, fb = spot(a), spot(b)
+        for _ in range(40):
+            if fa < fb:
+                high, b, fb = b, a, fa
+                a = high - ratio * (high - low)
+                fa = spot(a)
+            else:
+                low, a, fa = a, b, fb
+                b = low + ratio * (high - low)
+                fb = spot(b)
+        best = 0.5 * (low + high)
+        return best if math.isfinite(spot(best)) else paraxial
+
+
+def _reversed(system: LensSystem) -> LensSystem:
+    """The lens turned round (for the front focal distance): surfaces in reverse order, radii negated, each
+    medium now behind the surface that was in front of it."""
+    from .prescription import LensSurface
+
+    surfaces = system.prescription.surfaces
+    n = len(surfaces)
+    flipped = []
+    for k in range(n):
+        i = n - 1 - k
+        medium_behind = 1.0 if i == 0 else surfaces[i - 1].ior
+        abbe = None if i == 0 else surfaces[i - 1].abbe
+        thickness = surfaces[i - 1].thickness_mm if i > 0 else 0.0
+        flipped.append(LensSurface(radius_mm=-surfaces[i].radius_mm, thickness_mm=thickness, ior=medium_behind,
+                                   abbe=abbe, aperture_mm=surfaces[i].aperture_mm))
+    clone = object.__new__(LensSystem)
+    clone.prescription = system.prescription
+    clone.radius = np.array([s.radius_mm for s in flipped])
+    clone.thickness = np.array([s.thickness_mm for s in flipped])
+    clone.ior_d = np.array([s.ior for s in flipped])
+    clone.abbe = [s.abbe for s in flipped]
+    clone.aperture_radius = np.array([s.aperture_mm / 2.0 for s in flipped])
+    clone.stop = n - 1 - system.stop
+    clone.vertex_from_front = np.concatenate([[0.0], np.cumsum(clone.thickness[:-1])])
+    return clone
+
+
+def _intersect(system: LensSystem, i: int, z_vertex: float, o: np.ndarray, d: np.ndarray):
+    """Where rays (o, d) meet surface ``i`` (vertex at ``z_vertex``): the points, the unit normals facing the
+    rays, and which rays hit it at all. The part of the sphere near its vertex is the surface."""
+    radius = system.radius[i]
+    if radius == 0.0:
+        t = (z_vertex - o[:, 2]) / d[:, 2]
+        p = o + t[:, None] * d
+        normal = np.tile([0.0, 0.0, 1.0], (len(o), 1))
+        hit = t > 0.0
+    else:
+        centre = np.array([0.0, 0.0, z_vertex + radius])
+        oc = o - centre
+        b = np.einsum("ij,ij->i", oc, d)
+        c = np.einsum("ij,ij->i", oc, oc) - radius * radius
+        disc = b * b - c
+        hit = disc >= 0.0
+        root = np.sqrt(np.maximum(disc, 0.0))
+        # Of the two crossings, the one on the vertex's side of the centre: the nearer one when the ray travels
+        # from the vertex towards the centre, else the farther.
+        towards_centre = (d[:, 2] > 0.0) == (radius > 0.0)
+        t = np.where(towards_centre, -b - root, -b + root)
+        hit &= t > 0.0
+        p = o + t[:, None] * d
+        normal = (p - centre) / radius
+    normal = np.where((np.einsum("ij,ij->i", normal, d) > 0.0)[:, None], -normal, normal)
+    return p, normal, hit
+
+
+def _trace(system: LensSystem, order, o, d, shift, stop_radius, ior, stop_inside=None, entering=True):
+    z = system.vertex_z(shift)
+    ok = np.ones(len(o), bool)
+    for i in order:
+        p, normal, hit = _intersect(system, i, z[i], o, d)
+        r2 = p[:, 0] ** 2 + p[:, 1] ** 2
+        if system.radius[i] == 0.0:
+            inside = stop_inside(p[:, :2]) if stop_inside is not None else r2 <= stop_radius * stop_radius
+            ok &= hit & inside
+            o = p
+            continue
+        ok &= hit & (r2 <= system.aperture_radius[i] ** 2)
+        # Media either side of surface i: ior[i] behind it (towards the sensor), ior[i - 1] (or air) in front.
+        n_front = 1.0 if i == 0 else ior[i - 1]
+        n_back = ior[i]
+        eta = n_back / n_front if not entering else n_front / n_back
+        d, not_reflected = _refract(d, normal, eta)
+        ok &= not_reflected
+        o = p
+    return o, d, ok
+
+
+def trace_from_scene(system: LensSystem, o, d, shift, stop_radius, ior, stop_inside=None):
+    """Rays from the scene through the lens towards the sensor: exit points, directions and which got through."""
+    return _trace(system, range(len(system.radius)), np.asarray(o, float), np.asarray(d, float), shift,
+                  stop_radius, ior, stop_inside, entering=True)
+
+
+def trace_from_film(system: LensSystem, o, d, shift, stop_radius, ior, stop_inside=None):
+    """Rays from the sensor out through the lens into the scene: exit points on the front element, directions
+    and which got through (the renderer's direction, glsl/real_lens.glsl)."""
+    return _trace(system, range(len(system.radius) - 1, -1, -1), np.asarray(o, float), np.asarray(d, float),
+                  shift, stop_radius, ior, stop_inside, entering=False)
+
+
+@dataclass(frozen=True, eq=False)
+class LensSetting:
+    """A lens at one f-number and focus, making one image: what the renderer's camera rays are made from."""
+
+    system: LensSystem
+    f_number: float
+    shift: float  # mm the lens has moved forward from infinity focus
+    stop_radius: float  # mm
+    aperture: Aperture  # the iris's shape (round, blades, rounded blades), in units of the stop's radius
+    film_mm: tuple[float, float]  # the sensor area the image shows
+    film_radius_mm: float  # the pupil table reaches this far from the centre
+
+    @property
+    def sensor_z(self) -> float:
+        return self.system.efl
+
+    @property
+    def rear_z(self) -> float:
+        return float(self.system.vertex_z(self.shift)[-1])
+
+    @property
+    def image_distance_mm(self) -> float:
+        """Rear principal point to sensor: the focal length plus the focusing extension (what breathes)."""
+        return self.system.efl + self.shift
+
+    def stop_contains(self, points_mm: np.ndarray) -> np.ndarray:
+        return self.aperture.contains(np.asarray(points_mm) / self.stop_radius)
+
+    @cached_property
+    def pupil_bounds(self) -> np.ndarray:
+        """(PUPIL_BINS, 4): for film points at radii in each bin along +x, the box (x0, y0, x1, y1) on the rear
+        vertex's plane that every ray which gets through the lens crosses (the exit pupil, seen from there), a grid
+        cell wider on each side; an empty box where no ray gets through. Found, as pbrt does, by tracing a grid
+        of rays from points across each bin (at every channel's wavelength)."""
+        system = self.system
+        rear_radius = system.aperture_radius[-1]
+        half = 1.5 * rear_radius
+        cell = 2.0 * half / PUPIL_GRID
+        grid = (np.arange(PUPIL_GRID) + 0.5) * cell - half
+        gx, gy = np.meshgrid(grid, grid)
+        gx, gy = gx.ravel(), gy.ravel()
+        inside = gx * gx + gy * gy <= (rear_radius + cell) ** 2
+        gx, gy = gx[inside], gy[inside]
+        iors = np.unique(system.channel_iors().T, axis=0)
+        bounds = np.zeros((PUPIL_BINS, 4))
+        radii = np.linspace(0.0, self.film_radius_mm, PUPIL_BINS + 1)
+        film_x = (radii[:-1, None] + (np.arange(PUPIL_FILM_STEPS) + 0.5) / PUPIL_FILM_STEPS
+                  * (radii[1:] - radii[:-1])[:, None])
+        film_x = np.concatenate([film_x, radii[:-1, None], radii[1:, None]], axis=1)  # the bin's edges too
+        # The stop as the circle round its corners: a bladed stop's corners reach past the round stop's radius.
+        stop_radius = self.stop_radius * self.aperture.scale
+        vertex_z = system.vertex_z(self.shift)
+        passed = np.zeros((film_x.size, len(gx)), bool)
+        for ior in iors:
+            passed |= rays_through(film_x.reshape(-1), gx, gy, self.sensor_z, vertex_z, system.radius,
+                                   system.aperture_radius, np.ascontiguousarray(ior), system.stop, stop_radius)
+        passed = passed.reshape(PUPIL_BINS, -1, len(gx)).any(axis=1)
+        for b in range(PUPIL_BINS):
+            if passed[b].any():
+                xs, ys = gx[passed[b]], gy[passed[b]]
+                bounds[b] = (xs.min() - cell, ys.min() - cell, xs.max() + cell, ys.max() + cell)
+        return bounds
+
+    @cached_property
+    def ideal_irradiance(self) -> float:
+        """What an ideal lens at this f-number gives the centre of the image from a unit radiance: pi / (4 N^2).
+        Camera weights are divided by it, so that the real lens's image sits where the thin lens's does and shows
+        only what the glass adds: vignetting, cos^4 falloff, the pupil's aberrations, the light lost focusing close."""
+        return math.pi / (4.0 * self.f_number ** 2)
+
+    def film_points(self, pixels: np.ndarray, width: int, height: int) -> np.ndarray:
+        """Points on the sensor (camera frame, mm) that pixels (N, 2) image. The lens turns the image round, so
+        the top-right of the picture lies at the bottom-left of the sensor."""
+        ndc_x = 2.0 * pixels[:, 0] / width - 1.0
+        ndc_y = 1.0 - 2.0 * pixels[:, 1] / height
+        return np.stack([-ndc_x * self.film_mm[0] / 2.0, -ndc_y * self.film_mm[1] / 2.0,
+                         np.full(len(pixels), self.sensor_z)], axis=-1)
+
+    def sample_pupil(self, film: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Points on the rear vertex's plane towards the exit pupil of each film point, and their densities
+        (1 / the box's area): the box for the point's radius, turned to the point's direction (the lens is round)."""
+        r = np.hypot(film[:, 0], film[:, 1])
+        index = np.minimum((r / self.film_radius_mm * PUPIL_BINS).astype(int), PUPIL_BINS - 1)
+        box = self.pupil_bounds[index]
+        area = (box[:, 2] - box[:, 0]) * (box[:, 3] - box[:, 1])
+        x = box[:, 0] + u[:, 0] * (box[:, 2] - box[:, 0])
+        y = box[:, 1] + u[:, 1] * (box[:, 3] - box[:, 1])
+        safe_r = np.where(r > 0.0, r, 1.0)
+        cos_a = np.where(r > 0.0, film[:, 0] / safe_r, 1.0)
+        sin_a = np.where(r > 0.0, film[:, 1] / safe_r, 0.0)
+        points = np.stack([cos_a * x - sin_a * y, sin_a * x + cos_a * y, np.full(len(x), self.rear_z)], axis=-1)
+        return points, area
+
+    def rays(self, pixels, width: int, height: int, lens_samples=None):
+        """Camera-frame origins (mm, on the front element), unit directions and colour weights (N, 3) of the rays
+        the pixels ``pixels`` (N, 2) send out, with ``lens_samples`` (N, 2) choosing each one's point on the
+        exit pupil (the renderer's lens sample). A dispersive lens traces each sample at one channel's
+        wavelength, chosen by the first third of u.x (the rest of u.x, stretched, still places it on the pupil),
+        and weighs that channel three times. Without lens samples: the chief rays, through the centre of the stop
+        (d line), weight 1 where they get through."""
+        pixels = np.asarray(pixels, float).reshape(-1, 2)
+        film = self.film_points(pixels, width, height)
+        iors = self.system.channel_iors()
+        if lens_samples is None:
+            origins, directions, passed = self.chief_rays(film)
+            return origins, directions, np.repeat(passed[:, None], 3, axis=1)
+        u = np.array(lens_samples, float).reshape(-1, 2)
+        if self.system.dispersive:
+            channels = np.minimum(np.floor(3.0 * u[:, 0]), 2.0)
+            u[:, 0] = 3.0 * u[:, 0] - channels
+            channels = channels.astype(int)
+            colour = np.zeros((len(u), 3))
+            colour[np.arange(len(u)), channels] = 3.0
+        else:
+            channels = np.ones(len(u), int)
+            colour = np.ones((len(u), 3))
+        targets, area = self.sample_pupil(film, u)
+        directions = targets - film
+        directions /= np.linalg.norm(directions, axis=-1, keepdims=True)
+        origins = np.empty_like(film)
+        out = np.empty_like(film)
+        passed = np.zeros(len(film), bool)
+        for channel in range(3):
+            chosen = channels == channel
+            if chosen.any():
+                o, d, ok = trace_from_film(self.system, film[chosen], directions[chosen], self.shift,
+                                           self.stop_radius, iors[:, channel], self.stop_contains)
+                origins[chosen], out[chosen], passed[chosen] = o, d, ok
+        cos_theta = -directions[:, 2]
+        depth = self.sensor_z - self.rear_z
+        weight = np.where(passed & (area > 0.0), cos_theta ** 4 * area / (depth * depth) / self.ideal_irradiance,
+                          0.0)
+        return origins, out, weight[:, None] * colour
+
+    def chief_rays(self, film: np.ndarray):
+        """The rays from film points through the centre of the stop: where each pixel looks (picking, depth,
+        placing objects). Aimed by a few secant steps on the height at which a ray crosses the stop."""
+        system = self.system
+        iors = system.ior_d
+        r = np.hypot(film[:, 0], film[:, 1])
+        safe_r = np.where(r > 0.0, r, 1.0)
+        along = np.stack([np.where(r > 0.0, film[:, 0] / safe_r, 1.0), np.where(r > 0.0, film[:, 1] / safe_r, 0.0)],
+                         axis=-1)
+        z = system.vertex_z(self.shift)
+        behind = range(len(system.radius) - 1, system.stop, -1)
+
+        def stop_height(aim: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            target = np.stack([aim * along[:, 0], aim * along[:, 1], np.full(len(aim), self.rear_z)], axis=-1)
+            d = target - film
+            d /= np.linalg.norm(d, axis=-1, keepdims=True)
+            o, d2, ok = _trace(system, behind, film, d, self.shift, self.stop_radius, iors, entering=False)
+            t = (z[system.stop] - o[:, 2]) / d2[:, 2]
+            h = (o[:, 0] + t * d2[:, 0]) * along[:, 0] + (o[:, 1] + t * d2[:, 1]) * along[:, 1]
+            return np.where(ok, h, np.nan), d
+
+        a0 = np.zeros(len(film))
+        # First guess: the straight line from the film point to the stop's centre.
+        a1 = r * (self.rear_z - z[system.stop]) / np.maximum(self.sensor_z - z[system.stop], 1e-9)
+        h0, _ = stop_height(a0)
+        h1, _ = stop_height(a1)
+        for _ in range(8):
+            slope = np.where(np.abs(h1 - h0) > 1e-12, (a1 - a0) / (h1 - h0), 0.0)
+            a2 = np.where(np.isfinite(h1), a1 - h1 * slope, 0.5 * (a0 + a1))
+            a0, h0 = a1, h1
+            a1 = a2
+            h1, _ = stop_height(a1)
+        target = np.stack([a1 * along[:, 0], a1 * along[:, 1], np.full(len(a1), self.rear_z)], axis=-1)
+        d = target - film
+        d /= np.linalg.norm(d, axis=-1, keepdims=True)
+        o, d, ok = trace_from_film(system, film, d, self.shift, self.system.aperture_radius[system.stop], iors)
+        return o, d, ok.astype(float)
