@@ -449,10 +449,13 @@ def test_the_listed_presets_are_the_shipped_ones(capsys):
     status, out, err = run.status, run.out, run.err
     lines = out.splitlines()
     assert status == 0 and not err and lines[0].split() == ["lens", "focal", "length", "stops", "blades", "closest",
-                                                            "focus"]
+                                                            "focus", "model"]
     assert [line.startswith(lens.name + " ") for line, lens in zip(lines[1:], load_lens_presets())] == \
         [True] * len(load_lens_presets()) and len(lines) == 1 + len(load_lens_presets())
     assert "70-200 mm" in out and "f/2.8 to f/22" in out
+    # Real lenses say they are traced through glass, and how many surfaces it has.
+    double_gauss = next(line for line in lines if line.startswith("50 mm f/2 double-Gauss"))
+    assert double_gauss.endswith("glass, 11 surfaces") and "50.4 mm" in double_gauss
     run = run_cli(capsys, "--list-sensors")
     status, out, err = run.status, run.out, run.err
     lines = out.splitlines()

@@ -44,3 +44,88 @@ def test_the_shader_traces_the_glass_as_the_host_does(renderer, lens):
     assert np.allclose(origins[both], expected_origins[both], atol=2e-5)
     assert np.allclose(directions[both], expected_directions[both], atol=2e-4)
     assert np.allclose(weights[both], expected_weights[both], rtol=2e-3, atol=1e-4)
+
+
+# -- on the command line and in scene files ----------------------------------------------------------------------
+DOUBLE_GAUSS_ROWS = """# a double-Gauss as pbrt's lens files write it: radius, thickness, index (0: air), aperture
+29.475\t3.76\t1.67\t25.2
+84.83\t0.12\t1\t25.2
+19.275\t4.025\t1.67\t23
+40.77\t3.275\t1.699\t23
+12.75\t5.705\t1\t18
+0\t4.5\t0\t17.1
+-14.495\t1.18\t1.603\t17
+40.77\t6.065\t1.658\t20
+-20.385\t0.19\t1\t20
+437.065\t3.22\t1.717\t20
+-39.73\t0\t1\t20
+"""
+
+
+def test_the_command_line_mounts_a_real_lens_and_the_file_names_it(renderer, tmp_path, capsys):
+    from lenslab.render.film import read_image
+    from tests.helpers import run_cli
+
+    out = tmp_path / "shot.exr"
+    run = run_cli(capsys, "cornell_box", "--headless", "-o", out, "--lens", "50 mm f/2 double-Gauss", "--f-number",
+                  "4", "--focus-distance", "1.5", "--spp", "2", "--width", "48", "--height", "48")
+    assert run.status == 0, run.err
+    pixels, metadata = read_image(out)
+    assert metadata["Exif:LensModel"] == "50 mm f/2 double-Gauss"
+    assert metadata["Exif:FocalLength"] == pytest.approx(50.358, abs=0.01)  # the glass's, not the name's
+    assert float(metadata["lenslab:RealLensFocusShiftMM"]) > 1.0  # it moved forward to focus at 1.5 m
+    assert np.isfinite(pixels).all() and pixels.mean() > 0.01
+
+
+def test_a_pbrt_lens_file_is_a_lens_on_the_command_line(renderer, tmp_path, capsys):
+    from lenslab.render.film import read_image
+    from tests.helpers import run_cli
+
+    lens_file = tmp_path / "dgauss.50mm.dat"
+    lens_file.write_text(DOUBLE_GAUSS_ROWS)
+    out = tmp_path / "shot.exr"
+    run = run_cli(capsys, "cornell_box", "--headless", "-o", out, "--lens", lens_file, "--spp", "1", "--width", "32",
+                  "--height", "32")
+    assert run.status == 0, run.err
+    _, metadata = read_image(out)
+    assert metadata["Exif:LensModel"] == "dgauss.50mm"
+
+
+@pytest.mark.parametrize("argv, words, status", [
+    (["--lens", "50 mm f/2 double-Gauss", "--f-number", "1.4"], "f/1.4 is not on the lens", 2),
+    (["--lens", "50 mm f/2 double-Gauss", "--anamorphic-squeeze", "2"], "applies to the thin lens only", 1),
+    (["--lens", "50 mm f/2 double-Gauss", "--focus-distance", "0.1"], "nearer than", 1),
+])
+def test_what_a_real_lens_cannot_do_is_refused_in_one_line(tmp_path, capsys, argv, words, status):
+    """Exit 2 for what the options alone refuse, 1 for a camera the scene and the options together cannot make
+    (as for the thin lens: tests/test_cli.py)."""
+    from tests.helpers import run_cli
+
+    run = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.exr", *argv)
+    assert run.status == status and words in run.err and len(run.err.strip().splitlines()) == 1, run.err
+    assert not (tmp_path / "x.exr").exists()
+
+
+def test_a_broken_lens_file_is_named_with_its_line(tmp_path, capsys):
+    from tests.helpers import run_cli
+
+    lens_file = tmp_path / "broken.dat"
+    lens_file.write_text(DOUBLE_GAUSS_ROWS.replace("40.77\t6.065", "40.77\tsix"))
+    run = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.exr", "--lens", lens_file)
+    assert run.status == 2 and "broken.dat" in run.err and "line 9" in run.err, run.err
+    assert run.err.count("broken.dat") == 1 and len(run.err.strip().splitlines()) == 1
+
+
+def test_a_scene_names_its_lens_file_relative_to_itself(tmp_path):
+    import json
+
+    from lenslab.scene.io.loader import open_scene
+
+    (tmp_path / "lenses").mkdir()
+    (tmp_path / "lenses" / "dg.dat").write_text(DOUBLE_GAUSS_ROWS)
+    scene = {"lenslab_scene": 2, "camera": {"real_lens": "lenses/dg.dat", "focal_length_mm": 50.358, "f_number": 2.8,
+                                      "focus_distance_m": 2.0}}
+    (tmp_path / "scene.json").write_text(json.dumps(scene))
+    camera = open_scene(tmp_path / "scene.json").camera
+    assert camera.lens_system().name == "dg"
+    assert camera.frame(64, 48).real_lens.shift > 0.5

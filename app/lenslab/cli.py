@@ -285,14 +285,15 @@ def _print_presets(kind: str) -> int:
     from lenslab.optics.thinlens import format_distance
 
     if kind == "lenses":
-        header = ("lens", "focal length", "stops", "blades", "closest focus")
+        header = ("lens", "focal length", "stops", "blades", "closest focus", "model")
         rows = [(lens.name,
                  format_focal_length(lens.min_focal_length_mm) if not lens.is_zoom else
                  f"{lens.min_focal_length_mm:g}-{format_focal_length(lens.max_focal_length_mm)}",
                  f"{format_f_number(lens.widest_f_number)} to {format_f_number(lens.narrowest_f_number)}",
                  "round" if not lens.aperture_blades else
                  f"{lens.aperture_blades}" + (f", curvature {lens.blade_roundness:g}" if lens.blade_roundness else ""),
-                 format_distance(lens.min_focus_distance_m) if lens.min_focus_distance_m else "")
+                 format_distance(lens.min_focus_distance_m) if lens.min_focus_distance_m else "",
+                 f"glass, {len(lens.prescription.surfaces)} surfaces" if lens.is_real else "thin lens")
                 for lens in load_lens_presets()]
     else:
         header = ("sensor", "size", "crop", "circle of confusion")

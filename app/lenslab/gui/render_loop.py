@@ -790,7 +790,9 @@ class RenderLoop:
         origins, directions = frame.rays(frame.pixel_centres())
         hits = cast_rays(self._renderer, session.gpu_scene, origins, directions)
         node_index = session.hit_nodes(hits)
-        depth = np.where(hits.prim >= 0, hits.t * (directions @ frame.forward), np.inf).astype(np.float32)
+        # Depth along the view axis from the camera's position (a real lens's chief rays leave its front element).
+        along = (origins - frame.position) @ frame.forward + hits.t * (directions @ frame.forward)
+        depth = np.where(hits.prim >= 0, along, np.inf).astype(np.float32)
         self._gbuffer_size = (w, h)
         self._events.gbuffer_ready(GBuffer(node_index.reshape(h, w), depth.reshape(h, w), self._generation))
 

@@ -37,11 +37,15 @@ D_LINE_NM, F_LINE_NM, C_LINE_NM = 587.56, 486.13, 656.27
 #: The wavelength each colour channel's camera samples are traced at, nm: the dominant wavelengths of the sRGB
 #: (Rec. 709) primaries, so that a fringe has the colour the channel shows.
 CHANNEL_WAVELENGTHS_NM = (612.0, 549.0, 465.0)
+#: Steps of the chief rays' table, from the centre of the image to its corner.
+CHIEF_RAY_STEPS = 512
 #: Radial bins of the exit-pupil table, from the centre of the image to its corner (pbrt-v4 uses 64).
 PUPIL_BINS = 64
-#: Rear-plane points per side of the grid each bin's pupil is found with, and film positions across each bin.
-PUPIL_GRID = 48
-PUPIL_FILM_STEPS = 3
+#: Rear-plane points per side of the grids each bin's pupil is found with (a coarse one over the whole rear
+#: element, a fine one over the box it finds), and film positions inside each bin (its two edges besides).
+PUPIL_COARSE_GRID = 16
+PUPIL_GRID = 32
+PUPIL_FILM_STEPS = 1
 
 
 def dispersed_ior(n_d: float, abbe: float | None, wavelength_nm) -> np.ndarray | float:
@@ -390,37 +394,46 @@ class LensSetting:
     @cached_property
     def pupil_bounds(self) -> np.ndarray:
         """(PUPIL_BINS, 4): for film points at radii in each bin along +x, the box (x0, y0, x1, y1) on the rear
-        vertex's plane that every ray which gets through the lens crosses (the exit pupil, seen from there), a grid
-        cell wider on each side; an empty box where no ray gets through. Found, as pbrt does, by tracing a grid
-        of rays from points across each bin (at every channel's wavelength)."""
+        vertex's plane that every ray which gets through the lens crosses (the exit pupil, seen from there); an
+        empty box where no ray gets through. Found, as pbrt does, by tracing grids of rays from points across each
+        bin (at every channel's wavelength), in two passes: a coarse grid over the whole rear element finds each
+        bin's box, a fine grid over that box draws it tight. Each box is one fine cell wider on every side than
+        the rays found, so that a ray between the grid's points is not lost; every sample outside the pupil is
+        wasted, so the tighter the box, the fewer."""
         system = self.system
         rear_radius = system.aperture_radius[-1]
-        half = 1.5 * rear_radius
-        cell = 2.0 * half / PUPIL_GRID
-        grid = (np.arange(PUPIL_GRID) + 0.5) * cell - half
-        gx, gy = np.meshgrid(grid, grid)
-        gx, gy = gx.ravel(), gy.ravel()
-        inside = gx * gx + gy * gy <= (rear_radius + cell) ** 2
-        gx, gy = gx[inside], gy[inside]
-        iors = np.unique(system.channel_iors().T, axis=0)
-        bounds = np.zeros((PUPIL_BINS, 4))
         radii = np.linspace(0.0, self.film_radius_mm, PUPIL_BINS + 1)
         film_x = (radii[:-1, None] + (np.arange(PUPIL_FILM_STEPS) + 0.5) / PUPIL_FILM_STEPS
                   * (radii[1:] - radii[:-1])[:, None])
         film_x = np.concatenate([film_x, radii[:-1, None], radii[1:, None]], axis=1)  # the bin's edges too
+        whole = (-1.5 * rear_radius, -1.5 * rear_radius, 1.5 * rear_radius, 1.5 * rear_radius)
+        coarse = self._boxes_found(film_x, [whole] * PUPIL_BINS, PUPIL_COARSE_GRID)
+        return self._boxes_found(film_x, coarse, PUPIL_GRID)
+
+    def _boxes_found(self, film_x: np.ndarray, boxes, grid: int) -> np.ndarray:
+        """For each bin, the box round the points of a ``grid`` x ``grid`` grid over ``boxes[bin]`` (grown by one
+        cell) that rays from the bin's film points pass through, grown by one cell; zeros where none does."""
+        system = self.system
+        iors = np.ascontiguousarray(np.unique(system.channel_iors().T, axis=0))
         # The stop as the circle round its corners: a bladed stop's corners reach past the round stop's radius.
         stop_radius = self.stop_radius * self.aperture.scale
         vertex_z = system.vertex_z(self.shift)
-        passed = np.zeros((film_x.size, len(gx)), bool)
-        for ior in iors:
-            passed |= rays_through(film_x.reshape(-1), gx, gy, self.sensor_z, vertex_z, system.radius,
-                                   system.aperture_radius, np.ascontiguousarray(ior), system.stop, stop_radius)
-        passed = passed.reshape(PUPIL_BINS, -1, len(gx)).any(axis=1)
-        for b in range(PUPIL_BINS):
-            if passed[b].any():
-                xs, ys = gx[passed[b]], gy[passed[b]]
-                bounds[b] = (xs.min() - cell, ys.min() - cell, xs.max() + cell, ys.max() + cell)
-        return bounds
+        steps = (np.arange(grid) + 0.5) / grid
+        found = np.zeros((PUPIL_BINS, 4))
+        for b, (x0, y0, x1, y1) in enumerate(boxes):
+            if x1 <= x0 or y1 <= y0:
+                continue
+            cell_x, cell_y = (x1 - x0) / grid, (y1 - y0) / grid
+            x0, x1, y0, y1 = x0 - cell_x, x1 + cell_x, y0 - cell_y, y1 + cell_y
+            gx, gy = np.meshgrid(x0 + steps * (x1 - x0), y0 + steps * (y1 - y0))
+            gx, gy = gx.ravel(), gy.ravel()
+            passed = rays_through(film_x[b], gx, gy, self.sensor_z, vertex_z, system.radius, system.aperture_radius,
+                                  iors, stop_radius).any(axis=0)
+            if passed.any():
+                cell_x, cell_y = (x1 - x0) / grid, (y1 - y0) / grid
+                xs, ys = gx[passed], gy[passed]
+                found[b] = (xs.min() - cell_x, ys.min() - cell_y, xs.max() + cell_x, ys.max() + cell_y)
+        return found
 
     @cached_property
     def ideal_irradiance(self) -> float:
@@ -493,9 +506,43 @@ class LensSetting:
                           0.0)
         return origins, out, weight[:, None] * colour
 
+    @cached_property
+    def chief_ray_table(self) -> np.ndarray:
+        """(CHIEF_RAY_STEPS + 1, 4): for film points at evenly spaced radii along +x out to the table's reach, the
+        chief ray as it leaves the front element: its exit point's x and z, its direction's x and z (NaN where
+        no ray through the stop's centre gets out). The lens is round, so every film point's chief ray is the
+        one of its radius turned to its direction; a table of radii makes a whole image's rays cheap."""
+        radii = np.linspace(0.0, self.film_radius_mm, CHIEF_RAY_STEPS + 1)
+        film = np.stack([radii, np.zeros_like(radii), np.full_like(radii, self.sensor_z)], axis=-1)
+        o, d, ok = self._aim_through_stop_centre(film)
+        table = np.stack([o[:, 0], o[:, 2], d[:, 0], d[:, 2]], axis=-1)
+        table[~ok.astype(bool)] = np.nan
+        return table
+
     def chief_rays(self, film: np.ndarray):
         """The rays from film points through the centre of the stop: where each pixel looks (picking, depth,
-        placing objects). Aimed by a few secant steps on the height at which a ray crosses the stop."""
+        placing objects). Camera-frame exit points and directions, and 1 where such a ray gets out (else 0),
+        interpolated from :attr:`chief_ray_table` and turned to each point's direction."""
+        table = self.chief_ray_table
+        r = np.hypot(film[:, 0], film[:, 1])
+        position = np.clip(r / self.film_radius_mm * CHIEF_RAY_STEPS, 0.0, CHIEF_RAY_STEPS)
+        below = np.minimum(position.astype(int), CHIEF_RAY_STEPS - 1)
+        t = (position - below)[:, None]
+        row = (1.0 - t) * table[below] + t * table[below + 1]
+        safe_r = np.where(r > 0.0, r, 1.0)
+        # The film point at +x looks towards -x in the scene: its chief ray's radial coordinates are along it.
+        cos_a = np.where(r > 0.0, film[:, 0] / safe_r, 1.0)
+        sin_a = np.where(r > 0.0, film[:, 1] / safe_r, 0.0)
+        origins = np.stack([row[:, 0] * cos_a, row[:, 0] * sin_a, row[:, 1]], axis=-1)
+        directions = np.stack([row[:, 2] * cos_a, row[:, 2] * sin_a, row[:, 3]], axis=-1)
+        ok = np.isfinite(row).all(axis=1)
+        origins[~ok], directions[~ok] = 0.0, (0.0, 0.0, -1.0)
+        directions /= np.linalg.norm(directions, axis=-1, keepdims=True)
+        return origins, directions, ok.astype(float)
+
+    def _aim_through_stop_centre(self, film: np.ndarray):
+        """Rays from film points through the centre of the stop, aimed by secant steps on the height at which
+        they cross the stop's plane."""
         system = self.system
         iors = system.ior_d
         r = np.hypot(film[:, 0], film[:, 1])
@@ -520,7 +567,8 @@ class LensSetting:
         h0, _ = stop_height(a0)
         h1, _ = stop_height(a1)
         for _ in range(8):
-            slope = np.where(np.abs(h1 - h0) > 1e-12, (a1 - a0) / (h1 - h0), 0.0)
+            step = h1 - h0
+            slope = (a1 - a0) / np.where(np.abs(step) > 1e-12, step, np.inf)
             a2 = np.where(np.isfinite(h1), a1 - h1 * slope, 0.5 * (a0 + a1))
             a0, h0 = a1, h1
             a1 = a2

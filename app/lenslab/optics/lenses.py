@@ -227,10 +227,11 @@ def read_lens_file(path) -> LensPreset:
     from .prescription import is_prescription_file, read_prescription_file
 
     if is_prescription_file(path):
+        prescription = read_prescription_file(path)  # a PresetError naming the file, the line or the key
         try:
-            return real_lens_preset(read_prescription_file(path))
-        except ValueError as exc:
-            raise PresetError(path, "surfaces", str(exc)) from None
+            return real_lens_preset(prescription)
+        except ValueError as exc:  # read, but no lens (afocal glass, say)
+            raise PresetError(path, None, str(exc)) from None
     return build_preset(LensPreset, read_json(path), _KINDS, path)
 
 

@@ -270,7 +270,25 @@ def image_metadata(scene: Scene, spp: int, frame: CameraFrame) -> dict[str, obje
     }
     if cam.exposure_mode == "physical":
         metadata["lenslab:EV100"] = ev100(cam.f_number, cam.shutter_s, cam.iso)
+    if frame.real_lens is not None:
+        metadata.update(real_lens_metadata(frame))
     return metadata
+
+
+def real_lens_metadata(frame: CameraFrame) -> dict[str, object]:
+    """A real lens named as Exif names a lens (LensModel), with what its glass did for this image: how far it
+    moved to focus, its stop, and where its numbers come from."""
+    setting = frame.real_lens
+    system = setting.system
+    return {
+        "Exif:LensModel": system.name,
+        "lenslab:RealLens": system.name,
+        "lenslab:RealLensSource": system.prescription.source or str(system.prescription.path or ""),
+        "lenslab:RealLensSurfaces": len(system.radius),
+        "lenslab:RealLensFocusShiftMM": float(setting.shift),
+        "lenslab:RealLensStopDiameterMM": float(2.0 * setting.stop_radius),
+        "lenslab:RealLensDispersive": int(system.dispersive),
+    }
 
 
 def world_to_camera(frame: CameraFrame) -> np.ndarray:

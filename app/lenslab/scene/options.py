@@ -152,10 +152,19 @@ def _blades_that_make_a_stop(blades) -> str:
 
 
 def _lens_name(text: str) -> str:
-    """The name of a lens preset there is, as given (the overrides look it up again when they mount it)."""
+    """The name of a lens preset there is, or a lens file that reads, as given (the overrides look it up again
+    when they mount it). A broken lens file named here is the option's error, as an unreadable aperture image
+    is; a broken preset folder is an error of its own (command_line.option_argument)."""
     from lenslab.optics.lenses import find_lens
+    from lenslab.optics.presetfiles import PresetError
+    from lenslab.optics.real_lenses import names_a_file
 
-    find_lens(text)
+    try:
+        find_lens(text)
+    except PresetError as exc:
+        if names_a_file(text):
+            raise ValueError(str(exc)) from None
+        raise
     return text
 
 

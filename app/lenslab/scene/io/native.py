@@ -164,6 +164,12 @@ def _read_dataclass(value: Any, cls: type, path: str) -> Any:
 
 def _check_references(scene: Scene) -> None:
     """Cross-field checks the types alone cannot express."""
+    from lenslab.optics.real_lenses import names_a_file
+
+    real_lens = scene.camera.real_lens
+    if real_lens and names_a_file(real_lens) and not Path(real_lens).expanduser().is_absolute():
+        # A lens file is named relative to the scene, as meshes and textures are.
+        scene.camera.real_lens = str(scene.base_dir() / real_lens)
     try:
         scene.camera.validate()
     except ValueError as exc:
