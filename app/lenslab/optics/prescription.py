@@ -116,10 +116,19 @@ class PrescriptionError(PresetError):
         parts = [str(p) for p in (self.path, where) if p]
         ValueError.__init__(self, ": ".join(parts + [what]))
 
+    def __reduce__(self):
+        # Exceptions pickle as their class called with ``args`` (here the message alone), which this __init__
+        # does not take; a batch worker's error must cross to the scheduler whole.
+        return (_rebuild_error, (self.path, self.problem, self.surface, self.field, self.line, self.key))
+
     def relocated(self, path, *, line: int | None = None, key: str | None = None) -> PrescriptionError:
         """The same problem, said of ``path`` (and of a line or a key there): a reader knows where a surface
         came from, the dataclass that found the problem does not."""
         return PrescriptionError(path, self.problem, surface=self.surface, field=self.field, line=line, key=key)
+
+
+def _rebuild_error(path, problem, surface, field, line, key) -> PrescriptionError:
+    return PrescriptionError(path, problem, surface=surface, field=field, line=line, key=key)
 
 
 def _number(value: Any, name: str, path: Path | None = None) -> float:
@@ -328,7 +337,7 @@ def _read_text(path: Path) -> str:
     """The text of the regular file at ``path``, or a PrescriptionError naming it.  open_file refuses a
     folder, a device or a named pipe (which would block a reader for ever) before reading a byte."""
     try:
-        with open(path, 'rb') as file:
+        with open_file(path) as file:
             data = file.read(MAX_FILE_BYTES + 1)
     except OSError as exc:
         raise PrescriptionError(path, f"cannot read: {exc.strerror or exc}") from None
