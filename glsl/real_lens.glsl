@@ -4,7 +4,7 @@
 //
 // Lengths in mm, in the camera's frame (it looks down -z): the sensor at z = lens_sensor_z, surfaces from the
 // front element (index 0) to the rear. A ray starts on the sensor, aims at a point of the exit pupil's box for its
-// distance from the centre (precomputed, turned to its direction: the lens is round), and is refracted surface by
+// distance from the centre (a box or a disk, precomputed, turned to its direction: the lens is round), and is refracted surface by
 // surface towards the front; it is lost where it misses a sphere, lands outside a clear aperture or the stop, or is
 // totally reflected. Its weight is the camera measurement's cos^4(theta) dA / d^2 over the box, divided by what an
 // ideal lens at the same f-number gives (lens_weight_scale holds 1 / (d^2 * pi / (4 N^2))).
@@ -20,6 +20,7 @@ uniform vec2 lens_film_half;      // half the film's width and height, mm
 uniform float lens_film_radius;   // how far from the centre the pupil table reaches, mm
 uniform float lens_weight_scale;
 uniform vec4 lens_pupil[PUPIL_BINS];  // per radial bin, the exit pupil's box (x0, y0, x1, y1) for a point on +x
+uniform vec4 lens_pupil_disk[PUPIL_BINS];  // and the disk round it (centre, radius; w = 1: sample the disk)
 
 // Whether a point on the stop's plane (mm from the axis) is inside the iris: round, straight or rounded blades
 // (Aperture.contains, in units of the round stop's radius).
@@ -92,9 +93,16 @@ Ray real_lens_ray(vec2 ndc, vec2 u, out vec3 weight) {
     vec3 film = vec3(-ndc * lens_film_half, lens_sensor_z);  // the lens turns the image round
     float r = length(film.xy);
     int bin = min(int(r / lens_film_radius * float(PUPIL_BINS)), PUPIL_BINS - 1);
-    vec4 box = lens_pupil[bin];
-    float area = (box.z - box.x) * (box.w - box.y);
-    vec2 q = box.xy + u * (box.zw - box.xy);
+    vec4 box = lens_pupil[bin], disk = lens_pupil_disk[bin];
+    float area;
+    vec2 q;
+    if (disk.w > 0.0) {  // a round pupil: its disk wastes fewer samples than its box
+        area = PI * disk.z * disk.z;
+        q = disk.xy + disk.z * sample_concentric_disk(u);
+    } else {
+        area = (box.z - box.x) * (box.w - box.y);
+        q = box.xy + u * (box.zw - box.xy);
+    }
     vec2 along = r > 0.0 ? film.xy / r : vec2(1.0, 0.0);
     vec3 target = vec3(along.x * q.x - along.y * q.y, along.y * q.x + along.x * q.y, lens_rear_z);
     vec3 d = normalize(target - film);

@@ -129,3 +129,47 @@ def test_a_scene_names_its_lens_file_relative_to_itself(tmp_path):
     camera = open_scene(tmp_path / "scene.json").camera
     assert camera.lens_system().name == "dg"
     assert camera.frame(64, 48).real_lens.shift > 0.5
+
+
+# -- the exit pupil's table ----------------------------------------------------------------------------------------
+@pytest.mark.parametrize("lens", REAL_LENSES, ids=lambda lens: lens.name)
+@pytest.mark.parametrize("stop", ["widest", 8.0, 22.0])
+def test_the_pupil_table_holds_every_ray_that_gets_through(lens, stop):
+    """Unbiased only if no ray that gets through the glass falls outside the box (or disk) its film point samples:
+    a dense grid over the whole rear element, from film points across the image (at every channel's wavelength),
+    and every ray that gets out must have started inside its bin's region. And few samples are wasted where the
+    lens passes light at all."""
+    from lenslab.optics.lens_system import PUPIL_BINS, trace_from_film
+    from lenslab.optics.real_lenses import system_for
+
+    system = system_for(lens.prescription)
+    f_number = lens.widest_f_number if stop == "widest" else stop
+    setting = system.setting(f_number, 2000.0, (36.0, 24.0))
+    rear = system.aperture_radius[-1] * 1.5
+    grid = np.linspace(-rear, rear, 121)
+    gx, gy = (a.ravel() for a in np.meshgrid(grid, grid))
+    rng = np.random.default_rng(11)
+    for radius in rng.random(12) * setting.film_radius_mm:
+        film = np.tile([radius, 0.0, setting.sensor_z], (len(gx), 1))
+        target = np.stack([gx, gy, np.full_like(gx, setting.rear_z)], axis=-1)
+        directions = (target - film) / np.linalg.norm(target - film, axis=-1, keepdims=True)
+        passed = np.zeros(len(gx), bool)
+        for ior in system.channel_iors().T:
+            passed |= trace_from_film(system, film, directions, setting.shift, setting.stop_radius, ior,
+                                      setting.stop_contains)[2]
+        b = min(int(radius / setting.film_radius_mm * PUPIL_BINS), PUPIL_BINS - 1)
+        x0, y0, x1, y1 = setting.pupil_bounds[b]
+        cx, cy, r, on_disk = setting.pupil_disks[b]
+        xs, ys = gx[passed], gy[passed]
+        if on_disk:
+            assert (np.hypot(xs - cx, ys - cy) <= r + 1e-9).all()
+        else:
+            assert ((xs >= x0) & (xs <= x1) & (ys >= y0) & (ys <= y1)).all()
+    # Few samples wasted: of the samples of pixels that see anything, most get through.
+    pixels = rng.random((20000, 2)) * [300, 200]
+    frame = mounted_camera(lens, f_number=f_number).frame(300, 200)
+    _, _, weights = frame.rays(pixels, rng.random((20000, 2)), with_weights=True)
+    lit = frame.real_lens.pupil_bounds[np.minimum(
+        (np.hypot(*frame.real_lens.film_points(pixels, 300, 200)[:, :2].T) / frame.real_lens.film_radius_mm
+         * PUPIL_BINS).astype(int), PUPIL_BINS - 1), 2] != 0
+    assert (weights[lit].max(axis=1) > 0).mean() > 0.5

@@ -41,8 +41,11 @@ CHANNEL_WAVELENGTHS_NM = (612.0, 549.0, 465.0)
 CHIEF_RAY_STEPS = 512
 #: Radial bins of the exit-pupil table, from the centre of the image to its corner (pbrt-v4 uses 64).
 PUPIL_BINS = 64
-#: Rear-plane points per side of the grids each bin's pupil is found with (a coarse one over the whole rear
-#: element, a fine one over the box it finds), and film positions inside each bin (its two edges besides).
+#: Rear-plane points per side of the grids each bin's pupil is found with: over the whole rear element (where no
+#: earlier bin says where to look: fine enough for the pupil of a lens stopped down to f/22), over where the last
+#: bin's pupil was, and the fine one over the box that finds; and film positions inside each bin (its two edges
+#: besides).
+PUPIL_SEARCH_GRID = 96
 PUPIL_COARSE_GRID = 16
 PUPIL_GRID = 32
 PUPIL_FILM_STEPS = 1
@@ -114,6 +117,11 @@ class LensSystem:
     def ior(self, wavelength_nm: float = D_LINE_NM) -> np.ndarray:
         """The index behind each surface at ``wavelength_nm``."""
         return np.array([float(dispersed_ior(n, v, wavelength_nm)) for n, v in zip(self.ior_d, self.abbe)])
+
+    @cached_property
+    def distinct_channel_iors(self) -> np.ndarray:
+        """(wavelengths, surfaces): the channels' indices, once each (one row for achromatic glass)."""
+        return np.ascontiguousarray(np.unique(self.channel_iors().T, axis=0))
 
     def channel_iors(self) -> np.ndarray:
         """(surfaces, 3): each surface's index at each channel's wavelength (all three alike without dispersion)."""
@@ -329,6 +337,12 @@ def _intersect(system: LensSystem, i: int, z_vertex: float, o: np.ndarray, d: np
 
 
 def _trace(system: LensSystem, order, o, d, shift, stop_radius, ior, stop_inside=None, entering=True):
+    # A lost ray's numbers run off to infinity or NaN in the surfaces after it is lost: masked, not warned of.
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        return _trace_surfaces(system, order, o, d, shift, stop_radius, ior, stop_inside, entering)
+
+
+def _trace_surfaces(system, order, o, d, shift, stop_radius, ior, stop_inside, entering):
     z = system.vertex_z(shift)
     ok = np.ones(len(o), bool)
     for i in order:
@@ -363,6 +377,13 @@ def trace_from_film(system: LensSystem, o, d, shift, stop_radius, ior, stop_insi
                   shift, stop_radius, ior, stop_inside, entering=False)
 
 
+def _grown(box: np.ndarray, fraction: float) -> np.ndarray:
+    """A box (x0, y0, x1, y1) grown on every side by ``fraction`` of its width and height."""
+    box = np.asarray(box, float)
+    margin = fraction * (box[2:] - box[:2])
+    return np.concatenate([box[:2] - margin, box[2:] + margin])
+
+
 @dataclass(frozen=True, eq=False)
 class LensSetting:
     """A lens at one f-number and focus, making one image: what the renderer's camera rays are made from."""
@@ -391,49 +412,85 @@ class LensSetting:
     def stop_contains(self, points_mm: np.ndarray) -> np.ndarray:
         return self.aperture.contains(np.asarray(points_mm) / self.stop_radius)
 
-    @cached_property
+    @property
     def pupil_bounds(self) -> np.ndarray:
-        """(PUPIL_BINS, 4): for film points at radii in each bin along +x, the box (x0, y0, x1, y1) on the rear
-        vertex's plane that every ray which gets through the lens crosses (the exit pupil, seen from there); an
-        empty box where no ray gets through. Found, as pbrt does, by tracing grids of rays from points across each
-        bin (at every channel's wavelength), in two passes: a coarse grid over the whole rear element finds each
-        bin's box, a fine grid over that box draws it tight. Each box is one fine cell wider on every side than
-        the rays found, so that a ray between the grid's points is not lost; every sample outside the pupil is
-        wasted, so the tighter the box, the fewer."""
-        system = self.system
-        rear_radius = system.aperture_radius[-1]
+        """(PUPIL_BINS, 4): each radial bin's box round its exit pupil (x0, y0, x1, y1) (:meth:`_pupil_tables`)."""
+        return self._pupil_tables[0]
+
+    @property
+    def pupil_disks(self) -> np.ndarray:
+        """(PUPIL_BINS, 4): each radial bin's disk round its exit pupil (centre x, y, radius) and 1 where the disk
+        is sampled rather than the box, being the smaller (:meth:`_pupil_tables`)."""
+        return self._pupil_tables[1]
+
+    @cached_property
+    def _pupil_tables(self) -> tuple[np.ndarray, np.ndarray]:
+        """For film points at radii in each bin along +x, the box (x0, y0, x1, y1) on the rear vertex's plane that
+        every ray which gets through the lens crosses (the exit pupil, seen from there), and the disk round the
+        same rays; an empty box where no ray gets through. Every sample outside the pupil is wasted, so each bin is
+        sampled over the smaller of the two: the disk where the pupil is round (pi / 4 of its box), the box where
+        vignetting has cut it to a cat's eye.
+
+        Found, as pbrt does, by tracing grids of rays from points across each bin (its edges and middle, at every
+        channel's wavelength) to the rear plane. The pupil moves and shrinks smoothly across the image, so each
+        bin is searched where the last one's pupil was (the whole rear element for the first, finely, so that
+        the small pupil of a stopped-down lens is not missed between grid points), widening the search while the
+        rays found reach its edge; a fine grid over what is found then draws it tight, one fine cell wider on
+        every side so that no ray between the grid's points is lost."""
+        rear_radius = self.system.aperture_radius[-1]
         radii = np.linspace(0.0, self.film_radius_mm, PUPIL_BINS + 1)
         film_x = (radii[:-1, None] + (np.arange(PUPIL_FILM_STEPS) + 0.5) / PUPIL_FILM_STEPS
                   * (radii[1:] - radii[:-1])[:, None])
         film_x = np.concatenate([film_x, radii[:-1, None], radii[1:, None]], axis=1)  # the bin's edges too
-        whole = (-1.5 * rear_radius, -1.5 * rear_radius, 1.5 * rear_radius, 1.5 * rear_radius)
-        coarse = self._boxes_found(film_x, [whole] * PUPIL_BINS, PUPIL_COARSE_GRID)
-        return self._boxes_found(film_x, coarse, PUPIL_GRID)
-
-    def _boxes_found(self, film_x: np.ndarray, boxes, grid: int) -> np.ndarray:
-        """For each bin, the box round the points of a ``grid`` x ``grid`` grid over ``boxes[bin]`` (grown by one
-        cell) that rays from the bin's film points pass through, grown by one cell; zeros where none does."""
-        system = self.system
-        iors = np.ascontiguousarray(np.unique(system.channel_iors().T, axis=0))
-        # The stop as the circle round its corners: a bladed stop's corners reach past the round stop's radius.
-        stop_radius = self.stop_radius * self.aperture.scale
-        vertex_z = system.vertex_z(self.shift)
-        steps = (np.arange(grid) + 0.5) / grid
-        found = np.zeros((PUPIL_BINS, 4))
-        for b, (x0, y0, x1, y1) in enumerate(boxes):
-            if x1 <= x0 or y1 <= y0:
+        whole = np.array([-1.5, -1.5, 1.5, 1.5]) * rear_radius
+        boxes, disks = np.zeros((PUPIL_BINS, 4)), np.zeros((PUPIL_BINS, 4))
+        search = None
+        for b in range(PUPIL_BINS):
+            found = self._search_pupil(film_x[b], search, whole)
+            if found is None:
+                search = None  # beyond the image circle: look everywhere again further out
                 continue
-            cell_x, cell_y = (x1 - x0) / grid, (y1 - y0) / grid
-            x0, x1, y0, y1 = x0 - cell_x, x1 + cell_x, y0 - cell_y, y1 + cell_y
-            gx, gy = np.meshgrid(x0 + steps * (x1 - x0), y0 + steps * (y1 - y0))
-            gx, gy = gx.ravel(), gy.ravel()
-            passed = rays_through(film_x[b], gx, gy, self.sensor_z, vertex_z, system.radius, system.aperture_radius,
-                                  iors, stop_radius).any(axis=0)
-            if passed.any():
-                cell_x, cell_y = (x1 - x0) / grid, (y1 - y0) / grid
-                xs, ys = gx[passed], gy[passed]
-                found[b] = (xs.min() - cell_x, ys.min() - cell_y, xs.max() + cell_x, ys.max() + cell_y)
-        return found
+            xs, ys, cell_x, cell_y = self._scan(film_x[b], _grown(found, 1.0 / PUPIL_COARSE_GRID), PUPIL_GRID)
+            box = np.array([xs.min() - cell_x, ys.min() - cell_y, xs.max() + cell_x, ys.max() + cell_y])
+            centre = 0.5 * (box[:2] + box[2:])
+            radius = float(np.sqrt(((xs - centre[0]) ** 2 + (ys - centre[1]) ** 2).max())) + math.hypot(cell_x, cell_y)
+            boxes[b] = box
+            disks[b] = (*centre, radius, float(math.pi * radius * radius < (box[2] - box[0]) * (box[3] - box[1])))
+            search = _grown(box, 0.5)
+        return boxes, disks
+
+    def _search_pupil(self, film_x: np.ndarray, search, whole: np.ndarray) -> np.ndarray | None:
+        """The box round the coarse grid's points whose rays get through, searching ``search`` (None: the whole
+        rear element, on a grid fine enough for a stopped-down pupil) and widening it while they reach its edge."""
+        while True:
+            region = whole if search is None else search
+            grid = PUPIL_SEARCH_GRID if search is None else PUPIL_COARSE_GRID
+            xs, ys, cell_x, cell_y = self._scan(film_x, region, grid)
+            if not len(xs):
+                if search is None:
+                    return None
+                search = None
+                continue
+            box = np.array([xs.min() - cell_x, ys.min() - cell_y, xs.max() + cell_x, ys.max() + cell_y])
+            at_edge = (box[:2] <= region[:2] + cell_x).any() or (box[2:] >= region[2:] - cell_x).any()
+            if search is None or not at_edge:
+                return box
+            search = None if (_grown(box, 1.0)[2:] - _grown(box, 1.0)[:2] >= whole[2:] - whole[:2]).any() \
+                else _grown(box, 1.0)
+
+    def _scan(self, film_x: np.ndarray, region: np.ndarray, grid: int):
+        """The points of a ``grid`` x ``grid`` grid over ``region`` whose rays from any of ``film_x`` (on the
+        +x axis of the sensor) get out of the lens, and the grid's cell."""
+        system = self.system
+        x0, y0, x1, y1 = region
+        steps = (np.arange(grid) + 0.5) / grid
+        gx, gy = np.meshgrid(x0 + steps * (x1 - x0), y0 + steps * (y1 - y0))
+        gx, gy = gx.ravel(), gy.ravel()
+        # The stop as the circle round its corners: a bladed stop's corners reach past the round stop's radius.
+        passed = rays_through(film_x, gx, gy, self.sensor_z, system.vertex_z(self.shift), system.radius,
+                              system.aperture_radius, system.distinct_channel_iors,
+                              self.stop_radius * self.aperture.scale).any(axis=0)
+        return gx[passed], gy[passed], (x1 - x0) / grid, (y1 - y0) / grid
 
     @cached_property
     def ideal_irradiance(self) -> float:
@@ -452,13 +509,16 @@ class LensSetting:
 
     def sample_pupil(self, film: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Points on the rear vertex's plane towards the exit pupil of each film point, and their densities
-        (1 / the box's area): the box for the point's radius, turned to the point's direction (the lens is round)."""
+        (1 / the area sampled): the box or disk for the point's radius, turned to the point's direction (the lens is
+        round). A disk is sampled by the concentric map, which keeps a stratified pattern stratified."""
         r = np.hypot(film[:, 0], film[:, 1])
         index = np.minimum((r / self.film_radius_mm * PUPIL_BINS).astype(int), PUPIL_BINS - 1)
-        box = self.pupil_bounds[index]
-        area = (box[:, 2] - box[:, 0]) * (box[:, 3] - box[:, 1])
-        x = box[:, 0] + u[:, 0] * (box[:, 2] - box[:, 0])
-        y = box[:, 1] + u[:, 1] * (box[:, 3] - box[:, 1])
+        box, disk = self.pupil_bounds[index], self.pupil_disks[index]
+        on_disk = disk[:, 3] > 0.0
+        area = np.where(on_disk, math.pi * disk[:, 2] ** 2, (box[:, 2] - box[:, 0]) * (box[:, 3] - box[:, 1]))
+        in_disk = disk[:, :2] + disk[:, 2:3] * sample_concentric_disk(u)
+        x = np.where(on_disk, in_disk[:, 0], box[:, 0] + u[:, 0] * (box[:, 2] - box[:, 0]))
+        y = np.where(on_disk, in_disk[:, 1], box[:, 1] + u[:, 1] * (box[:, 3] - box[:, 1]))
         safe_r = np.where(r > 0.0, r, 1.0)
         cos_a = np.where(r > 0.0, film[:, 0] / safe_r, 1.0)
         sin_a = np.where(r > 0.0, film[:, 1] / safe_r, 0.0)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 
 @njit(cache=True)
@@ -52,7 +52,7 @@ def _gets_out(ox, oy, oz, dx, dy, dz, vertex_z, radius, aperture_radius, ior, st
     return True
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True)
 def rays_through(film_x, rear_x, rear_y, sensor_z, vertex_z, radius, aperture_radius, iors, stop_radius):
     """For every film point (film_x[i], 0, sensor_z) and every rear-plane point (rear_x[j], rear_y[j],
     vertex_z[-1]): whether the ray between them gets out of the front of the lens at any of the wavelengths whose
@@ -60,7 +60,7 @@ def rays_through(film_x, rear_x, rear_y, sensor_z, vertex_z, radius, aperture_ra
     (len(film_x), len(rear_x)) booleans."""
     count = len(radius)
     passed = np.zeros((len(film_x), len(rear_x)), np.bool_)
-    for i in prange(len(film_x)):
+    for i in range(len(film_x)):
         for j in range(len(rear_x)):
             ox, oz = film_x[i], sensor_z
             dx, dy, dz = rear_x[j] - ox, rear_y[j], vertex_z[count - 1] - oz

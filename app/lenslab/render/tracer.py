@@ -270,6 +270,7 @@ def real_lens_uniforms(frame: CameraFrame) -> dict[str, object]:
         "lens_film_radius": float(setting.film_radius_mm),
         "lens_weight_scale": float(1.0 / (depth * depth * setting.ideal_irradiance)),
         "lens_pupil": [tuple(float(v) for v in box) for box in setting.pupil_bounds],
+        "lens_pupil_disk": [tuple(float(v) for v in disk) for disk in setting.pupil_disks],
     }
 
 
