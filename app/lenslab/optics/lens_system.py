@@ -27,6 +27,7 @@ from functools import cached_property
 import numpy as np
 
 from .aperture import Aperture, sample_concentric_disk
+from .stops import exact_f_number
 from .prescription import LensPrescription
 from .pupil_trace import rays_through
 
@@ -37,8 +38,10 @@ D_LINE_NM, F_LINE_NM, C_LINE_NM = 587.56, 486.13, 656.27
 #: The wavelength each colour channel's camera samples are traced at, nm: the dominant wavelengths of the sRGB
 #: (Rec. 709) primaries, so that a fringe has the colour the channel shows.
 CHANNEL_WAVELENGTHS_NM = (612.0, 549.0, 465.0)
-#: Steps of the chief rays' table, from the centre of the image to its corner.
+#: Steps of the chief rays' table, from the centre of the image to its corner; aims tried across the rear element
+#: to bracket each chief ray before bisection closes in on it.
 CHIEF_RAY_STEPS = 512
+CHIEF_RAY_SCAN = 256
 #: Radial bins of the exit-pupil table, from the centre of the image to its corner (pbrt-v4 uses 64).
 PUPIL_BINS = 64
 #: Rear-plane points per side of the grids each bin's pupil is found with: over the whole rear element (where no
@@ -186,7 +189,8 @@ class LensSystem:
     def marked_f_number(self) -> float:
         """The widest f-number the lens is set to: as its source marks it (an f/2 design is f/2 even where
         paraxial optics says f/2.03; the stop opens no further than the glass allows), else the glass's own."""
-        return self.prescription.published_f_number or round(self.widest_f_number, 2)
+        marked = self.prescription.published_f_number
+        return exact_f_number(marked) if marked else round(self.widest_f_number, 2)
 
     def stop_radius_for(self, f_number: float) -> float:
         """The stop's radius, mm, that gives ``f_number``: the stop scales, the rest of the glass stays."""
@@ -250,12 +254,14 @@ class LensSystem:
             pupil_r = 0.5 * self.paraxial.entrance_pupil_diameter * stop_radius / self.aperture_radius[self.stop]
             target = np.stack([heights * pupil_r, np.zeros(rays), np.full(rays, pupil_z)], axis=-1)
             if origin_z is None:
-                origins = target - np.array([0.0, 0.0, 1.0]) * 10.0 * self.efl
                 directions = np.tile([0.0, 0.0, 1.0], (rays, 1))
             else:
-                origins = np.tile([0.0, 0.0, origin_z], (rays, 1))
-                directions = target - origins
+                directions = target - np.array([0.0, 0.0, origin_z])
                 directions /= np.linalg.norm(directions, axis=-1, keepdims=True)
+            # Each ray starts just in front of the lens, found back from its target: a point a thousand kilometres
+            # out would lose the rays' few micrometres to rounding in the spheres' intersections.
+            start_z = z[0] - self.aperture_radius[0] - 1.0
+            origins = target - directions * ((target[:, 2] - start_z) / directions[:, 2])[:, None]
             o, d, ok = trace_from_scene(self, origins, directions, shift, stop_radius, self.ior_d)
             if ok.sum() < 2:
                 return math.inf
@@ -264,21 +270,30 @@ class LensSystem:
             w = heights[ok]  # each ray stands for a ring of the pupil: weight by its radius
             return float(np.sum(w * x * x) / np.sum(w))
 
-        low, high = paraxial - span, paraxial + span
-        ratio = (math.sqrt(5.0) - 1.0) / 2.0
-        a, b = high - ratio * (high - low), low + ratio * (high - low)
-        fa, fb = spot(a), spot(b)
-        for _ in range(40):
-            if fa < fb:
-                high, b, fb = b, a, fa
-                a = high - ratio * (high - low)
-                fa = spot(a)
-            else:
-                low, a, fa = a, b, fb
-                b = low + ratio * (high - low)
-                fb = spot(b)
-        best = 0.5 * (low + high)
+        best = paraxial
+        for _ in range(4):  # a best focus found at the search's edge may lie beyond it: search again round it
+            low, high = best - span, best + span
+            best = _golden_section_minimum(spot, low, high)
+            if min(best - low, high - best) > 0.05 * span:
+                break
         return best if math.isfinite(spot(best)) else paraxial
+
+
+def _golden_section_minimum(f, low: float, high: float, steps: int = 40) -> float:
+    """Where the unimodal ``f`` is least on [low, high], by golden-section search."""
+    ratio = (math.sqrt(5.0) - 1.0) / 2.0
+    a, b = high - ratio * (high - low), low + ratio * (high - low)
+    fa, fb = f(a), f(b)
+    for _ in range(steps):
+        if fa < fb:
+            high, b, fb = b, a, fa
+            a = high - ratio * (high - low)
+            fa = f(a)
+        else:
+            low, a, fa = a, b, fb
+            b = low + ratio * (high - low)
+            fb = f(b)
+    return 0.5 * (low + high)
 
 
 def _reversed(system: LensSystem) -> LensSystem:
@@ -336,13 +351,15 @@ def _intersect(system: LensSystem, i: int, z_vertex: float, o: np.ndarray, d: np
     return p, normal, hit
 
 
-def _trace(system: LensSystem, order, o, d, shift, stop_radius, ior, stop_inside=None, entering=True):
+def _trace(system: LensSystem, order, o, d, shift, stop_radius, ior, stop_inside=None, entering=True, clip=True):
+    """Rays through the surfaces ``order``; ``clip`` False: through the glass's spheres alone, no clear aperture
+    or stop stopping them (the chief rays' geometry)."""
     # A lost ray's numbers run off to infinity or NaN in the surfaces after it is lost: masked, not warned of.
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        return _trace_surfaces(system, order, o, d, shift, stop_radius, ior, stop_inside, entering)
+        return _trace_surfaces(system, order, o, d, shift, stop_radius, ior, stop_inside, entering, clip)
 
 
-def _trace_surfaces(system, order, o, d, shift, stop_radius, ior, stop_inside, entering):
+def _trace_surfaces(system, order, o, d, shift, stop_radius, ior, stop_inside, entering, clip):
     z = system.vertex_z(shift)
     ok = np.ones(len(o), bool)
     for i in order:
@@ -350,10 +367,10 @@ def _trace_surfaces(system, order, o, d, shift, stop_radius, ior, stop_inside, e
         r2 = p[:, 0] ** 2 + p[:, 1] ** 2
         if system.radius[i] == 0.0:
             inside = stop_inside(p[:, :2]) if stop_inside is not None else r2 <= stop_radius * stop_radius
-            ok &= hit & inside
+            ok &= hit & (inside | (not clip))
             o = p
             continue
-        ok &= hit & (r2 <= system.aperture_radius[i] ** 2)
+        ok &= hit & ((r2 <= system.aperture_radius[i] ** 2) | (not clip))
         # Media either side of surface i: ior[i] behind it (towards the sensor), ior[i - 1] (or air) in front.
         n_front = 1.0 if i == 0 else ior[i - 1]
         n_back = ior[i]
@@ -601,10 +618,12 @@ class LensSetting:
         return origins, directions, ok.astype(float)
 
     def _aim_through_stop_centre(self, film: np.ndarray):
-        """Rays from film points through the centre of the stop, aimed by secant steps on the height at which
-        they cross the stop's plane."""
+        """Rays from film points through the centre of the stop, aimed by the glass's geometry alone (a rim may
+        clip the rays between a film point and the stop's centre that the search tries). Each is aimed at a point of the rear vertex's plane along its
+        film point's direction: a scan brackets the aim where the ray crosses the stop's plane at height 0 (the
+        bracket nearest the straight line to the stop's centre), bisection closes it. Where no ray through the
+        spheres reaches the stop's centre (beyond a fisheye's image circle) the point has no chief ray."""
         system = self.system
-        iors = system.ior_d
         r = np.hypot(film[:, 0], film[:, 1])
         safe_r = np.where(r > 0.0, r, 1.0)
         along = np.stack([np.where(r > 0.0, film[:, 0] / safe_r, 1.0), np.where(r > 0.0, film[:, 1] / safe_r, 0.0)],
@@ -612,29 +631,47 @@ class LensSetting:
         z = system.vertex_z(self.shift)
         behind = range(len(system.radius) - 1, system.stop, -1)
 
-        def stop_height(aim: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            target = np.stack([aim * along[:, 0], aim * along[:, 1], np.full(len(aim), self.rear_z)], axis=-1)
-            d = target - film
-            d /= np.linalg.norm(d, axis=-1, keepdims=True)
-            o, d2, ok = _trace(system, behind, film, d, self.shift, self.stop_radius, iors, entering=False)
-            t = (z[system.stop] - o[:, 2]) / d2[:, 2]
-            h = (o[:, 0] + t * d2[:, 0]) * along[:, 0] + (o[:, 1] + t * d2[:, 1]) * along[:, 1]
-            return np.where(ok, h, np.nan), d
+        def stop_height(aim: np.ndarray) -> np.ndarray:
+            """(N, K) heights along each film point's direction at which rays aimed at ``aim`` (N, K) cross the
+            stop's plane; NaN where a ray misses a sphere or is totally reflected."""
+            shape = aim.shape
+            origins = np.repeat(film, shape[1], axis=0)
+            directions_2d = np.repeat(along, shape[1], axis=0)
+            flat = aim.reshape(-1)
+            target = np.stack([flat * directions_2d[:, 0], flat * directions_2d[:, 1],
+                               np.full(len(flat), self.rear_z)], axis=-1)
+            d = (target - origins) / np.linalg.norm(target - origins, axis=-1, keepdims=True)
+            o, d, ok = _trace(system, behind, origins, d, self.shift, self.stop_radius, system.ior_d, entering=False,
+                              clip=False)
+            with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+                t = (z[system.stop] - o[:, 2]) / d[:, 2]
+                h = (o[:, 0] + t * d[:, 0]) * directions_2d[:, 0] + (o[:, 1] + t * d[:, 1]) * directions_2d[:, 1]
+            return np.where(ok & np.isfinite(h), h, np.nan).reshape(shape)
 
-        a0 = np.zeros(len(film))
-        # First guess: the straight line from the film point to the stop's centre.
-        a1 = r * (self.rear_z - z[system.stop]) / np.maximum(self.sensor_z - z[system.stop], 1e-9)
-        h0, _ = stop_height(a0)
-        h1, _ = stop_height(a1)
-        for _ in range(8):
-            step = h1 - h0
-            slope = (a1 - a0) / np.where(np.abs(step) > 1e-12, step, np.inf)
-            a2 = np.where(np.isfinite(h1), a1 - h1 * slope, 0.5 * (a0 + a1))
-            a0, h0 = a1, h1
-            a1 = a2
-            h1, _ = stop_height(a1)
-        target = np.stack([a1 * along[:, 0], a1 * along[:, 1], np.full(len(a1), self.rear_z)], axis=-1)
-        d = target - film
-        d /= np.linalg.norm(d, axis=-1, keepdims=True)
-        o, d, ok = trace_from_film(system, film, d, self.shift, self.system.aperture_radius[system.stop], iors)
-        return o, d, ok.astype(float)
+        reach = self.film_radius_mm + 1.5 * system.aperture_radius.max()
+        scan = np.linspace(-reach, reach, CHIEF_RAY_SCAN)
+        heights = stop_height(np.tile(scan, (len(film), 1)))
+        with np.errstate(invalid="ignore"):
+            crossing = (heights[:, :-1] * heights[:, 1:] <= 0.0) & np.isfinite(heights[:, :-1] + heights[:, 1:])
+        straight = r * (self.rear_z - z[system.stop]) / max(self.sensor_z - z[system.stop], 1e-9)
+        distance = np.where(crossing, np.abs(scan[:-1][None, :] - straight[:, None]), np.inf)
+        k = np.argmin(distance, axis=1)
+        found = np.isfinite(distance[np.arange(len(film)), k])
+        low, high = scan[k], scan[k + 1]
+        h_low = heights[np.arange(len(film)), k]
+        for _ in range(48):
+            middle = 0.5 * (low + high)
+            h_middle = stop_height(middle[:, None])[:, 0]
+            same_side = (h_middle * h_low > 0.0) & np.isfinite(h_middle)
+            low, h_low = np.where(same_side, middle, low), np.where(same_side, h_middle, h_low)
+            high = np.where(same_side, high, middle)
+        aim = 0.5 * (low + high)
+        # A bracket whose end fell off the glass (a ray missing a sphere) narrows onto that edge, not onto a
+        # crossing of the axis: only a ray that does cross the stop's centre is a chief ray.
+        found &= np.abs(stop_height(aim[:, None])[:, 0]) < 1e-6 * max(1.0, self.stop_radius)
+        target = np.stack([aim * along[:, 0], aim * along[:, 1], np.full(len(aim), self.rear_z)], axis=-1)
+        d = (target - film) / np.linalg.norm(target - film, axis=-1, keepdims=True)
+        # Through every rim too: past the last one that passes light (a fisheye's image circle), no pixel looks out.
+        o, d, ok = _trace(system, range(len(system.radius) - 1, -1, -1), film, d, self.shift, self.stop_radius,
+                          system.ior_d, entering=False)
+        return o, d, (ok & found).astype(float)
