@@ -165,7 +165,9 @@ def push_values(doc, target: tuple, changes: dict, text: str | None = None, merg
 
 class LensCommand(QUndoCommand):
     """Mount a lens preset (or none): it sets the focal length, clamps the aperture, sets the iris and moves the
-    focus out to the lens's minimum if it was nearer."""
+    focus out to the lens's minimum if it was nearer. A real lens names itself as the camera's ``real_lens`` and
+    sets the thin lens's stand-ins for glass aside (``LensPreset.mount``); none, or a thin-lens preset, takes a
+    real lens off."""
 
     def __init__(self, doc, lens: LensPreset | None):
         super().__init__(f"Lens {lens.name}" if lens else "No lens limits")
@@ -175,11 +177,13 @@ class LensCommand(QUndoCommand):
         changes = {}
         if lens is not None:
             changes = camera_changes_keeping_focus(cam, lens, **lens.mount(cam.focal_length_mm, cam.f_number))
+        elif cam.real_lens:  # Free: no limits, and the thin lens again
+            changes = camera_changes_keeping_focus(cam, None, real_lens="")
         self.old = {k: getattr(cam, k) for k in changes}
         self.new = changes
 
     def _apply(self, lens, values) -> None:
-        for key, value in values.items():
+        for key, value in _mounting_order(self.doc.scene.camera, values):
             self.doc.model.apply_value(("camera",), (key,), value, notify=False)
         self.doc.set_lens_state(lens)
         self.doc.model.notify(SceneChange("camera", ("camera",), ("focal_length_mm",)))
@@ -189,6 +193,20 @@ class LensCommand(QUndoCommand):
 
     def undo(self) -> None:
         self._apply(self.old_lens, self.old)
+
+
+def _mounting_order(camera, values: dict) -> list[tuple[str, Any]]:
+    """``values`` in an order that never leaves the camera one ``validate`` refuses between two of them: a real
+    lens comes off first (a thin lens takes any f-number, squeeze or aperture image), and the new one goes on last,
+    once the f-number is within it and the thin lens's stand-ins are set aside. Changing one real lens for another
+    passes through the thin lens."""
+    values = dict(values)
+    new_lens = values.pop("real_lens", camera.real_lens)
+    if new_lens == camera.real_lens:
+        return list(values.items())
+    off = [("real_lens", "")] if camera.real_lens else []
+    on = [("real_lens", new_lens)] if new_lens else []
+    return off + list(values.items()) + on
 
 
 class AddNodeCommand(QUndoCommand):

@@ -20,6 +20,7 @@ from PySide6.QtCore import QObject, Signal
 from PySide6.QtGui import QUndoStack
 
 from lenslab.optics import LensPreset
+from lenslab.optics.lenses import find_lens
 from lenslab.resources import scenes_dir
 from lenslab.scene.editable import CAMERA, EditableScene
 from lenslab.scene.events import EventEmitter
@@ -35,6 +36,20 @@ def is_shipped(path: Path | None) -> bool:
         return True
     except ValueError:
         return False
+
+
+def mounted_lens(scene: Scene) -> LensPreset | None:
+    """The lens a scene opens with: the real lens its camera is traced through, as the lens list names it (a lens
+    file's own entry where the camera names a file). A thin-lens preset leaves no trace in a scene, so any other
+    camera opens with no lens limits (Free); so does one whose real lens cannot be found (the render says why)."""
+    name = scene.camera.real_lens
+    if not name:
+        return None
+    try:
+        lens = find_lens(name)
+    except ValueError:  # PresetError too: no such lens, or a broken lens file
+        return None
+    return lens if lens.is_real else None
 
 
 def listen(emitter: EventEmitter, receiver: QObject, callback: Callable[[Any], None]) -> None:
@@ -58,7 +73,7 @@ class Document(QObject):
         self.path: Path | None = None
         self.display_name = "Untitled"
         self.selection: list[tuple] = []
-        self.lens: LensPreset | None = None
+        self.lens: LensPreset | None = mounted_lens(scene)
         self._set_path(path)
 
     @property
@@ -82,7 +97,7 @@ class Document(QObject):
         """Show another scene (File > Open, New): history and selection start afresh."""
         self._set_path(path)
         self.selection = []
-        self.lens = None
+        self.lens = mounted_lens(scene)
         self.undo_stack.clear()
         self.undo_stack.setClean()
         self.model.replace(scene)  # everything else is in place before anyone hears of it

@@ -31,7 +31,8 @@ from .stops import exact_f_number
 from .prescription import LensPrescription
 from .pupil_trace import rays_through
 
-__all__ = ["CHANNEL_WAVELENGTHS_NM", "LensSystem", "LensSetting", "PUPIL_BINS", "dispersed_ior"]
+__all__ = ["CHANNEL_WAVELENGTHS_NM", "LensSystem", "LensSetting", "PUPIL_BINS", "dispersed_ior", "refract",
+           "surface_crossing", "trace_from_film", "trace_from_scene"]
 
 #: The Fraunhofer lines the Abbe number is defined on, nm: V_d = (n_d - 1) / (n_F - n_C).
 D_LINE_NM, F_LINE_NM, C_LINE_NM = 587.56, 486.13, 656.27
@@ -81,7 +82,7 @@ class Paraxial:
         return self.efl / self.entrance_pupil_diameter
 
 
-def _refract(d: np.ndarray, normal: np.ndarray, eta: np.ndarray | float) -> tuple[np.ndarray, np.ndarray]:
+def refract(d: np.ndarray, normal: np.ndarray, eta: np.ndarray | float) -> tuple[np.ndarray, np.ndarray]:
     """Snell's law for unit directions ``d`` (N, 3) at unit normals facing against them; ``eta`` = n_in / n_out.
     Returns the refracted directions and which rays were not totally reflected."""
     cos_in = -np.einsum("ij,ij->i", d, normal)
@@ -323,7 +324,7 @@ def _reversed(system: LensSystem) -> LensSystem:
     return clone
 
 
-def _intersect(system: LensSystem, i: int, z_vertex: float, o: np.ndarray, d: np.ndarray):
+def surface_crossing(system: LensSystem, i: int, z_vertex: float, o: np.ndarray, d: np.ndarray):
     """Where rays (o, d) meet surface ``i`` (vertex at ``z_vertex``): the points, the unit normals facing the
     rays, and which rays hit it at all. The part of the sphere near its vertex is the surface."""
     radius = system.radius[i]
@@ -363,7 +364,7 @@ def _trace_surfaces(system, order, o, d, shift, stop_radius, ior, stop_inside, e
     z = system.vertex_z(shift)
     ok = np.ones(len(o), bool)
     for i in order:
-        p, normal, hit = _intersect(system, i, z[i], o, d)
+        p, normal, hit = surface_crossing(system, i, z[i], o, d)
         r2 = p[:, 0] ** 2 + p[:, 1] ** 2
         if system.radius[i] == 0.0:
             inside = stop_inside(p[:, :2]) if stop_inside is not None else r2 <= stop_radius * stop_radius
@@ -375,7 +376,7 @@ def _trace_surfaces(system, order, o, d, shift, stop_radius, ior, stop_inside, e
         n_front = 1.0 if i == 0 else ior[i - 1]
         n_back = ior[i]
         eta = n_back / n_front if not entering else n_front / n_back
-        d, not_reflected = _refract(d, normal, eta)
+        d, not_reflected = refract(d, normal, eta)
         ok &= not_reflected
         o = p
     return o, d, ok

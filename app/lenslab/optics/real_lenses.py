@@ -48,13 +48,33 @@ def real_lens_system(text: str) -> LensSystem:
         except OSError:
             raise ValueError(f"{text}: no such lens file") from None
         return _system_from_file(str(path.resolve()), modified)
-    from .lenses import find_lens
-
-    preset = find_lens(text)
+    preset = _preset_named(text, _lens_folders_state())
     if preset.prescription is None:
         raise ValueError(f"'{preset.name}' is a thin-lens preset, not a lens traced through its glass "
                          "(mount it as the lens, not as real_lens)")
     return system_for(preset.prescription)
+
+
+def _lens_folders_state() -> tuple:
+    """What the lens presets' folders hold, by name and modification time: a lookup by name is kept until a file
+    is added, removed or edited (reading every preset file again costs tens of milliseconds, and the studio looks
+    its camera's lens up at every refresh)."""
+    from .lenses import LENSES_DIR
+    from .presetfiles import preset_dirs
+
+    state = []
+    for folder in preset_dirs():
+        lenses = folder / LENSES_DIR
+        if lenses.is_dir():
+            state.extend((str(path), path.stat().st_mtime_ns) for path in sorted(lenses.iterdir()))
+    return tuple(state)
+
+
+@lru_cache(maxsize=32)
+def _preset_named(text: str, folders_state: tuple):
+    from .lenses import find_lens
+
+    return find_lens(text)
 
 
 @lru_cache(maxsize=32)

@@ -64,6 +64,8 @@ class CameraPanel(QWidget):
 
     lens_buttons = _SectionWidget("lens")
     lens_info = _SectionWidget("lens")
+    lens_diagram = _SectionWidget("lens")
+    lens_diagram_info = _SectionWidget("lens")
     iris = _SectionWidget("aperture")
     open_up = _SectionWidget("aperture")
     aperture_combo = _SectionWidget("aperture")
@@ -115,7 +117,9 @@ class CameraPanel(QWidget):
         saved = settings.value("camera/stop_scale", DEFAULT_STOP_SCALE) if settings is not None else DEFAULT_STOP_SCALE
         self.scale_name = saved if saved in STOP_SCALES else DEFAULT_STOP_SCALE
         try:
-            self.lenses = load_lens_presets()
+            # The thin-lens presets first, then the real lenses (each group by focal length), as the lens section
+            # shows them: Alt+1 to Alt+9 keep mounting the thin presets they always did.
+            self.lenses = sorted(load_lens_presets(), key=lambda lens: lens.is_real)
         except PresetError as exc:
             self.lenses = []
             self.status_message.emit(f"Lens presets not loaded: {exc}")
@@ -194,7 +198,7 @@ class CameraPanel(QWidget):
         cam = self.doc.scene.camera
         lens = self.doc.lens
         light = self.light_fraction()
-        self.lens_section.refresh(lens)
+        self.lens_section.refresh(lens, cam)
         self.aperture_section.refresh(cam, self.stop_scale(), self.scale_name, light)
         self.bokeh_section.refresh(cam)
         self.focal_section.refresh(cam, lens)

@@ -1,12 +1,13 @@
 """The camera panel's iris and bokeh section: the blades, their rotation and curvature, the anamorphic squeeze, the
-barrel's clipping (cat's eye) and an image of the stop."""
+barrel's clipping (cat's eye) and an image of the stop. The last three are the thin lens's stand-ins for what glass
+does: with a real lens mounted they step aside."""
 
 from __future__ import annotations
 
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from PySide6.QtWidgets import QFileDialog, QGridLayout, QHBoxLayout, QLabel, QPushButton, QToolButton
+from PySide6.QtWidgets import QFileDialog, QGridLayout, QHBoxLayout, QLabel, QPushButton, QToolButton, QWidget
 
 from lenslab.gui.camera_panel.section import CameraSection
 from lenslab.gui.widgets import IntEdit, NumberEdit, hint
@@ -43,11 +44,13 @@ class BokehSection(CameraSection):
                                           "Barrel clipping: cat's-eye bokeh and vignetting toward the corners, how "
                                           "far the barrel cuts into the stop at the frame's corner (0 none, 1 by "
                                           "the stop's radius)")
+        self.labels: dict[QWidget, QLabel] = {}
         for i, (label, widget) in enumerate((("Blades", self.blades), ("Rotation", self.rotation),
                                              ("Curvature", self.curvature), ("Squeeze", self.squeeze),
                                              ("Cat's eye", self.barrel))):
             text = QLabel(label)
             text.setToolTip(widget.toolTip())
+            self.labels[widget] = text
             grid.addWidget(text, i // 2, (i % 2) * 2)
             grid.addWidget(widget, i // 2, (i % 2) * 2 + 1)
         grid.setColumnStretch(1, 1)
@@ -67,6 +70,9 @@ class BokehSection(CameraSection):
         image_row.addWidget(self.aperture_image_clear)
         image_row.addWidget(self.aperture_image_label, 1)
         self.add(image_row)
+        # The thin lens's stand-ins for what glass does, and what each says while a real lens does it instead.
+        self.thin_lens_only = {widget: widget.toolTip() for widget in (
+            self.squeeze, self.barrel, self.aperture_image_button, self.aperture_image_clear)}
 
     def _camera_number(self, field: str, undo_text: str, decimals: int, step: float, tip: str) -> NumberEdit:
         """A number field that edits one of the camera's fields, within the range the field declares."""
@@ -120,3 +126,28 @@ class BokehSection(CameraSection):
         self.barrel.set_quietly(cam.barrel_clipping)
         self.aperture_image_label.setText(Path(cam.aperture_image).name if cam.aperture_image else "blades")
         self.aperture_image_clear.setEnabled(bool(cam.aperture_image))
+        self._show_glass_takes_over(cam.real_lens)
+
+    def _show_glass_takes_over(self, real_lens: str) -> None:
+        """With a real lens mounted its glass makes the cat's eye, the vignetting and the stop's image: the thin
+        lens's stand-ins for them step aside (the camera refuses them, ThinLensCamera.validate), and say why."""
+        glass = lens_display_name(real_lens)
+        for widget, thin_tip in self.thin_lens_only.items():
+            tip = (f"{glass} is traced through its glass, which makes its own bokeh, cat's eye and vignetting: "
+                   f"this thin-lens control does not apply (choose Free or a thin-lens preset to use it)"
+                   if real_lens else thin_tip)
+            widget.setToolTip(tip)
+            if real_lens:
+                widget.setEnabled(False)
+            elif widget is not self.aperture_image_clear:  # enabled above, while there is an image to clear
+                widget.setEnabled(True)
+            if widget in self.labels:
+                self.labels[widget].setEnabled(not real_lens)
+                self.labels[widget].setToolTip(tip)
+
+
+def lens_display_name(real_lens: str) -> str:
+    """A camera's ``real_lens`` as a sentence names it: a preset's name, or a lens file's name without its folder."""
+    from lenslab.optics.real_lenses import names_a_file
+
+    return f"The {Path(real_lens).stem}" if names_a_file(real_lens) else f"The {real_lens}"
