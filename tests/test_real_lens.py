@@ -173,3 +173,42 @@ def test_the_pupil_table_holds_every_ray_that_gets_through(lens, stop):
         (np.hypot(*frame.real_lens.film_points(pixels, 300, 200)[:, :2].T) / frame.real_lens.film_radius_mm
          * PUPIL_BINS).astype(int), PUPIL_BINS - 1), 2] != 0
     assert (weights[lit].max(axis=1) > 0).mean() > 0.5
+
+
+# -- where a pixel looks: click-to-focus and picking ---------------------------------------------------------------
+def test_click_to_focus_through_glass_makes_the_clicked_point_sharp():
+    """Click-to-focus sets the focus reading that puts the plane of focus at the clicked depth (from the camera's
+    position, where the depth buffer measures): the rays the centre pixel sends through every part of the pupil
+    then meet again at that point, to within what the lens's aberrations leave (under a millimetre at 2 m)."""
+    lens = next(lens for lens in REAL_LENSES if lens.name.startswith("50 mm"))
+    camera = mounted_camera(lens)
+    depth = 2.0
+    camera.focus_distance_m = camera.focus_setting_for(depth)
+    assert camera.plane_of_focus_m == pytest.approx(depth)
+    frame = camera.frame(300, 200)
+    rng = np.random.default_rng(2)
+    origins, directions, weights = frame.rays(np.tile([150.0, 100.0], (400, 1)), rng.random((400, 2)),
+                                              with_weights=True)
+    through = weights.max(axis=1) > 0
+    target = frame.position + depth * frame.forward
+    to_target = target - origins[through]
+    along = np.einsum("ij,ij->i", to_target, directions[through])
+    miss = np.linalg.norm(to_target - along[:, None] * directions[through], axis=1)
+    assert through.mean() > 0.5 and np.sqrt(np.mean(miss ** 2)) < 1e-3
+    # Focused at 1 m, the same rays miss the point by millimetres: the test can tell.
+    camera.focus_distance_m = camera.focus_setting_for(1.0)
+    origins, directions, _ = camera.frame(300, 200).rays(np.tile([150.0, 100.0], (400, 1)), rng.random((400, 2)),
+                                                         with_weights=True)
+    to_target = target - origins
+    along = np.einsum("ij,ij->i", to_target, directions)
+    assert np.sqrt(np.mean(np.linalg.norm(to_target - along[:, None] * directions, axis=1) ** 2)) > 0.005
+
+
+def test_a_pixel_beyond_the_fisheyes_image_circle_looks_nowhere():
+    """The corners of a full-frame image through the 10 mm fisheye lie outside its image circle: no chief ray leaves
+    the lens from there, so picking and the depth buffer find nothing (weight 0), while the centre looks ahead."""
+    lens = next(lens for lens in REAL_LENSES if lens.name.startswith("10 mm"))
+    frame = mounted_camera(lens).frame(300, 200)
+    _, directions, looks_out = frame.rays([(0.5, 0.5), (150.0, 100.0)], with_weights=True)
+    assert looks_out[0].max() == 0.0 and looks_out[1].min() == 1.0
+    assert directions[1] @ frame.forward == pytest.approx(1.0, abs=1e-3)

@@ -787,12 +787,14 @@ class RenderLoop:
         w, h = self._size
         frame = session.frame  # the full-size picture's, as the g-buffer is only made between full passes
         self._gbuffer_time = time.perf_counter()
-        origins, directions = frame.rays(frame.pixel_centres())
+        origins, directions, looks_out = frame.rays(frame.pixel_centres(), with_weights=True)
         hits = cast_rays(self._renderer, session.gpu_scene, origins, directions)
-        node_index = session.hit_nodes(hits)
+        # A pixel no ray leaves the lens from (beyond a fisheye's image circle) sees nothing.
+        seen = (hits.prim >= 0) & (np.reshape(looks_out, (len(origins), -1)).max(axis=1) > 0.0)
+        node_index = np.where(seen, session.hit_nodes(hits), -1)
         # Depth along the view axis from the camera's position (a real lens's chief rays leave its front element).
         along = (origins - frame.position) @ frame.forward + hits.t * (directions @ frame.forward)
-        depth = np.where(hits.prim >= 0, along, np.inf).astype(np.float32)
+        depth = np.where(seen, along, np.inf).astype(np.float32)
         self._gbuffer_size = (w, h)
         self._events.gbuffer_ready(GBuffer(node_index.reshape(h, w), depth.reshape(h, w), self._generation))
 

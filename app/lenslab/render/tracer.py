@@ -733,7 +733,9 @@ class RenderSession:
         from lenslab.render.raycast import cast_rays
 
         frame = self.frame
-        origins, directions = frame.rays([(x, y)])
+        origins, directions, looks_out = frame.rays([(x, y)], with_weights=True)
+        if not np.max(looks_out) > 0.0:  # beyond a fisheye's image circle: no ray from there leaves the lens
+            return None
         hits = cast_rays(self.renderer, self._gpu_scene, origins, directions)
         prim = int(hits.prim[0])
         if prim < 0:
