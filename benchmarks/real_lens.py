@@ -15,24 +15,19 @@ import argparse
 import dataclasses
 import math
 import statistics
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
-from lenslab.optics.lenses import load_lens_presets
-from lenslab.optics.real_lenses import system_for
-from lenslab.render.tracer import Renderer, RenderSession
-from lenslab.scene.io.loader import open_scene
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from render_throughput import samples_per_second  # noqa: E402
 
-
-def samples_per_second(renderer, scene, size: int, seconds: float) -> float:
-    session = RenderSession(renderer, scene, width=size, height=size, dispatch_seconds=0.25)
-    session.step(0.0, 1)  # compile and warm up, excluded from the figure
-    start, traced = time.perf_counter(), session.progress().samples_per_second * session.elapsed_seconds
-    session.step(seconds)
-    rate = (session.progress().samples_per_second * session.elapsed_seconds - traced) / (time.perf_counter() - start)
-    session.release()
-    return rate
+from lenslab.optics.lenses import load_lens_presets  # noqa: E402
+from lenslab.optics.real_lenses import system_for  # noqa: E402
+from lenslab.render.tracer import Renderer  # noqa: E402
+from lenslab.scene.io.loader import open_scene  # noqa: E402
 
 
 def with_camera(scene, **fields):

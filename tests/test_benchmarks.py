@@ -35,6 +35,13 @@ def test_vs_mitsuba_renders_every_scene_with_both_samplers(renderer, tmp_path):
 
 
 @pytest.mark.gl
+def test_real_lens_prints_a_cost_per_lens_and_depth(renderer, tmp_path):
+    out = run("real_lens.py", "--seconds", 0.05, "--size", 16, "--rounds", 1, tmp_path=tmp_path)
+    rows = [line.split() for line in out.splitlines() if line[:1].isdigit()]
+    assert len(rows) == 8 and all(float(row[-1]) > 0 for row in rows)  # four lenses, two depths; a table time
+
+
+@pytest.mark.gl
 def test_render_throughput_prints_a_figure_per_scene_and_depth(renderer, tmp_path):
     out = run("render_throughput.py", "--seconds", 0.05, "--size", 16, tmp_path=tmp_path)
     assert out.count("cornell_box") == 5 and out.count("dof_chart") == 5
