@@ -494,7 +494,7 @@ def test_shipped_lenses_are_achromats():
         system = LensSystem(read_prescription_file(path))
         back_focus = {}
         for line in (F_LINE_NM, C_LINE_NM):
-            y, nu, _ = system._paraxial_trace(1.0, 0.0, system.ior(line))
+            y, nu, _ = system.paraxial_trace(1.0, 0.0, system.ior(line))
             back_focus[line] = -y / nu
         assert abs(back_focus[F_LINE_NM] - back_focus[C_LINE_NM]) < 0.02, path.name
 

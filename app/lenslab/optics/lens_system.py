@@ -134,9 +134,10 @@ class LensSystem:
         return np.stack([self.ior(w) for w in CHANNEL_WAVELENGTHS_NM], axis=1)
 
     # -- first order ---------------------------------------------------------------------------------------
-    def _paraxial_trace(self, y: float, nu: float, ior: np.ndarray) -> tuple[float, float, list[float]]:
-        """A paraxial ray (height y, reduced angle n u) from the front to the rear vertex's plane; the heights
-        at each surface."""
+    def paraxial_trace(self, y: float, nu: float, ior: np.ndarray) -> tuple[float, float, list[float]]:
+        """A paraxial ray entering at height y with reduced angle n u, through the surfaces with the indices
+        ``ior`` (one wavelength's): its height on the rear vertex's plane, its reduced angle after the last
+        surface, and its height at each surface."""
         n_before, heights = 1.0, []
         for i, (radius, n_after) in enumerate(zip(self.radius, ior)):
             heights.append(y)
@@ -150,18 +151,17 @@ class LensSystem:
     @cached_property
     def paraxial(self) -> Paraxial:
         ior = self.ior_d
-        y, nu, _ = self._paraxial_trace(1.0, 0.0, ior)  # a ray from infinity at unit height
+        y, nu, _ = self.paraxial_trace(1.0, 0.0, ior)  # a ray from infinity at unit height
         if nu == 0.0:
             raise ValueError(f"lens '{self.name}' has no power: it is afocal, it cannot form an image")
         efl = -1.0 / nu
         back_focal = -y / nu
         # The front focal distance from a ray traced backwards: reverse the lens (radii negated, order reversed).
         reversed_system = _reversed(self)
-        yr, nur, _ = reversed_system._paraxial_trace(1.0, 0.0, reversed_system.ior_d)
+        yr, nur, _ = reversed_system.paraxial_trace(1.0, 0.0, reversed_system.ior_d)
         front_focal = -yr / nur
         track = float(self.vertex_from_front[-1])
-        # The entrance pupil: the stop's image in the glass in front of it; a paraxial ray from the stop's centre
-        # traced forwards out of the front gives its position, one from the stop's rim its size.
+        # The entrance pupil: the stop's image in the glass in front of it (its position and size fix the f-number).
         pupil_z, pupil_diameter = self._entrance_pupil()
         return Paraxial(efl=efl, back_focal=back_focal, front_focal=front_focal, track=track,
                         entrance_pupil_z=pupil_z, entrance_pupil_diameter=pupil_diameter)
@@ -172,8 +172,8 @@ class LensSystem:
         crosses the stop at y h_a + u h_b, h_a and h_b the heights of the rays (1, 0) and (0, 1). The chief ray
         (stop height 0) crosses the axis at z = h_b / h_a; a beam parallel to the axis fills the stop at
         height r_stop / h_a."""
-        _, _, unit_height = self._paraxial_trace(1.0, 0.0, self.ior_d)
-        _, _, unit_slope = self._paraxial_trace(0.0, 1.0, self.ior_d)
+        _, _, unit_height = self.paraxial_trace(1.0, 0.0, self.ior_d)
+        _, _, unit_slope = self.paraxial_trace(0.0, 1.0, self.ior_d)
         h_a, h_b = unit_height[self.stop], unit_slope[self.stop]
         return float(h_b / h_a), float(2.0 * self.aperture_radius[self.stop] / abs(h_a))
 
