@@ -156,9 +156,10 @@ PBRT_BROKEN = [
     ("infinity", _replace_row(2, "1e400 0.12 1 25.2"), 2, "finite"),
     ("ior too high", _replace_row(4, "40.77 3.275 3.5 23"), 4, "ior"),
     ("negative ior", _replace_row(4, "40.77 3.275 -1.5 23"), 4, "ior"),
-    ("negative thickness", _replace_row(2, "84.83 -0.12 1 25.2"), 2, "thickness_mm"),
-    ("no aperture", _replace_row(7, "-14.495 1.18 1.603 0"), 7, "aperture_mm"),
-    ("sphere smaller than aperture", _replace_row(5, "8.75 5.705 1 18"), 5, "half the clear aperture"),
+    # A row of a pbrt file is told in pbrt's column names (thickness, aperture), not our keys.
+    ("negative thickness", _replace_row(2, "84.83 -0.12 1 25.2"), 2, "thickness must be"),
+    ("no aperture", _replace_row(7, "-14.495 1.18 1.603 0"), 7, "aperture must be"),
+    ("sphere smaller than aperture", _replace_row(5, "8.75 5.705 1 18"), 5, "smaller than the semi-aperture"),
     ("glass behind the stop", _replace_row(6, "0 4.5 1.5 17.1"), 6, "stop"),
     ("a second stop", _replace_row(9, "0 0.19 1 20"), 9, "second aperture stop"),
     ("no stop", _replace_row(6, "1000 4.5 0 17.1"), None, "no aperture stop"),
@@ -258,7 +259,7 @@ MAPPING_BROKEN = [
     ("surfaces[4].abbe", 0, "surfaces[4].abbe", "(0, 150]"),
     ("surfaces[2].abbe", 64.17, "surfaces[2].abbe", "air"),
     ("surfaces[4].glass", 7, "surfaces[4].glass", "expected a string"),
-    ("surfaces[5].radius_mm", 8.0, "surfaces[5].radius_mm", "half the clear aperture"),
+    ("surfaces[5].radius_mm", 8.0, "surfaces[5].radius_mm", "smaller than the semi-aperture"),
     ("surfaces[6].ior", 1.5, "surfaces[6].ior", "stop"),
     ("surfaces[9].radius_mm", 0, "surfaces[9]", "second aperture stop"),
     ("surfaces[6].radius_mm", 1000, "surfaces", "no aperture stop"),
@@ -329,7 +330,7 @@ def test_built_in_memory_errors_name_the_surface():
     assert one_line_naming(caught.value, "surface 5", "second aperture stop").startswith("surface 5")
     with pytest.raises(PrescriptionError) as caught:
         LensSurface(4.0, 1.0, 1.5, None, 10.0)
-    one_line_naming(caught.value, "radius_mm", "half the clear aperture")
+    one_line_naming(caught.value, "radius_mm", "smaller than the semi-aperture")
     with pytest.raises(PrescriptionError) as caught:
         LensSurface(10.0, 1.0, 1.5, 200.0, 10.0)
     one_line_naming(caught.value, "abbe", "(0, 150]")

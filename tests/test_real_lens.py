@@ -74,6 +74,8 @@ def test_the_command_line_mounts_a_real_lens_and_the_file_names_it(renderer, tmp
     assert metadata["Exif:LensModel"] == "50 mm f/2 double-Gauss"
     assert metadata["Exif:FocalLength"] == pytest.approx(50.358, abs=0.01)  # the glass's, not the name's
     assert float(metadata["lenslab:RealLensFocusShiftMM"]) > 1.0  # it moved forward to focus at 1.5 m
+    # The thin lens's stand-ins did nothing: the file does not claim them.
+    assert "lenslab:AnamorphicSqueeze" not in metadata and "lenslab:BarrelClipping" not in metadata
     assert np.isfinite(pixels).all() and pixels.mean() > 0.01
 
 
@@ -84,15 +86,19 @@ def test_a_pbrt_lens_file_is_a_lens_on_the_command_line(renderer, tmp_path, caps
     lens_file = tmp_path / "dgauss.50mm.dat"
     lens_file.write_text(DOUBLE_GAUSS_ROWS)
     out = tmp_path / "shot.exr"
+    # Its glass traces to f/2.03, a 50.36 mm: marked (and typed) as the f/2 50 mm it is.
     run = run_cli(capsys, "cornell_box", "--headless", "-o", out, "--lens", lens_file, "--spp", "1", "--width", "32",
-                  "--height", "32")
+                  "--height", "32", "--f-number", "2", "--focal-length", "50")
     assert run.status == 0, run.err
     _, metadata = read_image(out)
-    assert metadata["Exif:LensModel"] == "dgauss.50mm"
+    assert metadata["Exif:LensModel"] == "dgauss.50mm" and metadata["lenslab:RealLensFile"] == str(lens_file)
+    assert metadata["Exif:FocalLength"] == pytest.approx(50.358, abs=0.01) and metadata["FNumber"] == 2.0
 
 
 @pytest.mark.parametrize("argv, words, status", [
     (["--lens", "50 mm f/2 double-Gauss", "--f-number", "1.4"], "f/1.4 is not on the lens", 2),
+    (["--lens", "50 mm f/2 double-Gauss", "--focal-length", "35"], "not on the lens '50 mm f/2 double-Gauss' "
+     "(50.36 mm)", 2),
     (["--lens", "50 mm f/2 double-Gauss", "--anamorphic-squeeze", "2"], "applies to the thin lens only", 1),
     (["--lens", "50 mm f/2 double-Gauss", "--focus-distance", "0.1"], "nearer than", 1),
 ])

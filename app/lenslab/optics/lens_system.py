@@ -27,7 +27,7 @@ from functools import cached_property
 import numpy as np
 
 from .aperture import Aperture, sample_concentric_disk
-from .stops import exact_f_number
+from .stops import exact_f_number, stop_scale
 from .prescription import LensPrescription
 from .pupil_trace import rays_through
 
@@ -39,6 +39,8 @@ D_LINE_NM, F_LINE_NM, C_LINE_NM = 587.56, 486.13, 656.27
 #: The wavelength each colour channel's camera samples are traced at, nm: the dominant wavelengths of the sRGB
 #: (Rec. 709) primaries, so that a fringe has the colour the channel shows.
 CHANNEL_WAVELENGTHS_NM = (612.0, 549.0, 465.0)
+#: The exact third stops, which a lens's widest aperture is marked by.
+THIRD_STOPS_EXACT = tuple(stop_scale("third").exact)
 #: Steps of the chief rays' table, from the centre of the image to its corner; aims tried across the rear element
 #: to bracket each chief ray before bisection closes in on it.
 CHIEF_RAY_STEPS = 512
@@ -189,9 +191,15 @@ class LensSystem:
     @property
     def marked_f_number(self) -> float:
         """The widest f-number the lens is set to: as its source marks it (an f/2 design is f/2 even where
-        paraxial optics says f/2.03; the stop opens no further than the glass allows), else the glass's own."""
+        paraxial optics says f/2.03; the stop opens no further than the glass allows), else the third stop the
+        glass's is within 3% of, else the glass's own."""
         marked = self.prescription.published_f_number
-        return exact_f_number(marked) if marked else round(self.widest_f_number, 2)
+        if marked:
+            return exact_f_number(marked)
+        # No mark given: the third stop within 3% of the glass's (f/2.03 is an f/2 lens), else the glass's own.
+        glass = self.widest_f_number
+        nearest = min(THIRD_STOPS_EXACT, key=lambda stop: abs(stop / glass - 1.0))
+        return nearest if abs(nearest / glass - 1.0) <= 0.03 else round(glass, 2)
 
     def stop_radius_for(self, f_number: float) -> float:
         """The stop's radius, mm, that gives ``f_number``: the stop scales, the rest of the glass stays."""

@@ -236,13 +236,13 @@ def read_lens_file(path) -> LensPreset:
 
 
 def real_lens_preset(prescription: LensPrescription) -> LensPreset:
-    """The lens-list entry of a real lens: its focal length and widest aperture from its glass (the marked
-    f-number where its source gives one: an f/2 lens is sold and set as f/2 even where paraxial optics says
-    f/2.03; its stop cannot open further than the glass allows)."""
+    """The lens-list entry of a real lens: its focal length and widest aperture from its glass (as marked: an f/2
+    lens is sold and set as f/2 even where paraxial optics says f/2.03; its stop cannot open further than the
+    glass allows; LensSystem.marked_f_number)."""
     from .real_lenses import system_for
 
     system = system_for(prescription)
-    widest = prescription.published_f_number or round(system.widest_f_number, 2)
+    widest = system.marked_f_number
     return LensPreset(prescription.name, focal_length_mm=system.efl, widest_f_number=widest,
                       narrowest_f_number=max(widest, prescription.narrowest_f_number),
                       aperture_blades=prescription.aperture_blades,

@@ -75,6 +75,10 @@ MAX_FILE_BYTES = 1 << 20
 PRESCRIPTION_SUFFIXES = (".dat", ".toml", ".json")
 
 
+#: Our surface keys by the names of the columns of pbrt's lens files, for errors said of a row of one.
+_PBRT_COLUMNS = {"radius_mm": "radius", "thickness_mm": "thickness", "aperture_mm": "aperture"}
+
+
 class PrescriptionError(PresetError):
     """A prescription that cannot be used.  ``str()`` is one line: the file (when there is one), where in it,
     and the problem, e.g. ``dgauss.dat: line 9 (surface 4): ior must lie in [1, 3], got 3.5`` or
@@ -112,7 +116,9 @@ class PrescriptionError(PresetError):
                 where = f"line {line}" + (f" (surface {surface})" if surface is not None else "")
             else:
                 where = f"surface {surface}" if surface is not None else ""
-            what = f"{field} {self.problem}" if field else self.problem
+            # A row of a pbrt file names its columns as pbrt's comment line does, not as our keys.
+            name = _PBRT_COLUMNS.get(field, field) if line is not None else field
+            what = f"{name} {self.problem}" if field else self.problem
         parts = [str(p) for p in (self.path, where) if p]
         ValueError.__init__(self, ": ".join(parts + [what]))
 
@@ -203,8 +209,8 @@ class LensSurface:
             # A sphere of radius R has no cap wider than 2R: the clear aperture cannot be cut from it.
             raise PrescriptionError(
                 None,
-                f"{abs(self.radius_mm):g} mm in size is less than half the clear aperture ({self.aperture_mm:g} mm): "
-                "no sphere that small is that wide",
+                f"{abs(self.radius_mm):g} mm is smaller than the semi-aperture {self.aperture_mm / 2:g} mm "
+                f"(clear aperture {self.aperture_mm:g} mm): no sphere that small is that wide",
                 field="radius_mm")
 
     @property

@@ -244,6 +244,9 @@ def image_metadata(scene: Scene, spp: int, frame: CameraFrame) -> dict[str, obje
     }
     if cam.aperture_image:
         used["aperture_image"] = cam.aperture_image
+    if frame.real_lens is not None:  # the thin lens's stand-ins: the glass does their work, they do nothing
+        for name in ("anamorphic_squeeze", "barrel_clipping", "focus_breathing"):
+            del used[name]
     if cam.exposure_mode == "physical":
         used.update(shutter=float(cam.shutter_s), iso=int(round(cam.iso)))
     metadata: dict[str, object] = {
@@ -283,7 +286,8 @@ def real_lens_metadata(frame: CameraFrame) -> dict[str, object]:
     return {
         "Exif:LensModel": system.name,
         "lenslab:RealLens": system.name,
-        "lenslab:RealLensSource": system.prescription.source or str(system.prescription.path or ""),
+        "lenslab:RealLensSource": system.prescription.source or system.prescription.description,
+        "lenslab:RealLensFile": str(system.prescription.path or ""),
         "lenslab:RealLensSurfaces": len(system.radius),
         "lenslab:RealLensFocusShiftMM": float(setting.shift),
         "lenslab:RealLensStopDiameterMM": float(2.0 * setting.stop_radius),

@@ -310,8 +310,8 @@ class ThinLensCamera:
         for name, idle in (("anamorphic_squeeze", 1.0), ("barrel_clipping", 0.0), ("aperture_image", ""),
                            ("pinhole", False)):
             if getattr(self, name) != idle:
-                raise CameraValueError(name, getattr(self, name), f"applies to the thin lens only; the "
-                                       f"{system.name} is traced through its glass (set real_lens to \"\" first)")
+                raise CameraValueError(name, getattr(self, name), f"applies to the thin lens only: the "
+                                       f"{system.name} is traced through its glass, which does this itself")
 
     def real_lens_setting(self, film_mm: tuple[float, float], base_dir: Path | None = None) -> LensSetting:
         """The real lens at this camera's f-number and focus, making an image of ``film_mm`` of sensor."""

@@ -217,7 +217,8 @@ _ROWS = (
     Option("clamp", float, "tame fireflies: cap the radiance one sample may add (biased; 0 = off, the default)",
            "render.clamp", metavar="L", metadata="lenslab:Clamp"),
     Option("lens", str, "mount a lens preset: its focal lengths, stops, iris and minimum focus (see --list-lenses; "
-           "the name's beginning will do where only one lens has it: 85mm)", metavar="NAME", parse_text=_lens_name),
+           "the name's beginning will do where only one lens has it: 85mm), or a real lens's file (.toml, .json or "
+           "pbrt's .dat; docs/lenses.md), traced through its glass", metavar="NAME", parse_text=_lens_name),
     Option("sensor", str, "a sensor preset: its size and circle of confusion (see --list-sensors)", metavar="NAME",
            parse_text=_sensor_name),
     Option("sensor_fit", str, "which part of the sensor the image shows (auto: the long sides together)",

@@ -43,9 +43,10 @@ class _OverridesMethods:
         """A focal length or f-number given with a lens must be one the lens has: f/1.2 on an f/1.4 lens is
         refused, not quietly changed."""
         lens = find_lens(self.lens)
-        if self.focal_length is not None and lens.clamp_focal_length(self.focal_length) != self.focal_length:
-            raise ValueError(f"focal_length {self.focal_length:g} mm is not on the lens '{lens.name}' "
-                             f"({lens.min_focal_length_mm:g}-{lens.max_focal_length_mm:g} mm)")
+        if self.focal_length is not None and not _on_the_lens(lens, self.focal_length):
+            on_it = (f"{lens.min_focal_length_mm:g}-{lens.max_focal_length_mm:g} mm" if lens.is_zoom
+                     else f"{lens.focal_length_mm:.4g} mm")
+            raise ValueError(f"focal_length {self.focal_length:g} mm is not on the lens '{lens.name}' ({on_it})")
         if self.f_number is not None and lens.clamp_f_number(self.f_number) != self.f_number:
             raise ValueError(f"{format_f_number(self.f_number)} is not on the lens '{lens.name}' "
                              f"({format_f_number(lens.widest_f_number)} to {format_f_number(lens.narrowest_f_number)})")
@@ -68,6 +69,8 @@ class _OverridesMethods:
             mounted = find_lens(self.lens).mount(camera_changes.get("focal_length_mm", camera.focal_length_mm),
                                                  camera_changes.get("f_number", camera.f_number))
             camera_changes = {**mounted, **camera_changes}
+            if mounted.get("real_lens"):  # the glass's focal length, whatever the barrel's rounded mark said
+                camera_changes["focal_length_mm"] = mounted["focal_length_mm"]
         if self.width is not None or self.height is not None:
             camera_changes["resolution"] = self._resolution(scene.camera.resolution)
         render_changes = self._changes("render")
@@ -113,3 +116,12 @@ SceneOverrides.__module__ = __name__
 SceneOverrides.__doc__ = """Settings for one render on top of the scene's: one field per option of scene/options.py,
 None where the scene's own value stays, and the Mitsuba defines. Checked when made (a ValueError of one line);
 ``open`` reads a scene file with them, ``apply`` sets them on a scene already read."""
+
+
+def _on_the_lens(lens, focal_length_mm: float) -> bool:
+    """Whether a focal length is one the lens has: within a zoom's range, a prime's own, or for a real lens
+    (whose glass fixes it: 50.36 mm for the 50 mm double-Gauss) what its barrel would say, within 2%."""
+    if lens.is_real:
+        marks = [lens.focal_length_mm, lens.prescription.published_focal_length_mm or lens.focal_length_mm]
+        return any(abs(focal_length_mm / mark - 1.0) <= 0.02 for mark in marks)
+    return lens.clamp_focal_length(focal_length_mm) == focal_length_mm
