@@ -218,3 +218,27 @@ def test_a_pixel_beyond_the_fisheyes_image_circle_looks_nowhere():
     _, directions, looks_out = frame.rays([(0.5, 0.5), (150.0, 100.0)], with_weights=True)
     assert looks_out[0].max() == 0.0 and looks_out[1].min() == 1.0
     assert directions[1] @ frame.forward == pytest.approx(1.0, abs=1e-3)
+
+
+def test_dispersion_off_traces_every_colour_at_the_d_line(tmp_path, capsys, renderer):
+    """A preview without the colour noise: with dispersion off, a dispersive lens's samples weigh all three
+    channels alike and follow the same path whatever their first third of u.x; on, one channel at a time (3, 0, 0
+    and so on). The command line says --no-dispersion and the file records it."""
+    from lenslab.render.film import read_image
+    from tests.helpers import run_cli
+
+    lens = next(lens for lens in REAL_LENSES if lens.name.startswith("50 mm"))
+    rng = np.random.default_rng(4)
+    pixels, u = rng.random((300, 2)) * [300, 200], rng.random((300, 2))
+    _, _, on = mounted_camera(lens).frame(300, 200).rays(pixels, u, with_weights=True)
+    _, _, off = mounted_camera(lens, dispersion=False).frame(300, 200).rays(pixels, u, with_weights=True)
+    lit = on.max(axis=1) > 0
+    assert ((on[lit] > 0).sum(axis=1) == 1).all() and np.allclose(on[lit].max(axis=1) / 3.0, on[lit].sum(axis=1) / 3.0)
+    lit_off = off.max(axis=1) > 0
+    assert np.allclose(off[lit_off, 0], off[lit_off, 1]) and np.allclose(off[lit_off, 1], off[lit_off, 2])
+    out = tmp_path / "preview.exr"
+    run = run_cli(capsys, "cornell_box", "--headless", "-o", out, "--lens", "50 mm f/2 double-Gauss",
+                  "--no-dispersion", "--spp", "1", "--width", "16", "--height", "16")
+    assert run.status == 0, run.err
+    _, metadata = read_image(out)
+    assert int(metadata["lenslab:Dispersion"]) == 0 and int(metadata["lenslab:RealLensDispersive"]) == 0

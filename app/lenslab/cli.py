@@ -54,7 +54,7 @@ def build_parser() -> argparse.ArgumentParser:
     for name in ("spp", "time_limit", "width", "height", "f_number", "focal_length", "focus_distance"):
         add_option(p, name)
     camera = p.add_argument_group("camera and lens")
-    for name in ("lens", "sensor", "sensor_fit", "focus_from", "focus_breathing", "circle_of_confusion",
+    for name in ("lens", "dispersion", "sensor", "sensor_fit", "focus_from", "focus_breathing", "circle_of_confusion",
                  "aperture_blades", "blade_curvature", "anamorphic_squeeze", "barrel_clipping", "aperture_image",
                  "exposure_mode", "iso", "shutter"):
         add_option(camera, name)

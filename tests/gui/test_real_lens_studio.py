@@ -172,3 +172,19 @@ def test_a_scene_whose_camera_names_a_real_lens_opens_with_that_lens_mounted(stu
     assert Document(open_scene(str(path))).lens == lens  # the window's first scene
     panel.choose_lens(None)
     assert doc.scene.camera.real_lens == ""
+
+
+def test_the_dispersion_switch_shows_for_dispersive_glass_and_sets_the_camera(studio):
+    """The lens section offers an achromatic preview for glass that disperses: unticking it sets the camera's
+    dispersion off in one undo step; a thin lens hides the switch."""
+    panel = studio
+    doc = panel.doc
+    panel.choose_lens(lens_named(panel, DOUBLE_GAUSS))
+    assert panel.dispersion.isVisibleTo(panel) and panel.dispersion.isChecked()
+    rows = doc.undo_stack.count()
+    panel.dispersion.setChecked(False)
+    assert doc.scene.camera.dispersion is False and doc.undo_stack.count() == rows + 1
+    doc.undo_stack.undo()
+    assert doc.scene.camera.dispersion is True and panel.dispersion.isChecked()
+    panel.choose_lens(None)
+    assert not panel.dispersion.isVisibleTo(panel)

@@ -124,11 +124,6 @@ class LensSystem:
         """The index behind each surface at ``wavelength_nm``."""
         return np.array([float(dispersed_ior(n, v, wavelength_nm)) for n, v in zip(self.ior_d, self.abbe)])
 
-    @cached_property
-    def distinct_channel_iors(self) -> np.ndarray:
-        """(wavelengths, surfaces): the channels' indices, once each (one row for achromatic glass)."""
-        return np.ascontiguousarray(np.unique(self.channel_iors().T, axis=0))
-
     def channel_iors(self) -> np.ndarray:
         """(surfaces, 3): each surface's index at each channel's wavelength (all three alike without dispersion)."""
         if not self.dispersive:
@@ -237,14 +232,15 @@ class LensSystem:
         return 0.5 * (span - math.sqrt(disc))
 
     def setting(self, f_number: float, focus_distance_mm: float, film_mm: tuple[float, float], *,
-                aperture: Aperture | None = None, film_radius_mm: float | None = None) -> "LensSetting":
+                aperture: Aperture | None = None, film_radius_mm: float | None = None,
+                dispersion: bool = True) -> "LensSetting":
         """The lens set to ``f_number`` and focused on ``focus_distance_mm`` from the sensor (found by tracing:
         the paraxial shift refined to the smallest spot at this aperture), making an image of ``film_mm``."""
         stop_radius = self.stop_radius_for(f_number)
         shift = self.best_focus_shift(focus_distance_mm, stop_radius)
         return LensSetting(self, f_number=float(f_number), shift=shift, stop_radius=stop_radius,
                            aperture=aperture or Aperture(), film_mm=film_mm,
-                           film_radius_mm=film_radius_mm or 0.5 * math.hypot(*film_mm))
+                           film_radius_mm=film_radius_mm or 0.5 * math.hypot(*film_mm), dispersion=dispersion)
 
     def best_focus_shift(self, distance_mm: float, stop_radius: float, rays: int = 24) -> float:
         """The shift that images a point on the axis ``distance_mm`` from the sensor into the smallest (RMS)
@@ -421,6 +417,24 @@ class LensSetting:
     aperture: Aperture  # the iris's shape (round, blades, rounded blades), in units of the stop's radius
     film_mm: tuple[float, float]  # the sensor area the image shows
     film_radius_mm: float  # the pupil table reaches this far from the centre
+    dispersion: bool = True  # False: every channel traced at the d line (an achromatic preview of dispersive glass)
+
+    @property
+    def dispersive(self) -> bool:
+        """Each sample traced at one channel's wavelength: the glass disperses and dispersion is on."""
+        return self.system.dispersive and self.dispersion
+
+    @cached_property
+    def channel_iors(self) -> np.ndarray:
+        """(surfaces, 3): the index behind each surface for each colour channel's rays."""
+        if self.dispersive:
+            return self.system.channel_iors()
+        return np.repeat(self.system.ior_d[:, None], 3, axis=1)
+
+    @cached_property
+    def distinct_iors(self) -> np.ndarray:
+        """(wavelengths, surfaces): the channels' indices, once each (one row when achromatic)."""
+        return np.ascontiguousarray(np.unique(self.channel_iors.T, axis=0))
 
     @property
     def sensor_z(self) -> float:
@@ -514,7 +528,7 @@ class LensSetting:
         gx, gy = gx.ravel(), gy.ravel()
         # The stop as the circle round its corners: a bladed stop's corners reach past the round stop's radius.
         passed = rays_through(film_x, gx, gy, self.sensor_z, system.vertex_z(self.shift), system.radius,
-                              system.aperture_radius, system.distinct_channel_iors,
+                              system.aperture_radius, self.distinct_iors,
                               self.stop_radius * self.aperture.scale).any(axis=0)
         return gx[passed], gy[passed], (x1 - x0) / grid, (y1 - y0) / grid
 
@@ -560,12 +574,12 @@ class LensSetting:
         (d line), weight 1 where they get through."""
         pixels = np.asarray(pixels, float).reshape(-1, 2)
         film = self.film_points(pixels, width, height)
-        iors = self.system.channel_iors()
+        iors = self.channel_iors
         if lens_samples is None:
             origins, directions, passed = self.chief_rays(film)
             return origins, directions, np.repeat(passed[:, None], 3, axis=1)
         u = np.array(lens_samples, float).reshape(-1, 2)
-        if self.system.dispersive:
+        if self.dispersive:
             channels = np.minimum(np.floor(3.0 * u[:, 0]), 2.0)
             u[:, 0] = 3.0 * u[:, 0] - channels
             channels = channels.astype(int)

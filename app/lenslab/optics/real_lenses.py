@@ -79,16 +79,18 @@ def _preset_named(text: str, folders_state: tuple):
 
 @lru_cache(maxsize=32)
 def _setting(system: LensSystem, f_number: float, focus_distance_mm: float, film_mm: tuple[float, float],
-             film_radius_mm: float, iris: tuple[int, float, float]) -> LensSetting:
+             film_radius_mm: float, iris: tuple[int, float, float], dispersion: bool) -> LensSetting:
     blades, rotation_rad, curvature = iris
     return system.setting(f_number, focus_distance_mm, film_mm, film_radius_mm=film_radius_mm,
-                          aperture=Aperture(blades=blades, rotation_rad=rotation_rad, curvature=curvature))
+                          aperture=Aperture(blades=blades, rotation_rad=rotation_rad, curvature=curvature),
+                          dispersion=dispersion)
 
 
 def lens_setting(system: LensSystem, f_number: float, focus_distance_mm: float, film_mm: tuple[float, float],
-                 film_radius_mm: float, aperture: Aperture) -> LensSetting:
+                 film_radius_mm: float, aperture: Aperture, dispersion: bool = True) -> LensSetting:
     """The lens at ``f_number``, focused ``focus_distance_mm`` from the sensor, making an image of ``film_mm``
-    whose pupil table reaches ``film_radius_mm`` (kept for the next frame of the same camera)."""
+    whose pupil table reaches ``film_radius_mm``, its glass dispersing or not (kept for the next frame of the
+    same camera)."""
     iris = (int(aperture.blades), float(aperture.rotation_rad), float(aperture.curvature))
     return _setting(system, float(f_number), float(focus_distance_mm), (float(film_mm[0]), float(film_mm[1])),
-                    float(film_radius_mm), iris)
+                    float(film_radius_mm), iris, bool(dispersion))

@@ -247,6 +247,7 @@ def image_metadata(scene: Scene, spp: int, frame: CameraFrame) -> dict[str, obje
     if frame.real_lens is not None:  # the thin lens's stand-ins: the glass does their work, they do nothing
         for name in ("anamorphic_squeeze", "barrel_clipping", "focus_breathing"):
             del used[name]
+        used["dispersion"] = int(cam.dispersion)
     if cam.exposure_mode == "physical":
         used.update(shutter=float(cam.shutter_s), iso=int(round(cam.iso)))
     metadata: dict[str, object] = {
@@ -291,7 +292,7 @@ def real_lens_metadata(frame: CameraFrame) -> dict[str, object]:
         "lenslab:RealLensSurfaces": len(system.radius),
         "lenslab:RealLensFocusShiftMM": float(setting.shift),
         "lenslab:RealLensStopDiameterMM": float(2.0 * setting.stop_radius),
-        "lenslab:RealLensDispersive": int(system.dispersive),
+        "lenslab:RealLensDispersive": int(setting.dispersive),
     }
 
 

@@ -255,14 +255,14 @@ def real_lens_uniforms(frame: CameraFrame) -> dict[str, object]:
     vertex_z = system.vertex_z(setting.shift)
     surfaces = [(float(system.radius[k]), float(vertex_z[k]), float(system.aperture_radius[k]), 0.0)
                 for k in range(count)] + [(0.0, 0.0, 0.0, 0.0)] * (MAX_LENS_SURFACES - count)
-    iors = [tuple(float(n) for n in row) for row in system.channel_iors()] + [(1.0, 1.0, 1.0)] * (
+    iors = [tuple(float(n) for n in row) for row in setting.channel_iors] + [(1.0, 1.0, 1.0)] * (
         MAX_LENS_SURFACES - count)
     depth = setting.sensor_z - setting.rear_z
     return {
         "lens_surface_count": count,
         "lens_surfaces": surfaces,
         "lens_iors": iors,
-        "lens_dispersive": int(system.dispersive),
+        "lens_dispersive": int(setting.dispersive),
         "lens_stop_radius": float(setting.stop_radius),
         "lens_sensor_z": float(setting.sensor_z),
         "lens_rear_z": float(setting.rear_z),

@@ -103,6 +103,9 @@ class ThinLensCamera:
     real_lens: str = field(default="", metadata={
         "doc": "a lens traced through its glass: a real lens preset's name or a prescription file (.toml, .json, "
                "pbrt's .dat; relative to the scene); empty: the thin lens (docs/lenses.md)"})
+    dispersion: bool = field(default=True, metadata={
+        "doc": "a real lens whose glass has Abbe numbers traces each sample at one colour's wavelength (its colour "
+               "fringes, and colour noise until it converges); false: every colour at the d line, achromatic"})
 
     # -- the real lens ------------------------------------------------------------------------------------
     def lens_system(self) -> LensSystem | None:
@@ -114,7 +117,7 @@ class ThinLensCamera:
     def _real_focal_length_mm(self) -> float:
         return self.lens_system().efl
 
-    def _real_focus_from_sensor_mm(self) -> float:
+    def real_focus_from_sensor_mm(self) -> float:
         """The focus distance from the sensor, mm, in whichever reference it is given (the lens reference of a
         real lens is ``position``, one focal length ahead of the sensor)."""
         distance = float(self.focus_distance_m) * MM_PER_M
@@ -137,7 +140,7 @@ class ThinLensCamera:
     def plane_of_focus_m(self) -> float:
         """Distance from the lens to the plane in focus, metres (what the renderer needs)."""
         if self.real_lens:
-            return (self._real_focus_from_sensor_mm() - self._real_focal_length_mm()) / MM_PER_M
+            return (self.real_focus_from_sensor_mm() - self._real_focal_length_mm()) / MM_PER_M
         if self.focus_from == "lens" or self.pinhole:  # a pinhole has everything sharp: no plane to work out
             return float(self.focus_distance_m)
         return object_distance_m(self.focal_length_mm, self.focus_distance_m)
@@ -149,7 +152,7 @@ class ThinLensCamera:
         has moved forward to focus (paraxially; the renderer refines it by tracing)."""
         if self.real_lens:
             system = self.lens_system()
-            return system.efl + system.paraxial_shift_for(self._real_focus_from_sensor_mm())
+            return system.efl + system.paraxial_shift_for(self.real_focus_from_sensor_mm())
         if not self.focus_breathing or self.pinhole:
             return float(self.focal_length_mm)
         return image_distance_mm(self.focal_length_mm, self.plane_of_focus_m)
@@ -315,8 +318,8 @@ class ThinLensCamera:
 
     def real_lens_setting(self, film_mm: tuple[float, float], base_dir: Path | None = None) -> LensSetting:
         """The real lens at this camera's f-number and focus, making an image of ``film_mm`` of sensor."""
-        return lens_setting(self.lens_system(), self.f_number, self._real_focus_from_sensor_mm(), film_mm,
-                            0.5 * math.hypot(*film_mm), self.aperture(base_dir))
+        return lens_setting(self.lens_system(), self.f_number, self.real_focus_from_sensor_mm(), film_mm,
+                            0.5 * math.hypot(*film_mm), self.aperture(base_dir), self.dispersion)
 
     def frame(self, width: int | None = None, height: int | None = None, *,
               base_dir: Path | None = None) -> "CameraFrame":

@@ -219,6 +219,9 @@ _ROWS = (
     Option("lens", str, "mount a lens preset: its focal lengths, stops, iris and minimum focus (see --list-lenses; "
            "the name's beginning will do where only one lens has it: 85mm), or a real lens's file (.toml, .json or "
            "pbrt's .dat; docs/lenses.md), traced through its glass", metavar="NAME", parse_text=_lens_name),
+    Option("dispersion", bool, "a real lens's glass disperses: each sample at one colour's wavelength (colour "
+           "fringes, and colour noise until it converges); off: achromatic, for a clean preview",
+           "camera.dispersion", metadata="lenslab:Dispersion"),
     Option("sensor", str, "a sensor preset: its size and circle of confusion (see --list-sensors)", metavar="NAME",
            parse_text=_sensor_name),
     Option("sensor_fit", str, "which part of the sensor the image shows (auto: the long sides together)",

@@ -66,6 +66,7 @@ class CameraPanel(QWidget):
     lens_info = _SectionWidget("lens")
     lens_diagram = _SectionWidget("lens")
     lens_diagram_info = _SectionWidget("lens")
+    dispersion = _SectionWidget("lens")
     iris = _SectionWidget("aperture")
     open_up = _SectionWidget("aperture")
     aperture_combo = _SectionWidget("aperture")

@@ -4,17 +4,16 @@ with a one-line readout of what the glass does."""
 
 from __future__ import annotations
 
-import math
 from typing import TYPE_CHECKING
 
-from PySide6.QtWidgets import QGridLayout, QPushButton
+from PySide6.QtWidgets import QCheckBox, QGridLayout, QPushButton
 
 from lenslab.gui.camera_panel.section import CameraSection
 from lenslab.gui.commands import LensCommand
 from lenslab.gui.lens_diagram import LensDiagram, LensView, lens_view
 from lenslab.gui.widgets import hint
 from lenslab.optics import LensPreset, format_f_number, format_focal_length
-from lenslab.optics.real_lenses import lens_setting, system_for
+from lenslab.optics.real_lenses import system_for
 
 if TYPE_CHECKING:
     from lenslab.gui.camera_panel import CameraPanel
@@ -60,13 +59,6 @@ def lens_tooltip(lens: LensPreset, shortcut: str) -> str:
     if lens.prescription.source:
         text += f"<br><i>Source: {lens.prescription.source}</i>"
     return text
-
-
-def focus_from_sensor_mm(cam: ThinLensCamera, efl: float) -> float:
-    """The camera's focus distance measured from the sensor, mm: a real lens's ``position`` (the lens reference)
-    is one focal length ahead of the sensor."""
-    distance = float(cam.focus_distance_m) * 1000.0
-    return distance + (efl if cam.focus_from == "lens" else 0.0)
 
 
 def diagram_readout(view: LensView) -> str:
@@ -125,6 +117,16 @@ class LensSection(CameraSection):
                                           "diagonal field of view its chief ray at the frame's corner traces (or, "
                                           "where the corners fall outside the lens's image circle, that circle)")
         self.add(self.lens_diagram_info)
+        self.dispersion = QCheckBox("Colour fringes (dispersion)")
+        self.dispersion.setToolTip("The glass's dispersion: each sample traced at one colour's wavelength, so its "
+                                   "colour fringes show (and colour noise, until the picture converges). Off: "
+                                   "every colour at one wavelength, an achromatic preview without that noise.")
+        self.dispersion.toggled.connect(self._dispersion_toggled)
+        self.add(self.dispersion)
+
+    def _dispersion_toggled(self, on: bool) -> None:
+        if bool(on) != self.doc.scene.camera.dispersion:
+            self.doc.set_camera("Colour fringes" if on else "Achromatic preview", False, dispersion=bool(on))
 
     @staticmethod
     def _grid(buttons: list[QPushButton]) -> QGridLayout:
@@ -167,11 +169,10 @@ class LensSection(CameraSection):
         if cam is not None and cam.real_lens:
             try:
                 system = cam.lens_system()
-                focus_mm = focus_from_sensor_mm(cam, system.efl)
+                focus_mm = cam.real_focus_from_sensor_mm()
                 film = cam.imaged_area_mm()
                 # The renderer's own setting (the focus found by tracing), from the same cache as its frame's.
-                setting = lens_setting(system, cam.f_number, focus_mm, film, 0.5 * math.hypot(*film),
-                                       cam.aperture(self.doc.scene.base_dir()))
+                setting = cam.real_lens_setting(film, self.doc.scene.base_dir())
                 view = lens_view(system, round(setting.shift, 6), round(setting.stop_radius, 6), focus_mm,
                                  (float(film[0]), float(film[1])))
             except ValueError:
@@ -180,3 +181,9 @@ class LensSection(CameraSection):
         self.lens_diagram.setVisible(view is not None)
         self.lens_diagram_info.setVisible(view is not None)
         self.lens_diagram_info.setText(diagram_readout(view) if view is not None else "")
+        # The dispersion switch, for glass that disperses (a lens without Abbe numbers is achromatic anyway).
+        self.dispersion.setVisible(view is not None and cam.lens_system().dispersive)
+        if cam is not None:
+            self.dispersion.blockSignals(True)
+            self.dispersion.setChecked(cam.dispersion)
+            self.dispersion.blockSignals(False)
