@@ -29,7 +29,6 @@ import numpy as np
 from .aperture import Aperture, sample_concentric_disk
 from .stops import exact_f_number, stop_scale
 from .prescription import LensPrescription
-from .pupil_trace import rays_through
 
 __all__ = ["CHANNEL_WAVELENGTHS_NM", "LensSystem", "LensSetting", "PUPIL_BINS", "dispersed_ior", "refract",
            "surface_crossing", "trace_from_film", "trace_from_scene"]
@@ -521,6 +520,8 @@ class LensSetting:
     def _scan(self, film_x: np.ndarray, region: np.ndarray, grid: int):
         """The points of a ``grid`` x ``grid`` grid over ``region`` whose rays from any of ``film_x`` (on the
         +x axis of the sensor) get out of the lens, and the grid's cell."""
+        from .pupil_trace import rays_through  # numba, loaded when a table is first made, not with every import
+
         system = self.system
         x0, y0, x1, y1 = region
         steps = (np.arange(grid) + 0.5) / grid

@@ -30,7 +30,7 @@ from lenslab.optics.lens_system import LensSetting, LensSystem
 from lenslab.optics.lenses import MAX_APERTURE_BLADES, LensPreset
 from lenslab.optics.real_lenses import lens_setting, real_lens_system
 from lenslab.optics.sensors import SENSOR_SIDE_RANGE_MM
-from lenslab.optics.stops import F_NUMBER_CONTROL_RANGE, F_NUMBER_RANGE
+from lenslab.optics.stops import F_NUMBER_CONTROL_RANGE, F_NUMBER_RANGE, format_f_number
 from lenslab.optics.thinlens import (FOCAL_LENGTH_CONTROL_RANGE_MM, FOCAL_LENGTH_RANGE_MM, FOCUS_DISTANCE_RANGE_M,
                                      FOCUS_REFERENCES, MM_PER_M,
                                      closest_focus_m, image_distance_mm, lens_radius_m,
@@ -308,7 +308,7 @@ class ThinLensCamera:
         widest = system.marked_f_number
         if self.f_number < widest * (1 - 1e-3):
             raise CameraValueError("f_number", self.f_number, f"is wider than the {system.name} opens: "
-                                   f"f/{widest:g} at most")
+                                   f"{format_f_number(widest)} at most")
         # The thin lens's stand-ins for what glass does: a real lens's glass does it (cat's eye, its own stop).
         for name, idle in (("anamorphic_squeeze", 1.0), ("barrel_clipping", 0.0), ("aperture_image", ""),
                            ("pinhole", False)):
