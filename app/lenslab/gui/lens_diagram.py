@@ -2,9 +2,8 @@
 of rays traced through the glass at the lens's current focus (docs/lenses.md).
 
 What it draws is the lens the renderer traces: the same surfaces, standing where unit focusing has moved them
-(``LensSystem.vertex_z``), and rays bent by the same Snell's law (``lens_system.surface_crossing`` and ``refract``).
-The tracer there gives only where a ray leaves the last surface; a drawing needs the point at every surface, so the
-loop is written out again here, for drawing only.
+(``LensSystem.vertex_z``), and rays through the renderer's own tracer, which keeps each surface's points for a
+drawing (``lens_system.trace_path_from_scene``).
 
 Coordinates are the camera frame's, in millimetres: light travels towards +z, the sensor lies at ``z = efl``. The
 side view is the y-z plane (the meridional plane), +y drawn up, the scene on the left. A film point below the axis
@@ -26,7 +25,7 @@ from PySide6.QtWidgets import QSizePolicy, QWidget
 
 from lenslab.gui import theme
 from lenslab.optics.aperture import Aperture
-from lenslab.optics.lens_system import LensSetting, LensSystem, refract, surface_crossing
+from lenslab.optics.lens_system import LensSetting, LensSystem, trace_path_from_scene
 
 __all__ = ["LensDiagram", "LensView", "RayPath", "lens_view"]
 
@@ -80,46 +79,11 @@ class LensView:
 
 
 # -- tracing, surface by surface ------------------------------------------------------------------------------------
-def _trace_points(system: LensSystem, origins: np.ndarray, directions: np.ndarray, shift: float,
-                  stop_radius: float, *, clip: bool = True, last: int | None = None):
-    """Rays from the scene through surfaces 0..``last`` (all by default): each surface's point (surfaces, N, 3),
-    the directions after the last, and for each ray the number of points it has before it is lost (a ray that
-    lands outside a clear aperture or the stop ends at that point; one that misses a sphere or is totally
-    reflected, at the point before). ``clip=False`` lets every ray through every opening (for aiming)."""
-    z = system.vertex_z(shift)
-    last = len(system.radius) - 1 if last is None else last
-    o, d = np.asarray(origins, float), np.asarray(directions, float)
-    alive = np.ones(len(o), bool)
-    ends = np.full(len(o), last + 1)
-    points = []
-    with np.errstate(invalid="ignore", divide="ignore"):
-        for i in range(last + 1):
-            p, normal, hit = surface_crossing(system, i, z[i], o, d)
-            hit &= np.all(np.isfinite(p), axis=-1)
-            missed = alive & ~hit
-            ends[missed] = i  # ends at the point before this surface
-            alive &= hit
-            points.append(np.where(hit[:, None], p, o))
-            opening = stop_radius if system.radius[i] == 0.0 else system.aperture_radius[i]
-            if clip:
-                outside = alive & (p[:, 0] ** 2 + p[:, 1] ** 2 > opening * opening)
-                ends[outside] = i + 1  # stopped on this surface, at this point
-                alive &= ~outside
-            if system.radius[i] != 0.0:
-                n_front = 1.0 if i == 0 else system.ior_d[i - 1]
-                d_new, passed = refract(d, normal, n_front / system.ior_d[i])
-                reflected = alive & ~passed
-                ends[reflected] = i + 1
-                alive &= passed
-                d = np.where(alive[:, None], d_new, d)
-            o = np.where(hit[:, None], p, o)
-    return np.stack(points), d, ends, alive
-
-
 def _stop_height(system: LensSystem, origins, directions, shift: float) -> np.ndarray:
     """The height (y) at which rays cross the plane of the stop, through the glass in front of it, openings
     ignored; NaN where a ray misses a surface on the way."""
-    points, _, _, alive = _trace_points(system, origins, directions, shift, math.inf, clip=False, last=system.stop)
+    points, _, _, alive = trace_path_from_scene(system, origins, directions, shift, math.inf, clip=False,
+                                                last=system.stop)
     return np.where(alive, points[-1][:, 1], np.nan)
 
 
@@ -169,7 +133,7 @@ def _fan(system: LensSystem, family: _Family, shift: float, stop_radius: float, 
     with np.errstate(invalid="ignore", divide="ignore"):
         t = np.where(origins[:, 2] < front_z, (front_z - origins[:, 2]) / directions[:, 2], 0.0)
     starts = origins + t[:, None] * directions
-    points, out, ends, alive = _trace_points(system, origins, directions, shift, stop_radius)
+    points, out, ends, alive = trace_path_from_scene(system, origins, directions, shift, stop_radius)
     sensor_z = system.efl
     paths = []
     for k in range(len(origins)):

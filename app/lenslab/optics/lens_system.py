@@ -31,7 +31,7 @@ from .stops import exact_f_number, stop_scale
 from .prescription import LensPrescription
 
 __all__ = ["CHANNEL_WAVELENGTHS_NM", "LensSystem", "LensSetting", "PUPIL_BINS", "dispersed_ior", "refract",
-           "surface_crossing", "trace_from_film", "trace_from_scene"]
+           "surface_crossing", "trace_from_film", "trace_from_scene", "trace_path_from_scene"]
 
 #: The Fraunhofer lines the Abbe number is defined on, nm: V_d = (n_d - 1) / (n_F - n_C).
 D_LINE_NM, F_LINE_NM, C_LINE_NM = 587.56, 486.13, 656.27
@@ -356,33 +356,55 @@ def surface_crossing(system: LensSystem, i: int, z_vertex: float, o: np.ndarray,
 
 
 def _trace(system: LensSystem, order, o, d, shift, stop_radius, ior, stop_inside=None, entering=True, clip=True):
-    """Rays through the surfaces ``order``; ``clip`` False: through the glass's spheres alone, no clear aperture
-    or stop stopping them (the chief rays' geometry)."""
-    # A lost ray's numbers run off to infinity or NaN in the surfaces after it is lost: masked, not warned of.
-    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        return _trace_surfaces(system, order, o, d, shift, stop_radius, ior, stop_inside, entering, clip)
+    """Rays through the surfaces ``order``: their last points, directions and which got through; ``clip`` False:
+    through the glass's spheres alone, no clear aperture or stop stopping them (the chief rays' geometry)."""
+    return _trace_surfaces(system, order, o, d, shift, stop_radius, ior, stop_inside, entering, clip)[:3]
 
 
-def _trace_surfaces(system, order, o, d, shift, stop_radius, ior, stop_inside, entering, clip):
+def _trace_surfaces(system, order, o, d, shift, stop_radius, ior, stop_inside, entering, clip, crossings=None):
+    """:func:`_trace`, and for each ray how many surfaces of ``order`` it crosses before it is lost (a ray that
+    misses a sphere ends before it; one that lands outside an opening or is totally reflected ends on it).
+    ``crossings``, a list, receives each surface's points in turn."""
     z = system.vertex_z(shift)
     ok = np.ones(len(o), bool)
-    for i in order:
-        p, normal, hit = surface_crossing(system, i, z[i], o, d)
-        r2 = p[:, 0] ** 2 + p[:, 1] ** 2
-        if system.radius[i] == 0.0:
-            inside = stop_inside(p[:, :2]) if stop_inside is not None else r2 <= stop_radius * stop_radius
-            ok &= hit & (inside | (not clip))
+    ends = np.full(len(o), len(order))
+    # A lost ray's numbers run off to infinity or NaN in the surfaces after it is lost: masked, not warned of.
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        for k, i in enumerate(order):
+            p, normal, hit = surface_crossing(system, i, z[i], o, d)
+            ends[ok & ~hit] = k
+            ok &= hit
+            if crossings is not None:
+                crossings.append(p)
+            r2 = p[:, 0] ** 2 + p[:, 1] ** 2
+            if system.radius[i] == 0.0:
+                inside = stop_inside(p[:, :2]) if stop_inside is not None else r2 <= stop_radius * stop_radius
+            else:
+                inside = r2 <= system.aperture_radius[i] ** 2
+            if clip:
+                ends[ok & ~inside] = k + 1
+                ok &= inside
+            if system.radius[i] != 0.0:
+                # Media either side of surface i: ior[i] behind it (towards the sensor), ior[i - 1] (or air) in front.
+                n_front = 1.0 if i == 0 else ior[i - 1]
+                n_back = ior[i]
+                eta = n_back / n_front if not entering else n_front / n_back
+                d, not_reflected = refract(d, normal, eta)
+                ends[ok & ~not_reflected] = k + 1
+                ok &= not_reflected
             o = p
-            continue
-        ok &= hit & ((r2 <= system.aperture_radius[i] ** 2) | (not clip))
-        # Media either side of surface i: ior[i] behind it (towards the sensor), ior[i - 1] (or air) in front.
-        n_front = 1.0 if i == 0 else ior[i - 1]
-        n_back = ior[i]
-        eta = n_back / n_front if not entering else n_front / n_back
-        d, not_reflected = refract(d, normal, eta)
-        ok &= not_reflected
-        o = p
-    return o, d, ok
+    return o, d, ok, ends
+
+
+def trace_path_from_scene(system: LensSystem, o, d, shift, stop_radius, *, clip=True, last: int | None = None):
+    """Rays from the scene through surfaces 0 to ``last`` (all by default), at the d line, surface by surface (the
+    studio's side view draws them): each surface's points (surfaces, N, 3), the directions after the last, how
+    many of those points each ray reaches before it is lost, and which got through."""
+    order = range((len(system.radius) - 1 if last is None else last) + 1)
+    crossings: list[np.ndarray] = []
+    _, d, ok, ends = _trace_surfaces(system, order, np.asarray(o, float), np.asarray(d, float), shift, stop_radius,
+                                     system.ior_d, None, True, clip, crossings)
+    return np.stack(crossings), d, ends, ok
 
 
 def trace_from_scene(system: LensSystem, o, d, shift, stop_radius, ior, stop_inside=None):
@@ -540,6 +562,14 @@ class LensSetting:
         only what the glass adds: vignetting, cos^4 falloff, the pupil's aberrations, the light lost focusing close."""
         return math.pi / (4.0 * self.f_number ** 2)
 
+    @property
+    def weight_scale(self) -> float:
+        """What a camera sample's cos^4(theta) times the pupil region's area is multiplied by: the camera
+        measurement's 1 / d^2 (d: the sensor to the rear vertex's plane, where the regions lie) over the ideal
+        lens's irradiance. glsl/real_lens.glsl's lens_weight_scale."""
+        depth = self.sensor_z - self.rear_z
+        return 1.0 / (depth * depth * self.ideal_irradiance)
+
     def film_points(self, pixels: np.ndarray, width: int, height: int) -> np.ndarray:
         """Points on the sensor (camera frame, mm) that pixels (N, 2) image. The lens turns the image round, so
         the top-right of the picture lies at the bottom-left of the sensor."""
@@ -602,9 +632,7 @@ class LensSetting:
                                            self.stop_radius, iors[:, channel], self.stop_contains)
                 origins[chosen], out[chosen], passed[chosen] = o, d, ok
         cos_theta = -directions[:, 2]
-        depth = self.sensor_z - self.rear_z
-        weight = np.where(passed & (area > 0.0), cos_theta ** 4 * area / (depth * depth) / self.ideal_irradiance,
-                          0.0)
+        weight = np.where(passed & (area > 0.0), cos_theta ** 4 * area * self.weight_scale, 0.0)
         return origins, out, weight[:, None] * colour
 
     @cached_property

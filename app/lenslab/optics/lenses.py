@@ -257,7 +257,9 @@ def _read_lens_dir(folder) -> list[LensPreset]:
     seen: dict[str, object] = {}
     # Sorted so that the result does not depend on the file system; dot files
     # are editor backups and lock files, not presets.
-    files = [path for pattern in ("*.json", "*.toml", "*.dat") for path in folder.glob(pattern)]
+    from .prescription import PRESCRIPTION_SUFFIXES  # a thin-lens preset is JSON; a real lens, any of these
+
+    files = [path for suffix in {".json", *PRESCRIPTION_SUFFIXES} for path in folder.glob(f"*{suffix}")]
     for path in sorted(files):
         if path.name.startswith("."):
             continue

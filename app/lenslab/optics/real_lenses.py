@@ -13,13 +13,9 @@ from pathlib import Path
 
 from .aperture import Aperture
 from .lens_system import LensSetting, LensSystem
-from .prescription import LensPrescription, read_prescription_file
+from .prescription import PRESCRIPTION_SUFFIXES, LensPrescription, read_prescription_file
 
-__all__ = ["PRESCRIPTION_SUFFIXES", "lens_setting", "names_a_file", "real_lens_system", "system_for"]
-
-#: The files a real lens may be read from: our own formats and pbrt's.
-PRESCRIPTION_SUFFIXES = (".toml", ".json", ".dat")
-
+__all__ = ["lens_setting", "names_a_file", "real_lens_system", "system_for"]
 
 def names_a_file(text: str) -> bool:
     """Whether a ``real_lens`` value is a path (it ends in a prescription file's suffix) rather than a preset's

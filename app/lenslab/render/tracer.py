@@ -257,7 +257,6 @@ def real_lens_uniforms(frame: CameraFrame) -> dict[str, object]:
                 for k in range(count)] + [(0.0, 0.0, 0.0, 0.0)] * (MAX_LENS_SURFACES - count)
     iors = [tuple(float(n) for n in row) for row in setting.channel_iors] + [(1.0, 1.0, 1.0)] * (
         MAX_LENS_SURFACES - count)
-    depth = setting.sensor_z - setting.rear_z
     return {
         "lens_surface_count": count,
         "lens_surfaces": surfaces,
@@ -268,7 +267,7 @@ def real_lens_uniforms(frame: CameraFrame) -> dict[str, object]:
         "lens_rear_z": float(setting.rear_z),
         "lens_film_half": (float(frame.film_mm[0] / 2.0), float(frame.film_mm[1] / 2.0)),
         "lens_film_radius": float(setting.film_radius_mm),
-        "lens_weight_scale": float(1.0 / (depth * depth * setting.ideal_irradiance)),
+        "lens_weight_scale": float(setting.weight_scale),
         "lens_pupil": [tuple(float(v) for v in box) for box in setting.pupil_bounds],
         "lens_pupil_disk": [tuple(float(v) for v in disk) for disk in setting.pupil_disks],
     }

@@ -151,13 +151,9 @@ class LensSection(CameraSection):
             button.setChecked((i == 0 and lens is None) or (i > 0 and self.lenses[i - 1] == lens))
         if lens is None:
             self.lens_info.setText("Free: any focal length and aperture.")
-        elif lens.is_real:
-            self.lens_info.setText(f"{lens.name} · traced through its glass ({glass_summary(lens)}) · "
-                                   f"{format_f_number(lens.widest_f_number)}–"
-                                   f"{format_f_number(lens.narrowest_f_number)}"
-                                   + (f" · {lens.aperture_blades} blades" if lens.aperture_blades else ""))
         else:
-            self.lens_info.setText(f"{lens.name} · {format_f_number(lens.widest_f_number)}–"
+            glass = f" · traced through its glass ({glass_summary(lens)})" if lens.is_real else ""
+            self.lens_info.setText(f"{lens.name}{glass} · {format_f_number(lens.widest_f_number)}–"
                                    f"{format_f_number(lens.narrowest_f_number)}"
                                    + (f" · {lens.aperture_blades} blades" if lens.aperture_blades else ""))
         self._show_glass(cam)
@@ -182,7 +178,7 @@ class LensSection(CameraSection):
         self.lens_diagram_info.setVisible(view is not None)
         self.lens_diagram_info.setText(diagram_readout(view) if view is not None else "")
         # The dispersion switch, for glass that disperses (a lens without Abbe numbers is achromatic anyway).
-        self.dispersion.setVisible(view is not None and cam.lens_system().dispersive)
+        self.dispersion.setVisible(view is not None and view.system.dispersive)
         if cam is not None:
             self.dispersion.blockSignals(True)
             self.dispersion.setChecked(cam.dispersion)
