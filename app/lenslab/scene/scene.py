@@ -14,6 +14,8 @@ from typing import Callable, ClassVar, Iterator
 
 import numpy as np
 
+from lenslab.colour_management.working_space import DEFAULT_WORKING_SPACE, WORKING_SPACES
+
 from lenslab.scene.camera import ThinLensCamera
 from lenslab.scene.lights import Light
 from lenslab.scene.materials import Diffuse, Material
@@ -157,6 +159,10 @@ class RenderSettings:
                "its samples drew (as Mitsuba: a little less noise, biased by O(1/spp))"})
     clamp: float = field(default=0.0, metadata={"range": (0.0, 1e9), "doc": "0 = off (unbiased); else the most "
                                                  "radiance one sample may add, to tame fireflies (biased)"})
+    working_space: str = field(default=DEFAULT_WORKING_SPACE, metadata={
+        "choices": tuple(WORKING_SPACES),
+        "doc": "the RGB the scene's colours are in and the renderer computes in: linear Rec.709 (sRGB primaries), "
+               "or ACEScg (docs/colour.md)"})
 
 
 @dataclass
