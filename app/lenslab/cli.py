@@ -55,14 +55,19 @@ def build_parser() -> argparse.ArgumentParser:
         add_option(p, name)
     camera = p.add_argument_group("camera and lens")
     for name in ("lens", "dispersion", "sensor", "sensor_fit", "focus_from", "focus_breathing", "circle_of_confusion",
-                 "aperture_blades", "blade_curvature", "anamorphic_squeeze", "barrel_clipping", "aperture_image",
-                 "exposure_mode", "iso", "shutter"):
+                 "aperture_blades", "blade_curvature", "anamorphic_squeeze", "barrel_clipping", "aperture_image"):
         add_option(camera, name)
     camera.add_argument("--list-lenses", action="store_true", help="print the lens presets and exit")
     camera.add_argument("--list-sensors", action="store_true", help="print the sensor presets and exit")
-    for name in ("seed", "max_depth", "sampler", "clamp", "tone_map"):
+    for name in ("exposure_mode", "iso", "shutter", "metering"):
+        add_option(camera, name)
+    for name in ("seed", "max_depth", "sampler", "clamp", "working_space"):
         add_option(p, name)
-    add_option(p, "exposure", default=0.0)
+    colour = p.add_argument_group("pictures (PNG, TIFF, JPEG): OpenColorIO's view transform (docs/colour.md)")
+    for name in ("display", "view", "look", "ocio_config"):
+        add_option(colour, name)
+    add_option(colour, "exposure", default=0.0)
+    add_option(colour, "contrast", default=1.0)
     p.add_argument("--denoise", action="store_true",
                    help="write the image denoised (Intel Open Image Denoise, guided by the first-hit albedo and normal "
                         "rendered beside it); an EXR also keeps the noisy image and the guides as layers")
@@ -201,9 +206,10 @@ def render_headless(args) -> int:
 
     output = _check_output(args.output)
     if output.suffix.lower() == ".exr":
-        for option, given in (("--exposure", bool(args.exposure)), ("--tone-map", args.tone_map is not None)):
-            if given:
-                _warn(f"{option} applies to PNG only: an EXR keeps the linear radiance")
+        given = {"display": args.display is not None, "view": args.view is not None, "look": args.look is not None,
+                 "exposure": args.exposure != 0.0, "contrast": args.contrast != 1.0}
+        for name in (name for name, yes in given.items() if yes):
+            _warn(f"{"--" + name} applies to pictures only: an EXR keeps the scene-linear values")
     overrides = scene_overrides(args)
     if args.denoise:  # a denoiser that cannot run says so now, not after the render
         from lenslab.render.denoise import DenoiseError, describe
@@ -216,6 +222,7 @@ def render_headless(args) -> int:
     loading_start = time.perf_counter()
     with _loading_status(console, f"loading {args.scene}"):
         scene = overrides.open(args.scene, warn=_warn)
+    view = _view_transform(args, scene.render.working_space)
     renderer = Renderer(args.device)
     try:
         with _loading_status(console, "building the kd-tree and compiling the kernel"):
@@ -250,13 +257,26 @@ def render_headless(args) -> int:
         _warn(f"the time limit ended before every pixel had a sample: the first pass was finished "
               f"{job.overran_time_limit:.1f} s later")
     # Once the image is whole and about to take its name, a stop signal could only misreport it.
-    job.write(output, exposure_stops=args.exposure, tone_map=args.tone_map or "clamp",
-              before_rename=_ignore_stop_signals, denoise=args.denoise)
+    job.write(output, view=view, before_rename=_ignore_stop_signals, denoise=args.denoise)
     print(one_line(f"wrote {output} ({session.width}x{session.height}, {job.samples_per_pixel} spp, "
                    f"{job.elapsed_seconds:.1f} s{', denoised' if args.denoise else ''})"), file=sys.stderr)
     job.release()
     renderer.release()
     return EXIT_OK
+
+
+def _view_transform(args, working_space: str):
+    """The view transform the command line asks for, checked against its OCIO config before anything renders."""
+    from lenslab.colour_management.config import ColourConfigError
+    from lenslab.colour_management.view import ViewTransform
+
+    view = ViewTransform(display=args.display or "", view=args.view or "", looks=args.look or "",
+                         exposure_stops=args.exposure, contrast=args.contrast, working_space=working_space,
+                         config=args.ocio_config or "")
+    try:
+        return view.resolved()
+    except ColourConfigError as exc:
+        raise CliError(str(exc)) from None
 
 
 def _first_pass_notice(pixels: int):

@@ -293,5 +293,5 @@ def _contact_sheet_frames(batch: Batch, summary) -> list:
         except (SceneError, ValueError, OSError) as exc:
             return " ".join(str(exc).split())
 
-    return [Frame(shot.output if shot.output.exists() else None, shot.name, caption(shot), tone_map=shot.tone_map,
-                  exposure=shot.exposure) for shot in batch.shots]
+    return [Frame(shot.output if shot.output.exists() else None, shot.name, caption(shot), view=shot.view)
+            for shot in batch.shots]

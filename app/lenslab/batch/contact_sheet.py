@@ -4,11 +4,12 @@ out a bracket to compare. Drawn with OpenImageIO (resizing, and text in the Droi
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
+from lenslab.colour_management.view import ViewTransform
 from lenslab.optics import format_camera_settings
 from lenslab.render import film
 
@@ -29,8 +30,7 @@ class Frame:
     image: Path | None
     title: str
     caption: str
-    tone_map: str = "filmic"  # how an EXR (linear) is shown; a PNG is shown as it is
-    exposure: float = 0.0
+    view: ViewTransform = ViewTransform()  # how an EXR (scene-linear) is shown; a picture is shown as it is
 
 
 def shot_caption(camera, lens_name: str | None = None) -> str:
@@ -99,7 +99,7 @@ def _thumbnail(frame: Frame, width: int) -> np.ndarray | None:
     if frame.image is None or not frame.image.exists():
         return None
     try:
-        pixels, _ = film.read_image(frame.image)
+        pixels, metadata = film.read_image(frame.image)
     except film.ExportError:
         return None
     pixels = pixels[..., :3] if pixels.shape[2] >= 3 else np.repeat(pixels[..., :1], 3, axis=2)
@@ -107,8 +107,9 @@ def _thumbnail(frame: Frame, width: int) -> np.ndarray | None:
     source = oiio.ImageBuf(np.ascontiguousarray(pixels, dtype=np.float32))
     resized = oiio.ImageBufAlgo.resize(source, roi=oiio.ROI(0, width, 0, height, 0, 1, 0, 3))
     small = resized.get_pixels(oiio.FLOAT).reshape(height, width, 3)
-    if frame.image.suffix.lower() == ".exr":  # linear radiance (resized as light adds up): shown tone mapped
-        return film.tone_map(small, frame.exposure, frame.tone_map)
+    if frame.image.suffix.lower() == ".exr":  # scene-linear (resized as light adds up): through the view transform
+        space = str(metadata.get("lenslab:WorkingSpace", frame.view.working_space))
+        return film.display_pixels(small, replace(frame.view, working_space=space))
     return np.clip(small, 0.0, 1.0)
 
 

@@ -24,6 +24,7 @@ from typing import Callable
 import numpy as np
 
 from lenslab.batch.spec import MAX_SPLIT, Shot
+from lenslab.scene.options import OPTIONS
 from lenslab.render.film import merge
 from lenslab.render.job import JobProgress
 
@@ -220,10 +221,15 @@ class ShotAssembly:
     def write(self) -> Path:
         """Merge, resolve and write the shot's image (its folder made if missing), whole or not at all."""
         from lenslab.render.film import resolve, write_image
+        from lenslab.render.job import exposure_metadata
 
         self.shot.output.parent.mkdir(parents=True, exist_ok=True)
         metadata = self.metadata()
-        return write_image(self.shot.output, resolve(self.accumulation()), metadata,
+        image = resolve(self.accumulation())
+        if metadata.get(OPTIONS["exposure_mode"].metadata) == "auto":  # metered on the merged image
+            metadata.update(exposure_metadata(metadata, image))
+        return write_image(self.shot.output, image, metadata,
                            sensor_exposure=float(metadata.get("lenslab:ExposureScale", 1.0)),
-                           exposure_stops=self.shot.exposure, tone_map_operator=self.shot.tone_map)
+                           view=dataclasses.replace(self.shot.view,
+                                                    working_space=str(metadata["lenslab:WorkingSpace"])))
 

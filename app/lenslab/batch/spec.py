@@ -36,6 +36,7 @@ from lenslab.atomic import check_output_file
 from lenslab.image_files import read_file_bytes
 from lenslab.limits import LARGEST_NUMBER
 from lenslab.render.film import EXPORT_SUFFIXES
+from lenslab.colour_management.view import ViewTransform
 from lenslab.scene.options import OLD_NAMES, OPTIONS, SCENE_OPTIONS
 from lenslab.scene.overrides import SceneOverrides
 
@@ -64,8 +65,7 @@ class Shot:
     output: Path
     overrides: SceneOverrides = field(default_factory=SceneOverrides)
     time_limit: float | None = None
-    exposure: float = 0.0  # PNG only, as on the command line
-    tone_map: str = "clamp"
+    view: ViewTransform = field(default_factory=ViewTransform)  # pictures only, as on the command line
     split: int = 1  # render in this many sample ranges, on as many workers, and merge
     where: str = ""  # "shots.toml, shot 2 ('bracket'), f/2.8" for messages
     number: int = 0  # which [[shots]] entry of the file it came from (1 for the first)
@@ -320,9 +320,8 @@ def _shot(number: int, index: int, values: dict, swept: list[str], folder: Path,
         time_limit = values.get("time_limit")
         if time_limit is not None:
             OPTIONS["time_limit"].check(time_limit)
-        exposure = OPTIONS["exposure"].check(values.get("exposure", 0.0))
-        tone_map = OPTIONS["tone_map"].check(values.get("tone_map", "clamp"))
-    except ValueError as exc:
+        view = _view_transform(values)
+    except ValueError as exc:  # ColourConfigError among them
         raise BatchError(f"{where}: {exc}") from None
     split = values.get("split", 1)
     if not 1 <= split <= MAX_SPLIT:
@@ -331,7 +330,19 @@ def _shot(number: int, index: int, values: dict, swept: list[str], folder: Path,
     if os.path.exists(folder / scene):  # a file beside the batch file; otherwise a shipped scene's name
         scene = str((folder / scene).resolve())
     return Shot(name=name, scene=scene, output=output, overrides=overrides, time_limit=time_limit,
-                exposure=exposure, tone_map=tone_map, split=split, where=where, number=number)
+                view=view, split=split, where=where, number=number)
+
+
+def _view_transform(values: dict) -> ViewTransform:
+    """The view transform a shot's pictures are made with, checked against its OCIO config (its working space is
+    the scene's, set when the image is written)."""
+    checked = {name: OPTIONS[name].check(values[name]) for name in ("display", "view", "look", "exposure",
+                                                                    "contrast", "ocio_config") if name in values}
+    view = ViewTransform(display=checked.get("display", ""), view=checked.get("view", ""),
+                         looks=checked.get("look", ""), exposure_stops=checked.get("exposure", 0.0),
+                         contrast=checked.get("contrast", 1.0), config=checked.get("ocio_config", ""))
+    view.resolved()
+    return view
 
 
 #: File systems take names of at most 255 bytes.

@@ -31,6 +31,7 @@ under 56,000 lux, lands at middle grey.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -112,6 +113,45 @@ def meter_luminance(luminance: np.ndarray, mode: str = "average", spot: tuple[fl
     weights = np.where(np.isfinite(lum), weights, 0.0)
     total = weights.sum()
     return float((np.where(np.isfinite(lum), lum, 0.0) * weights).sum() / total) if total > 0 else 0.0
+
+
+@dataclass(frozen=True)
+class Exposure:
+    """A picture's exposure as a camera made it: the ``scale`` from scene-linear values to the picture's, the
+    ``shutter_s`` it was made with (auto: the one the meter chose), its ``ev100`` (None: compensated, no camera
+    settings apply) and the meter's reading (auto only)."""
+
+    scale: float
+    shutter_s: float
+    ev100: float | None = None
+    metered_cd_m2: float | None = None
+
+
+def camera_exposure(mode: str, f_number: float, shutter_s: float, iso: float, light_fraction: float = 1.0,
+                    luminance: np.ndarray | None = None, meter_mode: str = "average",
+                    spot: tuple[float, float] = (0.5, 0.5)) -> Exposure:
+    """The exposure of a camera in ``mode`` (EXPOSURE_MODES). ``auto`` reads ``luminance`` (H, W: the render's
+    scene-linear luminance) with the meter and sets the shutter so that its reading lands at middle grey, the
+    f-number and ISO as given (aperture priority). The aperture's ``light_fraction`` counts in both physical
+    modes, as the light a camera's through-the-lens meter sees."""
+    if mode not in EXPOSURE_MODES:
+        raise ValueError(f"unknown exposure mode '{mode}' (choose from {', '.join(EXPOSURE_MODES)})")
+    if mode == "compensated":
+        return Exposure(1.0, shutter_s)
+    if mode == "physical":
+        return Exposure(exposure_scale(f_number, shutter_s, iso, light_fraction), shutter_s,
+                        ev100(f_number, shutter_s, iso))
+    if luminance is None:
+        raise ValueError("auto exposure needs the image to meter")
+    reading = meter_luminance(luminance, meter_mode, spot)
+    if not reading > 0.0:  # a black frame: nothing to meter, the camera's own shutter stays
+        return Exposure(exposure_scale(f_number, shutter_s, iso, light_fraction), shutter_s,
+                        ev100(f_number, shutter_s, iso), 0.0)
+    # The meter sees the light the aperture passes: as the f-number that passes as much, N / sqrt(fraction).
+    ev = metered_ev100(reading) - math.log2(require_positive("light_fraction", light_fraction))
+    chosen = min(max(shutter_for(ev, f_number, iso), SHUTTER_RANGE_S[0]), SHUTTER_RANGE_S[1])
+    return Exposure(exposure_scale(f_number, chosen, iso, light_fraction), chosen, ev100(f_number, chosen, iso),
+                    reading)
 
 
 def format_shutter(seconds: float) -> str:

@@ -1,7 +1,8 @@
-"""From accumulated samples to pictures: the linear image, display tone mapping, and export.
+"""From accumulated samples to pictures: the linear image, its display through OpenColorIO, and export.
 
-EXR holds the linear radiance as float32 RGB with the camera's settings as metadata (standard Exif names
-where they exist); PNG holds a display-referred 8-bit sRGB picture. Files are written to a temporary name
+EXR holds the linear radiance as float32 RGB in the working space with the camera's settings as metadata
+(standard Exif names where they exist); PNG holds a display-referred 8-bit picture, made through OpenColorIO's view
+transform (lenslab.colour_management.view). Files are written to a temporary name
 beside the target, checked, and renamed into place (lenslab.atomic), so an export is whole or absent, never
 half-written.
 """
@@ -16,23 +17,15 @@ from typing import Callable, Sequence
 import numpy as np
 
 from lenslab.atomic import atomic_path, write_failure_reason
-from lenslab.color import linear_to_srgb
+from lenslab.colour_management.view import ViewTransform
+from lenslab.colour_management.working_space import working_space
 from lenslab.limits import image_too_large
-from lenslab.scene.options import OPTIONS
 
 EXPORT_SUFFIXES = (".exr", ".png")
-TONE_MAPS = OPTIONS["tone_map"].allowed  # the operators below, as the options table names them
 
 
 class ExportError(RuntimeError):
     pass
-
-
-def check_tone_map(operator: str) -> str:
-    """``operator`` if it is one of TONE_MAPS; otherwise a ValueError that names it and the choices."""
-    if operator not in TONE_MAPS:
-        raise ValueError(f"unknown tone map '{operator}' (choose from {', '.join(TONE_MAPS)})")
-    return operator
 
 
 def resolve(accumulation: np.ndarray) -> np.ndarray:
@@ -63,37 +56,17 @@ def merge(*accumulations: np.ndarray) -> np.ndarray:
     return np.sum(accumulations, axis=0)
 
 
-# Narkowicz's fit of the ACES reference rendering transform, x (a x + b) / (x (c x + d) + e): a gentle shoulder
-# that keeps highlights. The only copy: glsl/display.comp gets them as #defines of the same names
-# (render/gpu_layout.py).
-FILMIC_A = 2.51
-FILMIC_B = 0.03
-FILMIC_C = 2.43
-FILMIC_D = 0.59
-FILMIC_E = 0.14
-
-
-def _filmic(x: np.ndarray) -> np.ndarray:
-    return np.clip((x * (FILMIC_A * x + FILMIC_B)) / (x * (FILMIC_C * x + FILMIC_D) + FILMIC_E), 0.0, 1.0)
-
-
-def tone_map(linear: np.ndarray, exposure_stops: float = 0.0, operator: str = "clamp") -> np.ndarray:
-    """Display-referred sRGB in [0, 1] from linear radiance. ``exposure_stops`` scales by 2**stops first."""
-    check_tone_map(operator)
-    x = np.maximum(linear, 0.0) * np.float32(2.0**exposure_stops)
-    if operator == "reinhard":
-        x = x / (1.0 + x)
-    elif operator == "filmic":
-        x = _filmic(x)
-    return linear_to_srgb(x).astype(np.float32)
+def display_pixels(linear: np.ndarray, view: ViewTransform = ViewTransform()) -> np.ndarray:
+    """Display code values in [0, 1] of the linear image (H, W, 3) through the view transform ``view`` (OCIO's CPU
+    processor): the steps of glsl/display.comp, which the studio runs on the GPU with OCIO's GLSL, in the same
+    order (no negative radiance goes in)."""
+    return view.apply(np.maximum(linear[..., :3], np.float32(0.0)))
 
 
 def to_8bit(display: np.ndarray) -> np.ndarray:
     return np.clip(np.round(display * 255.0), 0, 255).astype(np.uint8)
 
 
-#: The primaries and white point of LensLab's linear RGB (Rec. 709 / sRGB, D65), as OpenEXR's chromaticities.
-REC709_CHROMATICITIES = (0.64, 0.33, 0.30, 0.60, 0.15, 0.06, 0.3127, 0.3290)
 #: Metadata that OpenImageIO must be told is a 4 x 4 matrix (OpenEXR's worldToCamera and worldToNDC).
 MATRIX_ATTRIBUTES = ("worldtocamera", "worldtoNDC")
 
@@ -126,13 +99,15 @@ def estimated_file_bytes(path: str | os.PathLike, width: int, height: int, layer
 
 
 def write_image(path: str | os.PathLike, linear: np.ndarray, metadata: dict[str, object] | None = None,
-                *, sensor_exposure: float = 1.0, exposure_stops: float = 0.0, tone_map_operator: str = "clamp",
+                *, sensor_exposure: float = 1.0, view: ViewTransform = ViewTransform(),
                 before_rename: Callable[[], None] | None = None, layers: Sequence[Layer] = ()) -> Path:
-    """Write ``linear`` (H, W, 3) to an .exr (linear float) or .png (sRGB, tone mapped), whole or not at all.
+    """Write ``linear`` (H, W, 3) to an .exr (linear float) or .png (through the view transform), whole or not at
+    all.
 
     ``sensor_exposure`` multiplies the radiance first, in both: the camera's physical exposure, part of the
-    capture. ``exposure_stops`` and the tone map are the PNG's display look. An EXR carries Rec. 709
-    chromaticities and the camera matrices, and ``layers`` after its R, G, B (a PNG leaves them out); a PNG
+    capture. ``view`` (OCIO's display, view, looks, exposure and contrast) makes the PNG's pixels from it, and
+    names the working space the EXR's chromaticities describe. An EXR carries the chromaticities and the camera
+    matrices, and ``layers`` after its R, G, B (a PNG leaves them out); a PNG
     carries Exif (its eXIf chunk: f-number, exposure time, ISO, focal length) and LensLab's own values as text
     chunks. ``before_rename``: see lenslab.atomic.atomic_path."""
     import OpenImageIO as oiio  # imported here: only exporting needs it
@@ -159,13 +134,12 @@ def write_image(path: str | os.PathLike, linear: np.ndarray, metadata: dict[str,
         spec = oiio.ImageSpec(width, height, len(names), oiio.FLOAT)
         spec.channelnames = tuple(names)
         spec.attribute("compression", "zip")
-        spec.attribute("chromaticities", oiio.TypeDesc("float[8]"), REC709_CHROMATICITIES)
+        spec.attribute("chromaticities", oiio.TypeDesc("float[8]"), working_space(view.working_space).chromaticities)
     else:
-        pixels = to_8bit(tone_map(linear, exposure_stops, tone_map_operator))
+        pixels = to_8bit(display_pixels(linear, view))
         spec = oiio.ImageSpec(width, height, 3, oiio.UINT8)
-        spec.attribute("oiio:ColorSpace", "sRGB")
-        metadata.update({OPTIONS["exposure"].metadata: float(exposure_stops),
-                         OPTIONS["tone_map"].metadata: tone_map_operator})
+        spec.attribute("oiio:ColorSpace", view.display_colour_space())
+        metadata.update(view.metadata())
         # PNG keeps Exif's own tags in its eXIf chunk and only text besides: LensLab's values become text.
         metadata = {key: (_as_text(value) if key.startswith("lenslab:") else value) for key, value in metadata.items()
                     if key not in MATRIX_ATTRIBUTES}

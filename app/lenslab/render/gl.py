@@ -128,10 +128,12 @@ def _read(path: Path) -> str:
     return path.read_text(encoding="utf-8")
 
 
-def load_shader_source(name: str, defines: dict[str, object] | None = None, directory: Path | None = None) -> str:
+def load_shader_source(name: str, defines: dict[str, object] | None = None, directory: Path | None = None,
+                       includes: dict[str, str] | None = None) -> str:
     """Read ``glsl/<name>``, expand ``#include "file"`` (each file once) and put ``#define``s after #version:
     the buffer layout every shader shares (gpu_layout.glsl_defines), then the caller's ``defines``. An include
-    named in gpu_layout.glsl_generated_includes (the material kinds' dispatch) is that generated text, not a file."""
+    named in gpu_layout.glsl_generated_includes (the material kinds' dispatch) or in the caller's ``includes``
+    (OpenColorIO's view transform) is that generated text, not a file."""
     layout = glsl_defines()
     clash = sorted(layout.keys() & (defines or {}).keys())
     if clash:
@@ -140,7 +142,7 @@ def load_shader_source(name: str, defines: dict[str, object] | None = None, dire
     defines = {**layout, **(defines or {})}
     directory = directory or glsl_dir()
     seen: set[str] = set()
-    generated = glsl_generated_includes()
+    generated = {**glsl_generated_includes(), **(includes or {})}
 
     def expand(file_name: str) -> str:
         if file_name in seen:

@@ -1,5 +1,4 @@
-"""What the host and the shaders must agree on, declared once: record sizes, type codes and binding points,
-and the numbers of the display curves.
+"""What the host and the shaders must agree on, declared once: record sizes, type codes and binding points.
 
 Python packs the scene's buffers with these values (render/buffers.py, render/textures.py, render/bsp.py)
 and gl.load_shader_source hands every one of them to every compute shader as a #define of the same name
@@ -12,11 +11,9 @@ from __future__ import annotations
 
 import math
 
-from lenslab import color as _color
 from lenslab.optics.aperture import APERTURE_KINDS, ROUNDED_BLADE_BINS as _ROUNDED_BLADE_BINS
 from lenslab.optics.lens_system import PUPIL_BINS as _PUPIL_BINS
 from lenslab.optics.prescription import MAX_SURFACES as _MAX_LENS_SURFACES
-from lenslab.render import film as _film
 
 # -- Materials: MATERIAL_ROWS vec4 rows per material (scene/materials/base.py describes them; packed through
 # buffers.pack_material, read by glsl/bsdf.glsl), its type code in row 0, w. The numbers belong to the material
@@ -97,22 +94,6 @@ DISPLAY_BINDING = 8
 FEATURES_BINDING = 9
 FEATURE_ROWS = 2
 INSTANCES_BINDING = 10  # the instance table (render/instancing.py)
-# display.comp's tone maps, in the order of lenslab.render.film.TONE_MAPS.
-TONE_MAP_CLAMP = 0
-TONE_MAP_REINHARD = 1
-TONE_MAP_FILMIC = 2
-# display.comp's curves, with the numbers of the Python that applies them on the CPU (defined there, once):
-# lenslab.color's sRGB encoding and lenslab.render.film's filmic fit. Floats: see glsl_float.
-SRGB_SCALE = _color.SRGB_SCALE
-SRGB_OFFSET = _color.SRGB_OFFSET
-SRGB_EXPONENT = _color.SRGB_EXPONENT
-SRGB_LINEAR_SLOPE = _color.SRGB_LINEAR_SLOPE
-SRGB_LINEAR_CUTOFF = _color.SRGB_LINEAR_CUTOFF
-FILMIC_A = _film.FILMIC_A
-FILMIC_B = _film.FILMIC_B
-FILMIC_C = _film.FILMIC_C
-FILMIC_D = _film.FILMIC_D
-FILMIC_E = _film.FILMIC_E
 # raycast.comp's rays in and hits out; bsdf_probe.comp's items in and results out.
 RAYS_BINDING = 6
 HITS_BINDING = 7

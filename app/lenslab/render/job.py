@@ -21,7 +21,9 @@ from typing import Callable
 import numpy as np
 
 from lenslab import __version__
-from lenslab.optics.exposure import ev100
+from lenslab.colour_management.view import ViewTransform
+from lenslab.colour_management.working_space import luminance
+from lenslab.optics.exposure import camera_exposure
 from lenslab.optics.sensors import crop_factor
 from lenslab.optics.stops import format_f_number
 from lenslab.render.tracer import DEFAULT_DISPATCH_SECONDS, Renderer, RenderSession
@@ -165,13 +167,18 @@ class RenderJob:
             raise RuntimeError("the render job is not finished: some pixels may have no sample yet")
         return self.session.image()
 
-    def metadata(self) -> dict[str, object]:
-        return image_metadata(self.scene, self.session.samples_per_pixel, self.session.frame)
+    def metadata(self, image: np.ndarray | None = None) -> dict[str, object]:
+        """The image's metadata; an auto exposure meters ``image`` (the finished image when not given)."""
+        metadata = image_metadata(self.scene, self.session.samples_per_pixel, self.session.frame)
+        if self.scene.camera.exposure_mode == "auto":
+            metadata.update(exposure_metadata(metadata, self.image() if image is None else image))
+        return metadata
 
-    def write(self, path: str | os.PathLike, *, exposure_stops: float = 0.0, tone_map: str = "clamp",
+    def write(self, path: str | os.PathLike, *, view: ViewTransform = ViewTransform(),
               before_rename: Callable[[], None] | None = None, denoise: bool = False) -> Path:
-        """Write the finished image with its metadata (.exr linear, .png tone mapped), whole or not at all. A
-        camera in the physical exposure mode exposes both (docs/architecture.md, "Exposure"). ``before_rename``
+        """Write the finished image with its metadata (.exr linear, a picture through the view transform ``view``),
+        whole or not at all. A camera in the physical or auto exposure mode exposes both (docs/colour.md,
+        "Exposure"); the auto mode meters the image that is written. ``before_rename``
         runs once the file is whole, just before it takes the name (lenslab.atomic.atomic_path).
 
         ``denoise``: the main image is the denoised one (:meth:`denoised`), and the metadata says so; an EXR also
@@ -180,18 +187,18 @@ class RenderJob:
         from lenslab.render.film import ExportError, write_image
         from lenslab.render.denoise import DenoiseError
 
-        metadata = self.metadata()
         if not denoise:
-            image, layers = self.image(), ()
+            image, layers, denoiser = self.image(), (), None
         else:
             try:
-                image, layers, metadata["lenslab:Denoiser"] = self.denoised()
+                image, layers, denoiser = self.denoised()
             except DenoiseError as exc:  # before anything is written: the file is not touched
                 raise ExportError(f"{path}: cannot denoise ({exc})") from None
-            metadata["lenslab:Denoised"] = 1
+        metadata = self.metadata(image)
+        if denoiser is not None:
+            metadata.update({"lenslab:Denoiser": denoiser, "lenslab:Denoised": 1})
         return write_image(path, image, metadata, sensor_exposure=metadata["lenslab:ExposureScale"],
-                           exposure_stops=exposure_stops, tone_map_operator=tone_map, before_rename=before_rename,
-                           layers=layers)
+                           view=view, before_rename=before_rename, layers=layers)
 
     def denoised(self) -> tuple[np.ndarray, tuple, str]:
         """(the denoised image, the EXR layers to keep beside it, how it was denoised). A final frame: the guides
@@ -236,6 +243,8 @@ def image_metadata(scene: Scene, spp: int, frame: CameraFrame) -> dict[str, obje
         "anamorphic_squeeze": float(cam.anamorphic_squeeze),
         "barrel_clipping": float(cam.barrel_clipping),
         "exposure_mode": cam.exposure_mode,
+        "metering": cam.metering,
+        "working_space": scene.render.working_space,
         "spp": int(spp),
         "seed": int(scene.render.seed),
         "max_depth": int(scene.render.max_depth),
@@ -248,7 +257,7 @@ def image_metadata(scene: Scene, spp: int, frame: CameraFrame) -> dict[str, obje
         for name in ("anamorphic_squeeze", "barrel_clipping", "focus_breathing"):
             del used[name]
         used["dispersion"] = int(cam.dispersion)
-    if cam.exposure_mode == "physical":
+    if cam.exposure_mode != "compensated":
         used.update(shutter=float(cam.shutter_s), iso=int(round(cam.iso)))
     metadata: dict[str, object] = {
         "Software": f"LensLab {__version__}",
@@ -260,6 +269,7 @@ def image_metadata(scene: Scene, spp: int, frame: CameraFrame) -> dict[str, obje
         "Exif:FocalPlaneYResolution": pixels_per_cm,
         "Exif:FocalPlaneResolutionUnit": 3,
         "Exif:ExposureMode": 1 if cam.exposure_mode == "physical" else 0,  # manual, or auto
+        "Exif:ExposureProgram": EXIF_EXPOSURE_PROGRAM[cam.exposure_mode],
         "lenslab:Aperture": format_f_number(cam.f_number),  # the marked stop ("f/11" for 11.31)
         "lenslab:SensorWidthMM": float(sensor_w),
         "lenslab:SensorHeightMM": float(sensor_h),
@@ -273,10 +283,28 @@ def image_metadata(scene: Scene, spp: int, frame: CameraFrame) -> dict[str, obje
         "worldtoNDC": world_to_ndc(frame),
     }
     if cam.exposure_mode == "physical":
-        metadata["lenslab:EV100"] = ev100(cam.f_number, cam.shutter_s, cam.iso)
+        metadata["lenslab:EV100"] = camera_exposure("physical", cam.f_number, cam.shutter_s, cam.iso).ev100
     if frame.real_lens is not None:
         metadata.update(real_lens_metadata(frame))
     return metadata
+
+
+#: Exif's ExposureProgram: 0 not defined (compensated: no camera setting made the brightness), 1 manual, 3 aperture
+#: priority (the auto mode keeps the f-number and chooses the shutter).
+EXIF_EXPOSURE_PROGRAM = {"compensated": 0, "physical": 1, "auto": 3}
+
+
+def exposure_metadata(metadata: dict[str, object], image: np.ndarray) -> dict[str, object]:
+    """The entries of an auto exposure's metadata once ``image`` (the linear picture, before exposure) is metered:
+    the scale, the shutter the meter chose, its EV100 and the reading. From the metadata alone, so that a batch shot
+    merged from parts meters the merged image."""
+    exposure = camera_exposure("auto", float(metadata[OPTIONS["f_number"].metadata]),
+                               float(metadata[OPTIONS["shutter"].metadata]), float(metadata[OPTIONS["iso"].metadata]),
+                               float(metadata["lenslab:ApertureLightFraction"]),
+                               luminance(image, str(metadata["lenslab:WorkingSpace"])),
+                               str(metadata["lenslab:Metering"]))
+    return {"lenslab:ExposureScale": exposure.scale, OPTIONS["shutter"].metadata: exposure.shutter_s,
+            "lenslab:EV100": exposure.ev100, "lenslab:MeteredLuminance": exposure.metered_cd_m2}
 
 
 def real_lens_metadata(frame: CameraFrame) -> dict[str, object]:

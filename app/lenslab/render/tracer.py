@@ -30,7 +30,8 @@ from lenslab.render.denoise import MAX_MEMORY_MB
 from lenslab.render.features import GENERAL, KernelFeatures, scene_features
 from lenslab.render.gpu_layout import (ACCUMULATION_BINDING, APERTURE_TABLE_UNIT, DISPLAY_BINDING, FEATURE_ROWS,
                                       FEATURES_BINDING, MAX_LENS_SURFACES, SHADING_ROWS,
-                                      SPLAT_IMAGE_BINDING, TONE_MAP_CLAMP, TONE_MAP_FILMIC, TONE_MAP_REINHARD)
+                                      SPLAT_IMAGE_BINDING)
+from lenslab.colour_management.view import ViewTransform
 from lenslab.limits import SceneTooLarge, available_memory_bytes, format_bytes
 from lenslab.render.sobol import glsl_array_literal
 from lenslab.scene.camera import CameraFrame, ThinLensCamera
@@ -39,7 +40,10 @@ from lenslab.scene.scene import RenderSettings, Scene
 
 LOCAL_SIZE_X = 32  # GPU-NOTES: 32x1 work groups traversed the kd-tree fastest on llvmpipe
 DISPLAY_GROUP_X = 64  # display.comp's work groups: 64 pixels of a row
-TONE_MAP_CODES = {"clamp": TONE_MAP_CLAMP, "reinhard": TONE_MAP_REINHARD, "filmic": TONE_MAP_FILMIC}  # film.TONE_MAPS
+# display.comp includes OCIO's generated view transform under this name; its lookup tables take texture units from
+# DISPLAY_FIRST_TEXTURE_UNIT on, clear of the trace kernel's (APERTURE_TABLE_UNIT).
+OCIO_DISPLAY_INCLUDE = "ocio_display.glsl"
+DISPLAY_FIRST_TEXTURE_UNIT = 4
 DEFAULT_DISPATCH_SECONDS = 0.1
 # A splatted gaussian keeps one pass of samples (16 bytes each) until splat.comp has spread them. One sample
 # per pixel may take up to SPLAT_MEMORY_BYTES (a 3840 x 2160 image: 127 MiB; never more than one storage
@@ -96,18 +100,19 @@ class Renderer:
         self.largest_buffer_bytes = largest_storage_buffer(self.ctx.info["GL_RENDERER"], self.limits)
         self._programs: dict[tuple, object] = {}
         self._declared: dict[int, tuple[str, frozenset[str]]] = {}  # id(program): (shader, uniforms declared)
+        self._luts: dict[str, list] = {}  # OCIO's lookup tables as textures, by the GLSL that samples them
         # Told the shader's name before a kernel is compiled (seconds on llvmpipe): the studio says so on screen.
         self.on_compile: Callable[[str], None] | None = None
 
     @in_context
-    def program(self, shader: str, **defines):
+    def program(self, shader: str, includes: dict[str, str] | None = None, **defines):
         """The compute shader glsl/<shader> compiled with these #defines, besides the buffer layout that
-        gl.load_shader_source gives every shader (compiled once, then cached)."""
-        key = (shader, tuple(sorted(defines.items())))
+        gl.load_shader_source gives every shader, and with generated ``includes`` (compiled once, then cached)."""
+        key = (shader, tuple(sorted(defines.items())), tuple(sorted((includes or {}).items())))
         if key not in self._programs:
             if self.on_compile is not None:
                 self.on_compile(shader)
-            source = gl.load_shader_source(shader, defines)
+            source = gl.load_shader_source(shader, defines, includes=includes)
             program = self.ctx.compute_shader(source)
             self._programs[key] = program
             self._declared[id(program)] = (shader, gl.declared_uniforms(source))
@@ -142,8 +147,41 @@ class Renderer:
     def splat_program(self):
         return self.program("splat.comp", LOCAL_SIZE_X=LOCAL_SIZE_X)
 
-    def display_program(self):
-        return self.program("display.comp", LOCAL_SIZE_X=DISPLAY_GROUP_X)
+    def display_program(self, view: ViewTransform):
+        """display.comp with OCIO's GLSL for ``view``, its lookup tables bound to their texture units (made once
+        per transform and kept), and the uniforms of its exposure and contrast set."""
+        shader = view.gpu_shader()
+        program = self.program("display.comp", includes={OCIO_DISPLAY_INCLUDE: shader.source},
+                               LOCAL_SIZE_X=DISPLAY_GROUP_X)
+        for unit, texture in enumerate(self._lookup_textures(shader), start=DISPLAY_FIRST_TEXTURE_UNIT):
+            texture.use(unit)
+            if texture.extra in program:
+                program[texture.extra].value = unit
+        self.set_uniforms(program, view.gpu_uniforms())
+        return program
+
+    def _lookup_textures(self, shader) -> list:
+        """GL textures of OCIO's lookup tables for ``shader``: uploaded as OCIO's own GL code uploads them (its
+        values in its order, float32), kept for as long as the renderer."""
+        key = shader.source
+        if key not in self._luts:
+            textures = []
+            for table in shader.textures:
+                data = np.ascontiguousarray(table.values, np.float32)
+                if data.ndim == 4:  # a 3D LUT: edge x edge x edge x 3
+                    texture = self.ctx.texture3d(data.shape[2::-1], 3, data.tobytes(), dtype="f4")
+                else:
+                    texture = self.ctx.texture((data.shape[1], data.shape[0]), data.shape[2], data.tobytes(),
+                                               dtype="f4")
+                interpolation = moderngl.LINEAR if table.linear else moderngl.NEAREST
+                texture.filter = (interpolation, interpolation)
+                texture.repeat_x = texture.repeat_y = False
+                if data.ndim == 4:
+                    texture.repeat_z = False
+                texture.extra = table.sampler
+                textures.append(texture)
+            self._luts[key] = textures
+        return self._luts[key]
 
     def describe(self) -> dict[str, str]:
         return gl.describe_device(self.ctx)
@@ -153,6 +191,10 @@ class Renderer:
         for program in self._programs.values():
             program.release()
         self._programs.clear()
+        for textures in self._luts.values():
+            for texture in textures:
+                texture.release()
+        self._luts.clear()
         self._declared.clear()
         self.ctx.release()
 
@@ -779,17 +821,17 @@ class RenderSession:
         return film.resolve_features(self.feature_accumulation())
 
     @in_context
-    def display(self, exposure_stops: float = 0.0, tone_map: str = "clamp") -> np.ndarray:
-        """(H, W, 4) uint8 RGBA: the image as a screen shows it, made on the GPU (display.comp: the steps of
-        film.resolve, film.tone_map and film.to_8bit); alpha 0 where a pixel has no sample yet. A quarter of
+    def display(self, view: ViewTransform = ViewTransform()) -> np.ndarray:
+        """(H, W, 4) uint8 RGBA: the image as a screen shows it through ``view``, made on the GPU (display.comp:
+        the steps of film.display_pixels, with OCIO's GLSL); alpha 0 where a pixel has no sample yet. A quarter of
         the bytes of :meth:`accumulation` cross to the CPU, and no per-pixel work is left for it."""
-        return self._display_from(self._accumulation, exposure_stops, tone_map)
+        return self._display_from(self._accumulation, view)
 
     @in_context
-    def display_image(self, image: np.ndarray, exposure_stops: float = 0.0, tone_map: str = "clamp") -> np.ndarray:
+    def display_image(self, image: np.ndarray, view: ViewTransform = ViewTransform()) -> np.ndarray:
         """:meth:`display` of another linear image (H, W, 3) of this session's size, such as the denoiser's: it
-        goes up to the GPU once and comes back as RGBA8, instead of being tone-mapped in numpy (at 1920 x 1080,
-        a few milliseconds against a tenth of a second)."""
+        goes up to the GPU once and comes back as RGBA8, instead of going through OCIO's CPU processor (at
+        1920 x 1080, a few milliseconds against a tenth of a second)."""
         if image.shape[:2] != (self.height, self.width):
             raise ValueError(f"an image of {image.shape[1]} x {image.shape[0]} pixels is not this session's "
                              f"{self.width} x {self.height}")
@@ -799,18 +841,15 @@ class RenderSession:
             self._release_display_source()
             self._display_source = self.ctx.buffer(reserve=rgba.nbytes)
         self._display_source.write(rgba)
-        return self._display_from(self._display_source, exposure_stops, tone_map)
+        return self._display_from(self._display_source, view)
 
-    def _display_from(self, source, exposure_stops: float, tone_map: str) -> np.ndarray:
-        film.check_tone_map(tone_map)
+    def _display_from(self, source, view: ViewTransform) -> np.ndarray:
         pixels = self.width * self.height
         if self._display_pixels is None or self._display_pixels.size != 4 * pixels:
             self._release_display_pixels()
             self._display_pixels = self.ctx.buffer(reserve=4 * pixels)
-        program = self.renderer.display_program()
+        program = self.renderer.display_program(view)
         program["image_size"].value = (self.width, self.height)
-        program["exposure_scale"].value = float(2.0 ** exposure_stops)
-        program["tone_map"].value = TONE_MAP_CODES[tone_map]
         source.bind_to_storage_buffer(ACCUMULATION_BINDING)
         self._display_pixels.bind_to_storage_buffer(DISPLAY_BINDING)
         program.run((self.width + DISPLAY_GROUP_X - 1) // DISPLAY_GROUP_X, self.height, 1)

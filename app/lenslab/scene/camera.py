@@ -24,7 +24,8 @@ import numpy as np
 
 from lenslab.optics.aperture import Aperture
 from lenslab.optics.dof import COC_DIAGONAL_DIVISOR, DepthOfField
-from lenslab.optics.exposure import EXPOSURE_MODES, ISO_RANGE, SHUTTER_RANGE_S, exposure_scale
+from lenslab.optics.exposure import (EXPOSURE_MODES, ISO_RANGE, METER_MODES, SHUTTER_RANGE_S, Exposure,
+                                     camera_exposure, exposure_scale)
 from lenslab.optics.framing import SENSOR_FITS, imaged_area_mm
 from lenslab.optics.lens_system import LensSetting, LensSystem
 from lenslab.optics.lenses import MAX_APERTURE_BLADES, LensPreset
@@ -98,6 +99,9 @@ class ThinLensCamera:
     exposure_mode: str = field(default="compensated", metadata={"choices": EXPOSURE_MODES})
     iso: float = field(default=100.0, metadata={"range": ISO_RANGE})
     shutter_s: float = field(default=1.0 / 125.0, metadata={"range": SHUTTER_RANGE_S, "doc": "seconds"})
+    metering: str = field(default="average", metadata={
+        "choices": METER_MODES, "doc": "how the auto exposure meters: the centre-weighted average, or a spot at "
+                                       "the frame's centre"})
     resolution: tuple[int, int] = field(default=(640, 480), metadata={"range": (1, MAX_IMAGE_SIDE)})
     pinhole: bool = field(default=False, metadata={"doc": "an ideal pinhole: everything sharp, the f-number ignored"})
     real_lens: str = field(default="", metadata={
@@ -238,10 +242,18 @@ class ThinLensCamera:
 
     def exposure_scale(self, light_fraction: float = 1.0) -> float:
         """What the image's radiance is multiplied by: 1 in the compensated mode; in the physical mode
-        t S / (120 N^2) times the light the aperture passes (lenslab.optics.exposure)."""
+        0.18 t S / (12.5 N^2) times the light the aperture passes (lenslab.optics.exposure). The auto mode's
+        depends on the picture: :meth:`exposure`."""
         if self.exposure_mode != "physical":
             return 1.0
         return exposure_scale(self.f_number, self.shutter_s, self.iso, light_fraction)
+
+    def exposure(self, light_fraction: float = 1.0, luminance: np.ndarray | None = None,
+                 spot: tuple[float, float] = (0.5, 0.5)) -> Exposure:
+        """This camera's exposure of a picture whose scene-linear luminance is ``luminance`` (H, W; the auto mode
+        meters it with ``metering``): lenslab.optics.exposure.camera_exposure."""
+        return camera_exposure(self.exposure_mode, self.f_number, self.shutter_s, self.iso, light_fraction,
+                               luminance, self.metering, spot)
 
     def depth_of_field(self, width: int | None = None, height: int | None = None,
                        light_fraction: float = 1.0, reference: str | None = None) -> DepthOfField:

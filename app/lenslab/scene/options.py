@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
+from lenslab.colour_management.view import CONTRAST_RANGE, EXPOSURE_RANGE
 from lenslab.scene.camera import MAX_IMAGE_SIDE, ThinLensCamera
 from lenslab.scene.fields import declared_choices, declared_range
 from lenslab.scene.scene import RenderSettings
@@ -193,8 +194,6 @@ def _aperture_image_file(text: str) -> str:
     return path
 
 
-TONE_MAPS = ("clamp", "reinhard", "filmic")
-
 _ROWS = (
     Option("f_number", float, "aperture as an f-number, e.g. 2.8 or f/2.8 (1.4 is wide open and blurry, 16 is deep "
            "focus); a marked stop is its exact value (f/11 is 2^3.5)", "camera.f_number", metavar="N",
@@ -244,20 +243,36 @@ _ROWS = (
            metavar="C", metadata="lenslab:BarrelClipping"),
     Option("aperture_image", str, "a grayscale image of the stop (custom bokeh), relative to the current folder",
            "camera.aperture_image", metavar="FILE", parse_text=_aperture_image_file, metadata="lenslab:ApertureImage"),
-    Option("exposure_mode", str, "compensated (brightness kept) or physical (each stop a stop of light)",
+    Option("exposure_mode", str, "compensated (brightness kept, for scenes in arbitrary units), physical (manual: "
+           "each stop a stop of light) or auto (aperture priority: the meter picks the shutter)",
            "camera.exposure_mode", metadata="lenslab:ExposureMode"),
     Option("iso", float, "sensor speed; implies the physical exposure mode", "camera.iso", metavar="S",
            metadata="Exif:PhotographicSensitivity"),
     Option("shutter", float, "exposure time, e.g. 1/125 or 2s; implies the physical exposure mode",
            "camera.shutter_s", unit="s", metavar="T", parse_text=_shutter, metadata="ExposureTime"),
+    Option("metering", str, "how the auto exposure meters: average (centre-weighted) or spot (the frame's centre)",
+           "camera.metering", metadata="lenslab:Metering"),
+    Option("working_space", str, "the RGB the scene's colours are in and the renderer computes in",
+           "render.working_space", metadata="lenslab:WorkingSpace"),
     # How the image is made and written, not the scene: the render job's and the output's.
     Option("time_limit", float, "stop after this many seconds, keeping what has been rendered (at least one "
            "sample in every pixel)", unit="s", metavar="SECONDS", bounds=(0.001, 1e7), scene=False),
-    Option("exposure", float, "PNG only: brighten (+) or darken (-) by this many stops", unit="stops",
-           metavar="STOPS", bounds=(-30.0, 30.0), metadata="lenslab:DisplayExposureStops", scene=False),
-    Option("tone_map", str, "PNG only: how radiance above 1 is brought into the displayable range (default: clamp; "
-           "the studio shows and exports filmic unless told otherwise)", choices=TONE_MAPS,
-           metadata="lenslab:ToneMap", scene=False),
+    # The view transform of a picture (PNG, TIFF, JPEG; an EXR stays scene-linear): OpenColorIO's, from $OCIO or
+    # the built-in ACES config (lenslab.colour_management.view). Names are checked against the config when the
+    # transform is made, where the config is known.
+    Option("display", str, "the display a picture is made for (default: the OCIO config's first, sRGB)",
+           metavar="NAME", metadata="lenslab:Display", scene=False),
+    Option("view", str, "the display's view (default: its first, ACES 2.0 SDR in the built-in config; 'filmic' and "
+           "'clamp' name that and 'Un-tone-mapped')", metavar="NAME", old_names=("tone_map",),
+           metadata="lenslab:View", scene=False),
+    Option("look", str, "OCIO looks applied before the view, comma separated", metavar="NAMES",
+           metadata="lenslab:Looks", scene=False),
+    Option("exposure", float, "pictures only: brighten (+) or darken (-) by this many stops, in the view transform",
+           unit="stops", metavar="STOPS", bounds=EXPOSURE_RANGE, metadata="lenslab:DisplayExposureStops", scene=False),
+    Option("contrast", float, "pictures only: contrast about middle grey (1 = as the view makes it)",
+           metavar="C", bounds=CONTRAST_RANGE, metadata="lenslab:Contrast", scene=False),
+    Option("ocio_config", str, "an OpenColorIO config file (default: $OCIO, else the built-in ACES config)",
+           metavar="FILE", parse_text=_existing_file, metadata="lenslab:OCIOConfig", scene=False),
 )
 
 #: Every option by its name.

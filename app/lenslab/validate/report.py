@@ -57,9 +57,10 @@ def _write_png(path: Path, rgb8: np.ndarray) -> None:
 
 
 def display(linear: np.ndarray) -> np.ndarray:
-    from lenslab.render.film import to_8bit, tone_map
+    """Mitsuba's image and ours side by side, both through the default view transform (ACES 2.0 SDR on sRGB)."""
+    from lenslab.render.film import display_pixels, to_8bit
 
-    return to_8bit(tone_map(linear, 0.0, "clamp"))
+    return to_8bit(display_pixels(linear))
 
 
 def difference_image(image: np.ndarray, reference: np.ndarray) -> np.ndarray:
