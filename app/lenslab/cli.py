@@ -209,7 +209,7 @@ def render_headless(args) -> int:
         given = {"display": args.display is not None, "view": args.view is not None, "look": args.look is not None,
                  "exposure": args.exposure != 0.0, "contrast": args.contrast != 1.0}
         for name in (name for name, yes in given.items() if yes):
-            _warn(f"{"--" + name} applies to pictures only: an EXR keeps the scene-linear values")
+            _warn(f"--{name} applies to pictures only: an EXR keeps the scene-linear values")
     overrides = scene_overrides(args)
     if args.denoise:  # a denoiser that cannot run says so now, not after the render
         from lenslab.render.denoise import DenoiseError, describe
