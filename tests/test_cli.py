@@ -36,20 +36,43 @@ def test_headless_exr_is_linear_float_with_camera_metadata(renderer, tmp_path, c
     assert "wrote" in err and "\n" == err[-1]
 
 
-def test_headless_png_is_the_exr_tone_mapped_for_display(renderer, tmp_path, capsys):
-    from lenslab.render.film import tone_map
+def test_headless_png_is_the_exr_through_the_view_transform(renderer, tmp_path, capsys):
+    from lenslab.colour_management.view import ViewTransform
+    from lenslab.render.film import display_pixels
 
     for suffix in (".exr", ".png"):
         status, err = run_cli(capsys, "dof_chart", "--headless", "-o", tmp_path / f"shot{suffix}", *SMALL,
-                              "--tone-map", "filmic", "--exposure", "1")
+                              "--display", "Display P3 - Display", "--look", "ACES 1.3 Reference Gamut Compression",
+                              "--exposure", "1", "--contrast", "1.2")
         assert status == 0, err
     linear, _ = read_image(tmp_path / "shot.exr")
-    display, _ = read_image(tmp_path / "shot.png")
+    display, metadata = read_image(tmp_path / "shot.png")
     assert display.shape == (24, 32, 3)
-    # The same seed gives the same samples: the PNG is the EXR brightened a stop, filmic, sRGB-encoded, 8 bits.
-    expected = tone_map(linear, exposure_stops=1.0, operator="filmic")
-    assert np.abs(display - expected).max() <= 0.5 / 255 + 1e-6
-    assert np.abs(display - tone_map(linear)).max() > 0.05  # and not merely clamped: the options took effect
+    # The same seed gives the same samples: the PNG is the EXR through OCIO's view, a stop brighter, 8 bits.
+    view = ViewTransform(display="Display P3 - Display", looks="ACES 1.3 Reference Gamut Compression",
+                         exposure_stops=1.0, contrast=1.2)
+    assert np.abs(display - display_pixels(linear, view)).max() <= 0.5 / 255 + 1e-6
+    assert np.abs(display - display_pixels(linear)).max() > 0.05  # and not the default view: the options took effect
+    assert metadata["lenslab:Display"] == "Display P3 - Display"
+    assert metadata["lenslab:View"] == "ACES 2.0 - SDR 100 nits (P3 D65)"  # the display's default view, named
+
+
+def test_the_old_tone_map_names_are_views(renderer, tmp_path, capsys):
+    """--tone-map is an older name of --view; clamp is the un-tone-mapped view, filmic the display's default."""
+    from lenslab.colour_management.view import ViewTransform
+    from lenslab.render.film import display_pixels
+
+    for name in ("exr", "clamp", "filmic"):
+        args = ("--tone-map", name) if name != "exr" else ()
+        status, err = run_cli(capsys, "dof_chart", "--headless", "-o", tmp_path / f"{name}.{'exr' if name == 'exr' else 'png'}",
+                              *SMALL, *args)
+        assert status == 0, err
+    linear, _ = read_image(tmp_path / "exr.exr")
+    for name, view in (("clamp", "Un-tone-mapped"), ("filmic", "")):
+        picture, metadata = read_image(tmp_path / f"{name}.png")
+        assert np.abs(picture - display_pixels(linear, ViewTransform(view=view))).max() <= 0.5 / 255 + 1e-6
+    status, err = run_cli(capsys, "dof_chart", "--headless", "-o", tmp_path / "r.png", *SMALL, "--tone-map", "reinhard")
+    assert status != 0 and "reinhard" in err and "Un-tone-mapped" in err and not (tmp_path / "r.png").exists()
 
 
 def test_time_limit_alone_renders_what_fits(renderer, tmp_path, capsys):
@@ -341,7 +364,7 @@ def test_a_lens_mounts_and_focus_nearer_than_it_can_is_refused(renderer, tmp_pat
     ("--barrel-clipping", "2", "out of range [0, 1]"),
     ("--coc", "0", "out of range [0.0005, 1]"),
     ("--focus-from", "film", "invalid choice: 'film'"),
-    ("--exposure-mode", "auto", "invalid choice: 'auto'"),
+    ("--exposure-mode", "manual", "invalid choice: 'manual'"),
     ("--shutter", "1/0", "not a shutter time: '1/0'"),
     ("--aperture-image", "no_such_star.png", "no such file: no_such_star.png"),
 ])
@@ -470,11 +493,11 @@ def test_info_with_an_output_says_it_renders_nothing(capsys, tmp_path):
     assert not (tmp_path / "c.png").exists()
 
 
-def test_png_only_options_on_an_exr_are_each_named(renderer, capsys, tmp_path):
+def test_picture_only_options_on_an_exr_are_each_named(renderer, capsys, tmp_path):
     status, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "c.exr", "--spp", "1", "--width",
                           "8", "--height", "8", "--tone-map", "filmic", "--exposure", "1")
     assert status == 0
-    assert "--tone-map applies to PNG only" in err and "--exposure applies to PNG only" in err
+    assert "--view applies to pictures only" in err and "--exposure applies to pictures only" in err
 
 
 def test_a_folder_without_a_scene_is_called_a_folder(capsys, tmp_path):

@@ -150,7 +150,7 @@ def test_nothing_nearer_than_the_thin_lens_can_focus():
     ({"sensor": "super 8"}, "no sensor preset called 'super 8'"),
     ({"sensor_fit": "stretch"}, "sensor_fit 'stretch' is not one of auto, horizontal"),
     ({"focus_from": "film"}, "focus_from 'film' is not one of sensor, lens"),
-    ({"exposure_mode": "auto"}, "exposure_mode 'auto' is not one of compensated, physical"),
+    ({"exposure_mode": "manual"}, "exposure_mode 'manual' is not one of compensated, physical, auto"),
     ({"circle_of_confusion": 2.0}, "circle_of_confusion 2 is out of range"),
     ({"aperture_blades": 2}, "aperture_blades 2: a stop has 0 blades (round) or at least 3"),
     ({"aperture_blades": 40}, "aperture_blades 40 is out of range [0, 32]"),

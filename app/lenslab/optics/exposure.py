@@ -147,8 +147,8 @@ def camera_exposure(mode: str, f_number: float, shutter_s: float, iso: float, li
     if not reading > 0.0:  # a black frame: nothing to meter, the camera's own shutter stays
         return Exposure(exposure_scale(f_number, shutter_s, iso, light_fraction), shutter_s,
                         ev100(f_number, shutter_s, iso), 0.0)
-    # The meter sees the light the aperture passes: as the f-number that passes as much, N / sqrt(fraction).
-    ev = metered_ev100(reading) - math.log2(require_positive("light_fraction", light_fraction))
+    # The meter sees the light the aperture passes: a fraction of it reads as that much less luminance.
+    ev = metered_ev100(reading) + math.log2(require_positive("light_fraction", light_fraction))
     chosen = min(max(shutter_for(ev, f_number, iso), SHUTTER_RANGE_S[0]), SHUTTER_RANGE_S[1])
     return Exposure(exposure_scale(f_number, chosen, iso, light_fraction), chosen, ev100(f_number, chosen, iso),
                     reading)
