@@ -12,7 +12,7 @@ reference, by two errors:
   (a firefly would otherwise decide it alone, as in denoising papers), and less the reference's own noise,
   (A - B)^2 / 4 from its two halves A and B: an unbiased estimate of the error against the truly converged image,
   which may dip below 0 there;
-* display MAE: the mean absolute difference of the filmic tone-mapped, sRGB-encoded values in [0, 1] (what the
+* display MAE: the mean absolute difference of the display values in [0, 1] (the default view: ACES 2.0 SDR on sRGB) (what the
   studio shows by default; 0.01 is about 2.5 steps of 255). Not corrected: the reference's own, about half its
   halves' difference, is printed as its floor.
 
@@ -37,7 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from lenslab.render import denoise as oidn
-from lenslab.render.film import tone_map
+from lenslab.render.film import display_pixels
 from lenslab.render.gl import glsl_dir
 from lenslab.render.tracer import Renderer, RenderSession
 from lenslab.scene.io.loader import open_scene, shipped_scene_names
@@ -56,7 +56,7 @@ def rel_mse(image: np.ndarray, halves: np.ndarray) -> float:
 
 
 def display_mae(image: np.ndarray, halves: np.ndarray) -> float:
-    return float(np.mean(np.abs(tone_map(image, operator="filmic") - tone_map(halves.mean(axis=0), operator="filmic"))))
+    return float(np.mean(np.abs(display_pixels(image) - display_pixels(halves.mean(axis=0)))))
 
 
 def reference_floor(halves: np.ndarray) -> dict[str, float]:
@@ -64,7 +64,7 @@ def reference_floor(halves: np.ndarray) -> dict[str, float]:
     its halves' from each other."""
     reference = halves.mean(axis=0)
     noise = (halves[0] - halves[1]) ** 2 / 4 / (reference ** 2 + 0.01)
-    shown = [tone_map(half, operator="filmic") for half in halves]
+    shown = [display_pixels(half) for half in halves]
     return {"relMSE": float(noise.mean()), "display MAE": float(np.mean(np.abs(shown[0] - shown[1]))) / 2}
 
 

@@ -6,7 +6,7 @@ Printed, in one run:
   pixel (default 1024) the way a headless render takes them (lenslab.render.job.RenderJob);
 * the studio's progressive update at one sample per pixel: each update traces one more sample per pixel and
   then makes the picture the viewport shows, on the GPU (display.comp, as the render worker does) or, for
-  comparison, on the CPU (read the float image back, resolve and tone-map it in numpy, as it did before);
+  comparison, on the CPU (read the float image back, resolve it and run the view transform on the CPU, as it did before);
   updates per second in all and the median time of each part;
 * the million-triangle scene (scenes/marbles_on_sand): making the mesh and building its kd-tree, the kernel's
   first compile, and the seconds to 5 samples per pixel.
@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lenslab.render.film import resolve, to_8bit, tone_map
+from lenslab.render.film import display_pixels, resolve, to_8bit
 from lenslab.render.job import RenderJob
 from lenslab.render.tracer import Renderer, RenderSession
 from lenslab.scene.io.loader import open_scene
@@ -80,14 +80,14 @@ def progressive_updates(renderer, width: int, height: int, updates: int) -> None
         print(f"  {label:<34} {updates / total:7.1f} updates/s   (median: {breakdown})")
 
     def on_the_gpu() -> dict[str, float]:  # what the studio does now: display.comp, RGBA8 back
-        _, seconds = timed(lambda: session.display(0.0, "filmic"))
+        _, seconds = timed(lambda: session.display())
         return {"display.comp and read back": seconds}
 
     def on_the_cpu() -> dict[str, float]:  # what the studio did before: float32 back, numpy per pixel
         accumulation, read_seconds = timed(session.accumulation)
         linear, resolve_seconds = timed(lambda: resolve(accumulation))
-        _, tone_seconds = timed(lambda: to_8bit(tone_map(linear, 0.0, "filmic")))
-        return {"read back": read_seconds, "resolve": resolve_seconds, "tone-map to 8 bit": tone_seconds}
+        _, tone_seconds = timed(lambda: to_8bit(display_pixels(linear)))
+        return {"read back": read_seconds, "resolve": resolve_seconds, "view transform (OCIO, CPU) to 8 bit": tone_seconds}
 
     print(f"progressive update {width}x{height}, one sample per pixel each   (target for a GPU: 60 or more)")
     run("trace alone", None)

@@ -2,13 +2,13 @@
 
 The render worker (lenslab.gui.worker) does, per displayed frame: trace for a frame's time (a sixtieth of a
 second), then make the picture: on the GPU (display.comp, RGBA8 read back) or, with the denoiser on, read back
-the linear image and the albedo and normal guides, run Intel Open Image Denoise and tone-map its result on the
+the linear image and the albedo and normal guides, run Intel Open Image Denoise and show its result through the view transform on the
 GPU (RenderSession.display_image). This script times
 those steps at the viewport's size, framed as the viewport frames it (ThinLensCamera.view_frame), and prints:
 
 * pictures per second and samples per pixel after N seconds, without the denoiser;
 * the same with the denoiser run on every picture (the worst case; the worker runs it at most every 0.25 s),
-  and the median cost of each part: tracing, reading back, denoising, tone-mapping.
+  and the median cost of each part: tracing, reading back, denoising, the view transform.
 
 Usage: python benchmarks/viewport_loop.py [--scene cornell_box] [--width 1920] [--height 1080] [--seconds 5]
 """
@@ -39,7 +39,7 @@ def run(session: RenderSession, seconds: float, denoise) -> dict[str, list[float
         times["trace"].append(time.perf_counter() - start)
         start = time.perf_counter()
         if denoise is None:
-            session.display(0.0, "filmic")
+            session.display()
         else:
             t0 = time.perf_counter()
             image = session.image()
@@ -47,7 +47,7 @@ def run(session: RenderSession, seconds: float, denoise) -> dict[str, list[float
             t1 = time.perf_counter()
             clean = denoise(image, albedo, normal)
             t2 = time.perf_counter()
-            session.display_image(clean, 0.0, "filmic")
+            session.display_image(clean)
             t3 = time.perf_counter()
             times["read back"].append(t1 - t0)
             times["denoise"].append(t2 - t1)

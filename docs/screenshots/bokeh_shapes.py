@@ -11,7 +11,8 @@ from lenslab.scene.shapes import Sphere
 from lenslab.scene.transform import Transform
 from lenslab.render.tracer import Renderer
 from lenslab.render.job import RenderJob
-from lenslab.render.film import tone_map, to_8bit
+from lenslab.colour_management.view import ViewTransform
+from lenslab.render.film import display_pixels, to_8bit
 import OpenImageIO as oiio
 
 star = np.zeros((64, 64)); yy, xx = np.mgrid[0:64, 0:64] + 0.5
@@ -36,7 +37,7 @@ for name, kw in panels:
                   materials={"lamp": Emissive((4.0, 3.2, 2.2))}, nodes=lamps)
     job = RenderJob(r, scene, spp=int(sys.argv[1]) if len(sys.argv) > 1 else 512)
     img = job.run(); job.release()
-    tile = to_8bit(tone_map(img, 3.0, "filmic"))
+    tile = to_8bit(display_pixels(img, ViewTransform(exposure_stops=3.0)))
     tb = oiio.ImageBuf(oiio.ImageSpec(300, 200, 3, oiio.UINT8)); tb.set_pixels(oiio.ROI(0, 300, 0, 200, 0, 1, 0, 3), tile)
     oiio.ImageBufAlgo.render_text(tb, 8, 190, name, 14, "", (1, 1, 1))
     tiles.append(np.asarray(tb.get_pixels(oiio.UINT8)))
