@@ -302,8 +302,10 @@ def test_in_the_physical_mode_each_stop_of_aperture_is_a_stop_of_light(renderer,
         values[mode, f_number] = pixels.mean()
         if mode == "physical":
             assert metadata["ExposureTime"] == pytest.approx(1 / 30) and metadata["Exif:PhotographicSensitivity"] == 400
-            # The sky's radiance is 1: the exposure scale t S / (120 N^2) (ISO 12232, 78 / 0.65 = 120).
-            assert metadata["lenslab:ExposureScale"] == pytest.approx((1 / 30) * 400 / (120 * f_number ** 2), rel=1e-6)
+            # The sky's radiance is 1: the exposure scale 0.18 t S / (K N^2), K = 12.5 (ISO 2720's reflected-light
+            # meter: its reading lands at middle grey, lenslab.optics.exposure).
+            assert metadata["lenslab:ExposureScale"] == pytest.approx(0.18 * (1 / 30) * 400 / (12.5 * f_number ** 2),
+                                                                      rel=1e-6)
     assert values["compensated", 4.0] == pytest.approx(values["compensated", 2 ** 1.5], rel=0.02)
     assert values["physical", 2 ** 1.5] / values["physical", 4.0] == pytest.approx(2.0, rel=0.02)
 

@@ -10,7 +10,7 @@ import pytest
 
 from lenslab.resources import scenes_dir
 from lenslab.scene.io.loader import open_scene, shipped_scene_names
-from lenslab.scene.io.native import load_scene, save_scene, scene_to_dict
+from lenslab.scene.io.native import FORMAT_VERSION, load_scene, save_scene, scene_to_dict
 from lenslab.scene.scene import SceneError
 from lenslab.scene.shapes import MeshFile
 
@@ -22,18 +22,19 @@ def test_shipped_scenes_round_trip_losslessly(tmp_path, name):
     again = load_scene(tmp_path / "copy.json")
     assert again == scene
     assert scene_to_dict(again) == scene_to_dict(scene)
-    assert json.loads((tmp_path / "copy.json").read_text())["lenslab_scene"] == 3
+    assert json.loads((tmp_path / "copy.json").read_text())["lenslab_scene"] == FORMAT_VERSION == 4
 
 
-def test_a_version_2_scene_reads_as_written_and_saves_as_version_3(tmp_path):
-    # Version 3 added keys only: a version 2 file (the shipped scenes are) reads with their defaults.
+def test_a_version_2_scene_reads_as_written_and_saves_as_the_newest_version(tmp_path):
+    # Versions 3 and 4 added keys only: a version 2 file reads with their defaults (a light's radiance in nits).
     path = tmp_path / "v2.json"
     path.write_text(json.dumps({"lenslab_scene": 2, "materials": {"lamp": {"type": "emissive", "radiance": [2, 2, 2]}}}))
     scene = load_scene(path)
-    assert scene.materials["lamp"].surface is None
-    save_scene(scene, tmp_path / "v3.json")
-    saved = json.loads((tmp_path / "v3.json").read_text())
-    assert saved["lenslab_scene"] == 3 and saved["materials"]["lamp"]["surface"] is None
+    assert scene.materials["lamp"].surface is None and scene.materials["lamp"].unit == "nits"
+    save_scene(scene, tmp_path / "v4.json")
+    saved = json.loads((tmp_path / "v4.json").read_text())
+    assert saved["lenslab_scene"] == FORMAT_VERSION and saved["materials"]["lamp"]["surface"] is None
+    assert saved["materials"]["lamp"]["unit"] == "nits"
 
 
 def test_shipped_scenes_are_listed():

@@ -28,22 +28,30 @@ class Light:
 
 @dataclass
 class PointLight(Light):
-    """Light from a single point, equally in all directions: ``intensity`` in W/sr per channel."""
+    """Light from a single point, equally in all directions: ``intensity`` in candela per channel (its luminance
+    in cd), or with ``unit`` "lumens" the light's colour scaled so that its luminance is the total flux, which
+    spreads over the sphere: intensity = flux / (4 pi) (scene/light_units.py)."""
 
     type_name: ClassVar[str] = "point"
     position: Vec3 = (0.0, 2.0, 0.0)
-    intensity: RGB = field(default=(10.0, 10.0, 10.0), metadata={"range": (0.0, 1e9)})
+    intensity: RGB = field(default=(10.0, 10.0, 10.0), metadata={"range": (0.0, 1e9),
+                                                                 "doc": "candela per channel, or lumens: see unit"})
+    unit: str = field(default="candela", metadata={
+        "choices": ("candela", "lumens"),
+        "doc": "what intensity's luminance gives: candela, or lumens (the flux over the whole sphere)"})
 
 
 @dataclass
 class SunLight(Light):
-    """A distant disk of light: ``irradiance`` (W/m^2 on a surface facing it) arriving from ``direction``
-    (pointing towards the sun) over a cone of ``angular_diameter_deg`` (0.53 for our sun; 0 for a point at
-    infinity, whose shadows are razor sharp)."""
+    """A distant disk of light: ``irradiance`` (lux on a surface facing it: the luminance of the RGB; clear
+    midday sun gives about 100,000 lux) arriving from ``direction`` (pointing towards the sun) over a cone of
+    ``angular_diameter_deg`` (0.53 for our sun; 0 for a point at infinity, whose shadows are razor sharp).
+    Lux is the one unit a sun is written in (scene/light_units.py): a legacy scene's numbers read as lux too."""
 
     type_name: ClassVar[str] = "sun"
     direction: Vec3 = field(default=(0.3, 1.0, 0.2), metadata={"nonzero_vector": True})
-    irradiance: RGB = field(default=(3.0, 3.0, 3.0), metadata={"range": (0.0, 1e9)})
+    irradiance: RGB = field(default=(3.0, 3.0, 3.0), metadata={"range": (0.0, 1e9),
+                                                               "doc": "lux per channel on a surface facing the sun"})
     angular_diameter_deg: float = field(default=0.53, metadata={"range": (0.0, 30.0),
                                                                 "zero_or_at_least": SMALLEST_SUN_DEG})
 
@@ -66,9 +74,13 @@ class SunLight(Light):
 @dataclass
 class SpotLight(Light):
     """Light from one point into a cone, as Mitsuba 3's ``spot`` (``src/emitters/spot.cpp``): ``intensity``
-    in W/sr along ``direction``, the same out to ``beam_width_deg`` from the axis, then falling linearly in the
+    in candela along ``direction``, the same out to ``beam_width_deg`` from the axis, then falling linearly in the
     angle to zero at ``cutoff_angle_deg`` (both measured from the axis: half the cone's opening). A beam wider
     than the cutoff is the cutoff (a hard edge), as in Mitsuba.
+
+    With ``unit`` "lumens" the intensity's luminance is the spot's total flux, and all of it leaves through the
+    cone: intensity = flux / weighted_solid_angle() (scene/light_units.py), so narrowing the cone brightens the
+    beam, as a reflector behind a bulb does (Unity HDRP's "reflector" option does the same).
 
     An optional ``texture`` is projected through the cone like a slide: the image fills the square that the
     cutoff cone's tangent spans, u = 1/2 + x / (2 z tan(cutoff)), v = 1/2 + y / (2 z tan(cutoff)), with
@@ -80,7 +92,12 @@ class SpotLight(Light):
     position: Vec3 = (0.0, 2.0, 0.0)
     direction: Vec3 = field(default=(0.0, -1.0, 0.0), metadata={"nonzero_vector": True,
                                                                 "doc": "the cone's axis, where the light goes"})
-    intensity: RGB = field(default=(10.0, 10.0, 10.0), metadata={"range": (0.0, 1e9)})
+    intensity: RGB = field(default=(10.0, 10.0, 10.0), metadata={"range": (0.0, 1e9),
+                                                                 "doc": "candela per channel, or lumens: see unit"})
+    unit: str = field(default="candela", metadata={
+        "choices": ("candela", "lumens"),
+        "doc": "what intensity's luminance gives: candela on the axis, or lumens (the flux, all of it through "
+               "the cone)"})
     cutoff_angle_deg: float = field(default=20.0, metadata={"range": (0.01, 180.0),
                                                             "doc": "no light beyond this angle from the axis"})
     beam_width_deg: float = field(default=15.0, metadata={"range": (0.0, 180.0),

@@ -23,15 +23,18 @@ from typing import Any
 from lenslab.atomic import atomic_path
 from lenslab.image_files import not_found, read_file_bytes
 from lenslab.limits import LARGEST_NUMBER
+from lenslab.scene.fields import text_problem
 from lenslab.scene.materials import MATERIAL_TYPES, Material
-from lenslab.scene.scene import ENVIRONMENT_TYPES, Environment, Node, Scene, SceneError
+from lenslab.scene.light_units import check_environment_map
+from lenslab.scene.scene import ENVIRONMENT_TYPES, Environment, EnvironmentMap, Node, Scene, SceneError
 from lenslab.scene.shapes import SHAPE_TYPES, MeshFile, Shape
 from lenslab.scene.textures import TEXTURE_TYPES, Texture
 from lenslab.scene.lights import LIGHT_TYPES, Light
 
 FORMAT_KEY = "lenslab_scene"
-FORMAT_VERSION = 3
-READABLE_VERSIONS = (1, 2, FORMAT_VERSION)  # 2 differs from 3 only by what 3 added (docs/scene-format.md)
+FORMAT_VERSION = 4
+#: 2, 3 and 4 differ only by what each added (docs/scene-format.md, "Versions"): an older file reads unchanged.
+READABLE_VERSIONS = (1, 2, 3, FORMAT_VERSION)
 #: Version 1 files measured the focus distance from the lens, kept the sensor one focal length behind it and
 #: spanned the image across the sensor's width; version 2's defaults are the photographer's (docs/scene-format.md,
 #: "Versions"). A version 1 file is read with its old meaning, so it renders exactly as it always did.
@@ -109,8 +112,9 @@ def _read_value(value: Any, annotation: Any, path: str, meta: dict) -> Any:
     if annotation is str:
         if not isinstance(value, str):
             raise _Invalid(path, f"expected a string, got {_describe(value)}")
-        if "choices" in meta and value not in meta["choices"]:
-            raise _Invalid(path, f"'{value}' is not one of {', '.join(meta['choices'])}")
+        problem = text_problem(meta, value)
+        if problem:
+            raise _Invalid(path, problem)
         return value
     if origin is tuple:
         if not isinstance(value, list) or len(value) != len(args):
@@ -174,6 +178,11 @@ def _check_references(scene: Scene) -> None:
         scene.camera.validate()
     except ValueError as exc:
         raise _Invalid("camera", str(exc)) from None
+    if isinstance(scene.environment, EnvironmentMap):
+        try:  # the range holds a negative EV; a negative scale or mean luminance is named while the scene opens
+            check_environment_map(scene.environment)
+        except ValueError as exc:
+            raise _Invalid("environment.strength", str(exc)) from None
     if scene.camera.aperture_image:
         try:  # read now, so that a missing or black image is named while the scene opens
             scene.camera.aperture(scene.base_dir())
