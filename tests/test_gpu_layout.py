@@ -8,10 +8,11 @@ import re
 import moderngl
 import pytest
 
+from lenslab.colour_management.view import ViewTransform
 from lenslab.render.gl import declared_uniforms, load_shader_source
 from lenslab.render.gpu_layout import glsl_defines
 from lenslab.render.sobol import glsl_array_literal
-from lenslab.render.tracer import RenderSession
+from lenslab.render.tracer import OCIO_DISPLAY_INCLUDE, RenderSession
 from lenslab.resources import glsl_dir
 from lenslab.scene.io.loader import open_scene
 
@@ -19,11 +20,13 @@ LAYOUT = glsl_defines()
 KERNELS = sorted(path.name for path in glsl_dir().glob("*.comp"))
 # What the host passes besides the layout; a kernel that does not read one ignores it.
 KERNEL_DEFINES = {"LOCAL_SIZE_X": 32, "SOBOL_DIRECTIONS": glsl_array_literal()}
+# And the code it generates: display.comp includes OpenColorIO's view transform (the default one here).
+KERNEL_INCLUDES = {OCIO_DISPLAY_INCLUDE: ViewTransform().gpu_shader().source}
 
 
 @pytest.mark.parametrize("kernel", KERNELS)
 def test_every_kernel_is_compiled_with_every_layout_constant(kernel):
-    lines = set(load_shader_source(kernel, KERNEL_DEFINES).splitlines())
+    lines = set(load_shader_source(kernel, KERNEL_DEFINES, includes=KERNEL_INCLUDES).splitlines())
     assert {f"#define {name} {value}" for name, value in LAYOUT.items()} <= lines
 
 
@@ -41,7 +44,7 @@ def test_a_kernel_cannot_redefine_the_layout():
 
 @pytest.mark.parametrize("kernel", KERNELS)
 def test_a_kernel_without_the_layout_does_not_compile(renderer, kernel):
-    source = load_shader_source(kernel, KERNEL_DEFINES)
+    source = load_shader_source(kernel, KERNEL_DEFINES, includes=KERNEL_INCLUDES)
     without = "\n".join(line for line in source.splitlines()
                         if not (line.startswith("#define ") and line.split()[1] in LAYOUT))
     with pytest.raises(moderngl.Error):

@@ -72,7 +72,7 @@ def test_a_value_reaches_the_scene_the_same_from_the_command_line_a_batch_file_a
         assert got == expected or (isinstance(got, float) and math.isclose(got, expected)), (option.name, got)
 
 
-@pytest.mark.parametrize("old, name", sorted(OLD_NAMES.items()))
+@pytest.mark.parametrize("old, name", sorted((old, name) for old, name in OLD_NAMES.items() if OPTIONS[name].scene))
 def test_older_spellings_are_still_read(old, name, tmp_path):
     option = OPTIONS[name]
     value = a_value(option)
@@ -82,6 +82,16 @@ def test_older_spellings_are_still_read(old, name, tmp_path):
     (shot,) = parse_batch(toml, tmp_path / "shots.toml").shots
     assert getattr(shot.overrides, name) == getattr(SceneOverrides(**{name: value}), name)
     assert shot.output.name != "a_.png"  # an output pattern may name the setting as it was written
+
+
+def test_the_old_tone_map_is_read_as_the_view_everywhere(tmp_path):
+    """tone_map was how a picture's display curve was named; its values clamp and filmic name views now."""
+    args = build_parser().parse_args(["cornell_box", "--tone-map", "clamp"])
+    assert args.view == "clamp"
+    toml = "[[shots]]\nscene = 'cornell_box'\noutput = 'a_{tone_map}.png'\ntone_map = 'filmic'\n"
+    (shot,) = parse_batch(toml, tmp_path / "shots.toml").shots
+    assert shot.view.resolved().view == "ACES 2.0 - SDR 100 nits (Rec.709)"
+    assert shot.output.name == "a_filmic.png"
 
 
 def test_a_setting_given_twice_under_two_spellings_is_refused(tmp_path):
