@@ -91,7 +91,7 @@ class _Context:
     def __init__(self):
         self.textures, self.floats = [], []
 
-    def index_of(self, texture):
+    def index_of(self, texture, data=False):
         if texture is None:
             return -1
         self.textures.append(texture)

@@ -263,7 +263,8 @@ def test_textured_reflectances_become_textures_shared_by_every_material_that_ref
     ''' + SENSOR + '</scene>', base_dir=write_quad_obj(tmp_path), warn=warnings.append)
     a, b, c, d = (scene.materials[f"{n}.bsdf"] for n in "abcd")
     assert isinstance(a, Diffuse) and isinstance(b, Plastic) and a.albedo_texture is b.albedo_texture
-    assert a.albedo_texture == ImageTexture(file="wood.png")  # a mesh's uvs take Mitsuba's identity to_uv as is
+    # a mesh's uvs take Mitsuba's identity to_uv as is; an 8-bit file without raw is sRGB, as Mitsuba reads it
+    assert a.albedo_texture == ImageTexture(file="wood.png", color_space="srgb")
     assert c.albedo_texture == Checkerboard(color_a=(0.4,) * 3, color_b=(0.2,) * 3, tiles=(2.0, -2.0),
                                             offset=(0.0, 2.0))  # Mitsuba's defaults, two squares per unit
     # A conductor's tint cannot vary over the surface: the texture's mean, with a warning naming the line.
@@ -295,7 +296,7 @@ def test_bitmap_properties_missing_files_and_bad_values(tmp_path):
                 <string name="wrap_mode" value="clamp"/><string name="format" value="float16"/></texture>
         </bsdf></shape>''' + SENSOR + '</scene>', base_dir=write_quad_obj(tmp_path), warn=warnings.append, name="gone.xml")
     texture = next(iter(scene.materials.values())).albedo_texture
-    assert (texture.file, texture.color_space, texture.filter, texture.wrap) == ("gone.exr", "linear", "nearest", "clamp")
+    assert (texture.file, texture.color_space, texture.filter, texture.wrap) == ("gone.exr", "raw", "nearest", "clamp")
     assert warnings == [f'gone.xml:3: <texture type="bitmap" name="reflectance">: texture file not found: '
                         f"{tmp_path / 'gone.exr'}; LensLab shows a magenta checkerboard in its place"]
     for body, message in (('<string name="wrap_mode" value="wrap"/>', 'line 2: .*invalid wrap_mode "wrap"'),

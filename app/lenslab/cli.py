@@ -210,6 +210,10 @@ def render_headless(args) -> int:
                  "exposure": args.exposure != 0.0, "contrast": args.contrast != 1.0}
         for name in (name for name, yes in given.items() if yes):
             _warn(f"--{name} applies to pictures only: an EXR keeps the scene-linear values")
+    if args.ocio_config:  # the config of the whole render: its textures as well as its picture
+        from lenslab.colour_management.config import use_config
+
+        use_config(args.ocio_config)
     overrides = scene_overrides(args)
     if args.denoise:  # a denoiser that cannot run says so now, not after the render
         from lenslab.render.denoise import DenoiseError, describe
@@ -271,8 +275,7 @@ def _view_transform(args, working_space: str):
     from lenslab.colour_management.view import ViewTransform
 
     view = ViewTransform(display=args.display or "", view=args.view or "", looks=args.look or "",
-                         exposure_stops=args.exposure, contrast=args.contrast, working_space=working_space,
-                         config=args.ocio_config or "")
+                         exposure_stops=args.exposure, contrast=args.contrast, working_space=working_space)
     try:
         return view.resolved()
     except ColourConfigError as exc:

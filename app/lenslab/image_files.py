@@ -132,6 +132,26 @@ def read_pixels(path: str | os.PathLike) -> tuple[np.ndarray, bool]:
     return (pixels[..., None] if pixels.ndim == 2 else pixels), str(spec.format) in FLOAT_FORMATS
 
 
+def holds_floats(path: str | os.PathLike) -> bool | None:
+    """Whether the image file holds floating-point values (EXR, HDR) rather than 8 or 16-bit integers, from its
+    header alone; None when it cannot be read."""
+    import OpenImageIO as oiio
+
+    try:
+        check_regular_file(path)
+    except NotARegularFile:
+        return None
+    with _decoders_quiet():
+        image = oiio.ImageInput.open(str(path))
+        if image is None:
+            oiio.geterror()  # cleared, so that it is not reported with a later, unrelated error
+            return None
+        try:
+            return str(image.spec().format) in FLOAT_FORMATS
+        finally:
+            image.close()
+
+
 _quiet_lock = threading.Lock()
 
 

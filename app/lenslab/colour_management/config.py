@@ -22,10 +22,22 @@ class ColourConfigError(ValueError):
     """A config that cannot be read, or a name (display, view, look, colour space) a config does not have."""
 
 
+_chosen_for_this_process = ""
+
+
+def use_config(source: str | os.PathLike) -> None:
+    """Make ``source`` the config of everything this process does that names none (the command line's
+    ``--ocio-config``: its textures and its pictures alike), before $OCIO."""
+    global _chosen_for_this_process
+    _chosen_for_this_process = str(source or "").strip()
+
+
 def config_source(source: str | os.PathLike | None = DEFAULT_SOURCE) -> str:
-    """The config ``source`` stands for: itself when given, else ``$OCIO`` when set, else BUILTIN_CONFIG. A file is
-    made absolute, so that the cache holds one entry for it however it was named."""
-    text = str(source or "").strip() or os.environ.get("OCIO", "").strip() or BUILTIN_CONFIG
+    """The config ``source`` stands for: itself when given, else the one :func:`use_config` chose, else ``$OCIO``
+    when set, else BUILTIN_CONFIG. A file is made absolute, so that the cache holds one entry for it however it was
+    named."""
+    text = (str(source or "").strip() or _chosen_for_this_process or os.environ.get("OCIO", "").strip()
+            or BUILTIN_CONFIG)
     if text.startswith("ocio://"):
         return text
     return str(Path(text).expanduser().resolve())
@@ -38,7 +50,7 @@ def load_config(source: str | os.PathLike | None = DEFAULT_SOURCE):
     if resolved.startswith("ocio://"):
         return _load(resolved, None)
     path = Path(resolved)
-    where = f"{path} (from $OCIO)" if not str(source or "").strip() else str(path)
+    where = f"{path} (from $OCIO)" if resolved == _from_environment() else str(path)
     if not path.is_file():
         raise ColourConfigError(f"{where}: no such OCIO config file")
     try:
@@ -49,6 +61,11 @@ def load_config(source: str | os.PathLike | None = DEFAULT_SOURCE):
         return _load(resolved, stamp)
     except ColourConfigError as exc:
         raise ColourConfigError(f"{where}: {exc}") from None
+
+
+def _from_environment() -> str:
+    text = os.environ.get("OCIO", "").strip()
+    return str(Path(text).expanduser().resolve()) if text and not text.startswith("ocio://") else text
 
 
 @lru_cache(maxsize=8)

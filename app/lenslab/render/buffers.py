@@ -29,7 +29,11 @@ from lenslab.render.gpu_layout import (ENV_CONSTANT, ENV_MAP, GEOMETRY_BINDING, 
                                        PRIM_REFS_BINDING, SHADING_BINDING, SHADING_ROWS, INSTANCES_BINDING)
 from lenslab.render.instancing import GroupCache, PackedGroup, join_layers, triangle_rows
 from lenslab.render.textures import TextureTable, read_texture_image
+from lenslab.colour_management.config import DEFAULT_SOURCE, ColourConfigError
+from lenslab.colour_management.working_space import DEFAULT_WORKING_SPACE
 from lenslab.scene.flatten import FlatScene
+from lenslab.scene.light_units import (environment_in_nits, environment_map_scale, light_in_candela,
+                                       sphere_mean_luminance)
 from lenslab.scene.materials import Emissive, Material, inner_materials
 from lenslab.scene.materials.base import MICROFACET_CODES  # noqa: F401 (imported from here)
 from lenslab.scene.materials.registry import HOLDING_CODES, KINDS, WRAPPER_CODES, pack_record
@@ -216,8 +220,9 @@ def _area_light_entries(flat: FlatScene, power: np.ndarray) -> list[_LightEntry]
 
 
 def _environment_uniforms(environment: Environment, textures: TextureTable, scene_radius: float,
-                          importance: bool = True):
-    """(uniform values, power for light selection, sampling tables to append to image_data)."""
+                          importance: bool = True, working_space: str = DEFAULT_WORKING_SPACE):
+    """(uniform values, power for light selection, sampling tables to append to image_data). A map's strength
+    becomes the scale of its pixels here, where its image is read (scene/light_units.py)."""
     uniforms = {"env_type": ENV_CONSTANT, "env_radiance": (0.0, 0.0, 0.0), "env_strength": 1.0, "env_texture": -1,
                 "env_world_to_map": _mat3_uniform(np.eye(3)), "env_dist_offset": 0, "env_size": (1, 1),
                 "env_table_size": (1, 1), "env_rows_pole_to_pole": 0}
@@ -227,25 +232,34 @@ def _environment_uniforms(environment: Environment, textures: TextureTable, scen
     if isinstance(environment, EnvironmentMap):
         path = Path(environment.file)
         path = path if path.is_absolute() else textures.base_dir / path
-        try:
-            rgb = read_texture_image(path, "linear")
-        except OSError as exc:
+        try:  # a colour, in the working space: a float file's linear Rec.709, an 8-bit file's sRGB (as Mitsuba)
+            rgb = read_texture_image(path, "auto", textures.working_space, config_source=textures.colour_config)
+        except (OSError, ColourConfigError) as exc:
             message = str(exc) if os.path.exists(path) else f"{path}: environment map not found"
             textures.warnings.append(f"{message}; lighting with a dim magenta sky instead")
             uniforms["env_radiance"] = MISSING_SKY
             return uniforms, infinite_light_power(4.0 * math.pi * luminance(MISSING_SKY), scene_radius)
         # Without importance sampling (for comparisons) the tables describe a uniform image.
         distribution = EnvironmentDistribution.from_image(rgb if importance else np.ones_like(rgb))
+        scale = _environment_map_scale(environment, rgb, working_space)
         uniforms.update(
-            env_type=ENV_MAP, env_strength=float(environment.strength),
-            env_texture=textures.index_of(InlineImageTexture(pixels=rgb, name=str(path))),
+            env_type=ENV_MAP, env_strength=scale,
+            env_texture=textures.index_of(InlineImageTexture(pixels=rgb, name=str(path), color_space="raw")),
             env_world_to_map=_mat3_uniform(environment.world_from_map().T),
             env_dist_offset=textures.add_floats(distribution.packed()), env_size=(rgb.shape[1], rgb.shape[0]),
             env_table_size=(distribution.pdf.shape[1], distribution.pdf.shape[0]),
             env_rows_pole_to_pole=int(environment.rows == "pole_to_pole"),
         )
-        return uniforms, environment_power(rgb, environment.strength, scene_radius)
+        return uniforms, environment_power(rgb, scale, scene_radius)
     raise TypeError(f"no GPU packing for environment type {type(environment).__name__}")
+
+
+def _environment_map_scale(environment: EnvironmentMap, rgb: np.ndarray, working_space: str) -> float:
+    """What the map's pixels are multiplied by: its strength in its unit (a plain scale needs no mean)."""
+    if environment.unit == "scale":
+        return float(environment.strength)
+    mean = sphere_mean_luminance(rgb, environment.rows, working_space)
+    return environment_map_scale(environment.strength, environment.unit, mean)
 
 
 def _mat3_uniform(matrix: np.ndarray) -> tuple[float, ...]:
@@ -303,12 +317,17 @@ def buffer_bytes(value) -> int:
 def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None = None,
                base_dir: Path | None = None, lights: Sequence[Light] = (),
                environment_importance: bool = True, packed_groups: Sequence[PackedGroup] | None = None,
-               group_cache: GroupCache | None = None) -> PackedScene:
+               group_cache: GroupCache | None = None, working_space: str = DEFAULT_WORKING_SPACE,
+               colour_config: str = DEFAULT_SOURCE) -> PackedScene:
     """Arrays and uniforms for the trace kernel; ``base_dir`` resolves relative texture paths.
     ``environment_importance=False`` samples an environment map uniformly (to measure what importance
     sampling gains). ``kdtree`` is the world's own primitives' tree (built here when None); ``packed_groups`` are
     the mesh groups' trees and rows (render/instancing.py; ``group_cache``, a GroupCache, keeps them and their
-    moved trees from one edit to the next), packed here when None."""
+    moved trees from one edit to the next), packed here when None. Lights and the environment given in
+    photometric units other than the renderer's (lumens, an EV) are converted here (scene/light_units.py), with the
+    luminance of ``working_space``, the scene's (flattening converted the area lights). Image textures and the
+    environment map are read into ``working_space`` through the OCIO config ``colour_config`` (empty: $OCIO, else
+    the built-in one; colour_management/texture_spaces.py)."""
     if kdtree is None:
         kdtree = kdtree_cache.kdtree(flat.prim_bounds(), triangles=flat.triangles)
     group_cache = group_cache or GroupCache()
@@ -318,7 +337,7 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
     n_tri, n_prim = flat.triangle_count, flat.prim_count
     material_ids = np.concatenate([flat.triangle_material, flat.sphere_material]).astype(np.int32)
 
-    textures = TextureTable(base_dir or Path.cwd())
+    textures = TextureTable(base_dir or Path.cwd(), working_space=working_space, colour_config=colour_config)
     bounds = flat.bounds()
     scene_radius = max(0.5 * float(np.linalg.norm(bounds[1] - bounds[0])), 1e-3)
 
@@ -331,6 +350,8 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
     at_infinity = {"falloff": 1.0 / (math.pi * scene_radius**2), "reach2": -1.0}
     sun_at_infinity = {**at_infinity, "falloff": 0.25 / (math.pi * scene_radius**2)}
     sun_uniforms = {"sun_direction": (0.0, 1.0, 0.0), "sun_one_minus_cos": 0.0, "sun_radiance": (0.0, 0.0, 0.0)}
+    lights = [light_in_candela(light) for light in lights]
+    environment = environment_in_nits(environment, working_space)
     suns = [light.name for light in lights if isinstance(light, SunLight)]
     if len(suns) > 1:
         raise ValueError(f"lights: only one sun per scene (found {', '.join(repr(name) for name in suns)})")
@@ -347,7 +368,8 @@ def pack_scene(flat: FlatScene, environment: Environment, kdtree: KdTree | None 
             # pbrt-v4's DistantLight::Phi: the irradiance falling on a disk of the scene's radius.
             entries.append(_LightEntry(LIGHT_SUN, math.pi * scene_radius**2 * luminance(light.irradiance),
                                        vector=light.unit_direction(), rgb=light.radiance(), **sun_at_infinity))
-    env_uniforms, env_power = _environment_uniforms(environment, textures, scene_radius, environment_importance)
+    env_uniforms, env_power = _environment_uniforms(environment, textures, scene_radius, environment_importance,
+                                                    working_space)
     if env_power > 0:
         entries.append(_LightEntry(LIGHT_ENVIRONMENT, env_power, **at_infinity))
     total = sum(e.power for e in entries)

@@ -1,5 +1,6 @@
-"""Textures for the GPU: image files read through OpenImageIO, linearised, packed as half floats (or as
-32-bit floats where a value is beyond the half-float range, as the sun in an HDR panorama can be).
+"""Textures for the GPU: image files read through OpenImageIO, brought from their colour space into the scene's
+working space (colour) or read as stored (data: colour_management/texture_spaces.py says which is which), packed as
+half floats (or as 32-bit floats where a value is beyond the half-float range, as the sun in an HDR panorama can be).
 
 A texture that cannot be read is not fatal: the render goes on with a magenta-and-black checkerboard in its
 place (hard to miss in a picture) and a warning naming the file, so one broken path never costs the user
@@ -15,7 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
-from lenslab.color import srgb_to_linear
+from lenslab.colour_management.config import DEFAULT_SOURCE, ColourConfigError
+from lenslab.colour_management.texture_spaces import colour_space_problem, data_slot_note, to_working_space
+from lenslab.colour_management.working_space import DEFAULT_WORKING_SPACE
 from lenslab.image_files import read_pixels
 from lenslab.render.gpu_layout import (TEXELS_FLOAT, TEXELS_HALF, TEXTURE_CHECKER, TEXTURE_FILTER_BILINEAR,
                                        TEXTURE_FILTER_NEAREST, TEXTURE_IMAGE, TEXTURE_ROWS, TEXTURE_WRAP_CLAMP,
@@ -33,8 +36,11 @@ WRAP_CODES = {"repeat": TEXTURE_WRAP_REPEAT, "mirror": TEXTURE_WRAP_MIRROR, "cla
 FILTER_CODES = {"bilinear": TEXTURE_FILTER_BILINEAR, "nearest": TEXTURE_FILTER_NEAREST}
 
 
-def read_texture_image(path: Path, color_space: str = "auto") -> np.ndarray:
-    """(H, W, 3) float32 linear RGB. Raises OSError naming the file when it cannot be read."""
+def read_texture_image(path: Path, color_space: str = "auto", working_space: str = DEFAULT_WORKING_SPACE, *,
+                       data: bool = False, config_source: str = DEFAULT_SOURCE) -> np.ndarray:
+    """(H, W, 3) float32: a colour texture's texels in ``working_space``, a data texture's (``data``) as stored
+    (texture_spaces.to_working_space). Raises OSError naming the file when it cannot be read, ColourConfigError
+    when OCIO cannot convert it."""
     pixels, is_float = read_pixels(path)
     height, width = pixels.shape[:2]
     if max(width, height) > MAX_SIDE:
@@ -42,13 +48,20 @@ def read_texture_image(path: Path, color_space: str = "auto") -> np.ndarray:
         log.warning("%s: %dx%d texture reduced to %dx%d", path, width, height, pixels.shape[1], pixels.shape[0])
     channels = pixels.shape[2]
     rgb = np.repeat(pixels[..., :1], 3, axis=2) if channels < 3 else pixels[..., :3]
-    if color_space == "srgb" or (color_space == "auto" and not is_float):
-        rgb = srgb_to_linear(np.clip(rgb, 0.0, 1.0))
+    rgb = to_working_space(rgb, color_space, is_float, working_space, data=data, config_source=config_source)
+    return _sane_texels(rgb, path)
+
+
+def _sane_texels(rgb: np.ndarray, path: Path | str) -> np.ndarray:
+    """``rgb`` with what no texel may be replaced, each kind with one warning naming the file."""
     if not np.isfinite(rgb).all():  # NaN or infinity in a float file: black, or every path that sees it is lost
         bad = int((~np.isfinite(rgb)).any(axis=2).sum())
         log.warning("%s: %d texel%s NaN or infinite: read as black", path, bad, " is" if bad == 1 else "s are")
         rgb = np.where(np.isfinite(rgb), rgb, 0.0)
-    if rgb.min(initial=0.0) < 0.0:  # no colour or radiance is negative; one would subtract light from the image
+    # No colour or radiance is negative; one would subtract light from the image. (A colour beyond the working
+    # space's gamut, converted into it, is negative too: a P3 texture's pure red in linear Rec.709. ACEScg, wider,
+    # holds P3's colours.)
+    if rgb.min(initial=0.0) < 0.0:
         bad = int((rgb < 0.0).any(axis=2).sum())
         log.warning("%s: %d texel%s negative: read as 0", path, bad, " is" if bad == 1 else "s are")
         rgb = np.maximum(rgb, 0.0)
@@ -74,39 +87,59 @@ def _reduced(pixels: np.ndarray, scale: float) -> np.ndarray:
 
 @dataclass
 class TextureTable:
-    """Collects the textures a scene's materials use, each once, as GPU records and packed texels."""
+    """Collects the textures a scene's materials and lights use, each once per use (colour or data), as GPU
+    records and packed texels: colour textures in ``working_space``, through the OCIO config ``colour_config``."""
 
     base_dir: Path
     warnings: list[str] = field(default_factory=list)
+    working_space: str = DEFAULT_WORKING_SPACE
+    colour_config: str = DEFAULT_SOURCE
     _records: list[np.ndarray] = field(default_factory=list)
     _texels: list[np.ndarray] = field(default_factory=list)
     _texel_count: int = 0  # in uints
-    _index: dict[int, int] = field(default_factory=dict)
+    _index: dict[tuple[int, bool], int] = field(default_factory=dict)
+    # The textures indexed, kept alive: a temporary one (the sky's pixels) freed would leave its id to another.
+    _held: list[Texture] = field(default_factory=list)
 
-    def index_of(self, texture: Texture | None) -> int:
-        """The record index of ``texture`` (added on first use), or -1 for none."""
+    def index_of(self, texture: Texture | None, data: bool = False) -> int:
+        """The record index of ``texture`` (added on first use), or -1 for none. ``data``: the slot holds numbers
+        (roughness, normals, heights, opacity, a weight), read as stored rather than as a colour."""
         if texture is None:
             return -1
-        key = id(texture)
+        key = (id(texture), data)  # a texture used both ways is read both ways
         if key not in self._index:
-            self._index[key] = self._add(texture)
+            self._index[key] = self._add(texture, data)
+            self._held.append(texture)
         return self._index[key]
 
-    def _add(self, texture: Texture) -> int:
+    def warn(self, message: str) -> None:
+        """A problem the render survives, said once (the caller reports them)."""
+        if message not in self.warnings:
+            self.warnings.append(message)
+
+    def _add(self, texture: Texture, data: bool = False) -> int:
         record = np.zeros((TEXTURE_ROWS, 4), np.float32)
         if isinstance(texture, ImageTexture):
             path = Path(texture.file)
             path = path if path.is_absolute() else self.base_dir / path
             try:
-                rgb = read_texture_image(path, texture.color_space)
+                rgb = self._read(path, texture.color_space, data)
+            except ColourConfigError as exc:
+                self.warn(f"{path}: {exc}; showing a magenta checkerboard instead")
+                return self._add(MISSING)
             except OSError as exc:
                 message = str(exc) if os.path.exists(path) else f"{path}: texture file not found"
-                self.warnings.append(f"{message}; showing a magenta checkerboard instead")  # the caller reports it
+                self.warn(f"{message}; showing a magenta checkerboard instead")
                 return self._add(MISSING)
             self._add_texels(record, rgb, texture)
         elif isinstance(texture, InlineImageTexture):
-            self._add_texels(record, np.asarray(texture.pixels, np.float32)[..., :3], texture)
-        elif isinstance(texture, Checkerboard):
+            try:
+                rgb = self._inline_pixels(texture, data)
+            except ColourConfigError as exc:
+                self.warn(f"{texture.name}: {exc}; showing a magenta checkerboard instead")
+                return self._add(MISSING)
+            self._add_texels(record, rgb, texture)
+        elif isinstance(texture, Checkerboard):  # its colours are typed in the working space, as every colour is
             record[0, 0] = TEXTURE_CHECKER
             record[3, :3], record[4, :3] = texture.color_a, texture.color_b
         else:
@@ -114,6 +147,26 @@ class TextureTable:
         record[1:3, :3] = texture.uv_matrix()  # (s, t) = rows 1 and 2 . (u, v, 1)
         self._records.append(record)
         return len(self._records) - 1
+
+    def _read(self, path: Path, color_space: str, data: bool) -> np.ndarray:
+        self._check_colour_space(color_space, path, data)
+        return read_texture_image(path, color_space, self.working_space, data=data, config_source=self.colour_config)
+
+    def _inline_pixels(self, texture: InlineImageTexture, data: bool) -> np.ndarray:
+        rgb = np.asarray(texture.pixels, np.float32)[..., :3]
+        self._check_colour_space(texture.color_space, texture.name, data)
+        return to_working_space(rgb, texture.color_space, True, self.working_space, data=data,
+                                config_source=self.colour_config)
+
+    def _check_colour_space(self, color_space: str, where: Path | str, data: bool) -> None:
+        """A ColourConfigError for a colour space that is none (a scene file's reader refuses it; one set in the
+        studio or by a script reaches here); a warning naming the texture where a data slot reads it raw."""
+        problem = colour_space_problem(color_space, self.colour_config)
+        if problem:
+            raise ColourConfigError(f"color_space {problem}")
+        note = data_slot_note(color_space, self.colour_config) if data else None
+        if note:
+            self.warn(f"{where}: {note}")
 
     def _add_texels(self, record: np.ndarray, rgb: np.ndarray, texture: ImageTexture | InlineImageTexture) -> None:
         height, width = rgb.shape[:2]

@@ -475,7 +475,8 @@ class RenderSession:
         self._stage("packing")
         packed = pack_scene(self.flat_scene, scene.environment, kdtree=world_tree, base_dir=scene.base_dir(),
                             lights=scene.lights, environment_importance=self.environment_importance,
-                            packed_groups=packed_groups, group_cache=self._groups)
+                            packed_groups=packed_groups, group_cache=self._groups,
+                            working_space=scene.render.working_space)
         packing = time.perf_counter()
         # What the render survives but the user should hear about: unmapped mesh materials, missing textures.
         self.warnings = [*self.flat_scene.warnings, *packed.warnings]

@@ -9,6 +9,11 @@ command line and batch files accept (:func:`declared_range`). ``"controls"`` is 
 boxes and presets *offer* (:func:`control_range`; the declared range where a field names none): f/0.5 to f/128
 for an f-number that may be f/0.13. A control range limits what the controls offer, never what a scene holds: a
 control showing a value outside it shows it as it is (:func:`range_holding`) and leaves it so.
+
+A text field whose values no fixed list holds (a texture's ``color_space``: a keyword or any colour space of the
+OCIO config) names a ``"check"`` instead of ``"choices"``: a function of the value that says what is wrong with it
+in words, or None; ``"suggestions"`` are the values a control may offer while still taking any other
+(:func:`text_problem`).
 """
 
 from __future__ import annotations
@@ -31,6 +36,16 @@ def declared_range(cls: type, field_name: str) -> tuple:
 def declared_choices(cls: type, field_name: str) -> tuple[str, ...]:
     """The values a text field of ``cls`` may take."""
     return tuple(_metadata(cls, field_name)["choices"])
+
+
+def text_problem(metadata, value: str) -> str | None:
+    """Why a text field with this metadata does not take ``value``: not one of its ``"choices"``, or what its
+    ``"check"`` says; None when it takes it."""
+    if "choices" in metadata and value not in metadata["choices"]:
+        return f"'{value}' is not one of {', '.join(metadata['choices'])}"
+    if "check" in metadata:
+        return metadata["check"](value)
+    return None
 
 
 def control_range(cls: type, field_name: str) -> tuple:

@@ -19,7 +19,8 @@ from pathlib import Path
 import numpy as np
 
 from lenslab.limits import LARGEST_NUMBER
-from lenslab.scene.materials import Mask, Material, walk_materials
+from lenslab.scene.light_units import areas_by_material, emissive_in_nits
+from lenslab.scene.materials import Emissive, Mask, Material, walk_materials
 from lenslab.scene.scene import DEFAULT_MATERIAL, Node, Scene, SceneError
 from lenslab.scene.shapes import Box, Cylinder, Disk, MeshFile, Rectangle, Relief, Sphere, TriangleMesh
 from lenslab.scene.io.meshes import LoadedMesh, MeshLoadError, MeshPart
@@ -275,15 +276,18 @@ def flatten_scene(scene: Scene, mesh_loader=None, instance_min_triangles: int | 
     triangle_node = cat(tri_node, (0,), np.int32)
     for what, parts in (("normals", tri_normals), ("texture coordinates", tri_uvs)):
         _check_finite_attribute(what, parts, triangle_node, nodes)
+    triangles, triangle_material = cat(tris, (0, 3, 3), np.float32), cat(tri_mat, (0,), np.int32)
+    sphere_rows, sphere_material = np.asarray(spheres, np.float32).reshape(-1, 4), np.asarray(sph_mat, np.int32)
 
     return FlatScene(
-        triangles=cat(tris, (0, 3, 3), np.float32),
+        triangles=triangles,
         triangle_normals=cat(tri_normals, (0, 3, 3), np.float32),
         triangle_uvs=cat(tri_uvs, (0, 3, 2), np.float32),
-        triangle_material=cat(tri_mat, (0,), np.int32),
-        spheres=np.asarray(spheres, np.float32).reshape(-1, 4),
-        sphere_material=np.asarray(sph_mat, np.int32),
-        materials=materials,
+        triangle_material=triangle_material,
+        spheres=sphere_rows,
+        sphere_material=sphere_material,
+        materials=_lights_in_nits(material_names, materials, triangles, triangle_material, sphere_rows,
+                                  sphere_material),
         material_names=material_names,
         prim_node=np.concatenate([triangle_node, np.asarray(sph_node, np.int32)]),
         nodes=nodes,
@@ -291,6 +295,23 @@ def flatten_scene(scene: Scene, mesh_loader=None, instance_min_triangles: int | 
         groups=tuple(groups),
         instances=tuple(instances),
     )
+
+
+def _lights_in_nits(names: list[str], materials: list[Material], triangles: np.ndarray,
+                    triangle_material: np.ndarray, spheres: np.ndarray, sphere_material: np.ndarray) -> list[Material]:
+    """The materials with every area light's radiance in nits: one given in lumens is spread over the world-space
+    area of the shapes that carry it, known only now (scene/light_units.py). Emitters are never instanced, so the
+    world-space arrays hold all of their shapes."""
+    if not any(isinstance(m, Emissive) and m.unit != "nits" for held in materials for m in walk_materials(held)):
+        return materials
+    areas = areas_by_material(triangles, triangle_material, spheres, sphere_material, len(materials))
+    converted = []
+    for name, material, area in zip(names, materials, areas):
+        try:
+            converted.append(emissive_in_nits(material, float(area)))
+        except ValueError as exc:  # a unit no file reader checked: a scene made in code
+            raise SceneError(f"material '{name}': {exc}") from None
+    return converted
 
 
 def _mesh_group(key: tuple, mesh: TriangleMesh, node: Node) -> MeshGroup:

@@ -64,10 +64,16 @@ class Environment:
 
 @dataclass
 class ConstantEnvironment(Environment):
-    """Light arriving from every direction with the same radiance (the sky of a white furnace)."""
+    """Light arriving from every direction with the same radiance (the sky of a white furnace): in nits (cd/m^2,
+    the default), or with ``unit`` "ev" the sky's colour scaled so that its luminance is an EV100, the sky's
+    luminance then being (12.5 / 100) 2^EV cd/m^2 (scene/light_units.py)."""
 
     type_name: ClassVar[str] = "constant"
-    radiance: RGB = field(default=(0.0, 0.0, 0.0), metadata={"range": (0.0, 1e6)})
+    radiance: RGB = field(default=(0.0, 0.0, 0.0), metadata={"range": (0.0, 1e6),
+                                                             "doc": "cd/m^2 (nits) per channel, or an EV: see unit"})
+    unit: str = field(default="nits", metadata={
+        "choices": ("nits", "ev"),
+        "doc": "what radiance's luminance gives: nits (cd/m^2), or an EV100 (luminance 0.125 x 2^EV cd/m^2)"})
 
 
 @dataclass
@@ -77,12 +83,25 @@ class EnvironmentMap(Environment):
     In its own frame the image's centre column looks down -Z and its top row straight up (+Y). ``rotation_deg``
     turns the panorama about that vertical axis (clockwise seen from above: the centre column moves towards +X),
     then ``zenith`` tilts it, by the shortest turn that takes +Y to ``zenith``: any orientation is one pair of
-    the two (:meth:`world_from_map`, :func:`environment_orientation`). ``strength`` scales the radiance.
+    the two (:meth:`world_from_map`, :func:`environment_orientation`).
+
+    ``strength`` sets the radiance as ``unit`` says (scene/light_units.py): ``scale``, the default, multiplies
+    the image's values (nits: a scene in arbitrary units, a Mitsuba import); ``nits`` is the map's mean luminance
+    over the sphere in cd/m^2, the image scaled to have it; ``ev`` the same as an EV100, (12.5 / 100) 2^EV
+    cd/m^2. Only an EV may be negative.
     """
 
     type_name: ClassVar[str] = "map"
     file: str = field(default="", metadata={"required": True, "doc": "lat-long image, relative to the scene"})
-    strength: float = field(default=1.0, metadata={"range": (0.0, 1e6)})
+    # An EV may be negative (a night sky is EV -3): the range holds it, and a negative scale or nits are refused
+    # by unit (light_units.check_environment_map). EV -64 is far darker than starlight (EV -6).
+    strength: float = field(default=1.0, metadata={
+        "range": (-64.0, 1e6),
+        "doc": "multiplies the image (unit scale), its mean luminance in cd/m^2 (nits), or that as an EV100 (ev)"})
+    unit: str = field(default="scale", metadata={
+        "choices": ("scale", "nits", "ev"),
+        "doc": "what strength gives: a scale of the image's values, the map's mean luminance over the sphere in "
+               "nits (cd/m^2), or that luminance as an EV100"})
     rotation_deg: float = field(default=0.0, metadata={"range": (-360.0, 360.0)})
     rows: str = field(default="centred", metadata={
         "choices": ("centred", "pole_to_pole"),

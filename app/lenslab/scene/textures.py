@@ -23,6 +23,8 @@ from typing import ClassVar
 
 import numpy as np
 
+from lenslab.colour_management.texture_spaces import KEYWORDS, colour_space_problem
+
 RGB = tuple[float, float, float]
 
 UV_LIMIT = 1e6  # beyond any real repeat count or offset; keeps (s, t) well inside float32's exact integers
@@ -113,8 +115,11 @@ def _tidied(fields: dict, matrix: np.ndarray) -> dict:
 class ImageTexture(Texture):
     type_name: ClassVar[str] = "image"
     file: str = field(default="", metadata={"required": True, "doc": "PNG, JPEG, EXR, HDR...; relative to the scene"})
-    color_space: str = field(default="auto", metadata={"choices": ("auto", "srgb", "linear"),
-                                                        "doc": "auto: 8/16-bit files are sRGB, float files linear"})
+    # Not "choices": any colour space of the OCIO config is a value too, so the reader asks "check" instead.
+    color_space: str = field(default="auto", metadata={
+        "check": colour_space_problem, "suggestions": KEYWORDS,
+        "doc": "auto (8/16-bit files sRGB, float files linear Rec.709; raw in a data slot), srgb, linear (Rec.709), "
+               "raw (data: never converted), or any OCIO colour space's name (docs/colour.md)"})
     tiles: tuple[float, float] = _tiles_field((1.0, 1.0), "repeats per unit uv")
     shear: float = _shear_field()
     rotation_deg: float = _rotation_field()
@@ -138,7 +143,8 @@ class Checkerboard(Texture):
 
 @dataclass(eq=False)
 class InlineImageTexture(Texture):
-    """Pixels that came inside another file (a GLB's embedded images): linear float RGB, (H, W, 3).
+    """Pixels that came inside another file (a GLB's embedded images): float RGB, (H, W, 3), linear Rec.709 unless
+    ``color_space`` says otherwise.
 
     Not written to scene files: it is re-read from the mesh file that holds it whenever the scene loads.
     """
@@ -146,6 +152,7 @@ class InlineImageTexture(Texture):
     type_name: ClassVar[str] = "inline_image"
     pixels: object = None  # numpy array; `object` keeps the scene format's reader away from it
     name: str = ""
+    color_space: str = "linear"  # as ImageTexture's; "raw" for pixels already in the working space
     tiles: tuple[float, float] = (1.0, 1.0)
     shear: float = 0.0
     rotation_deg: float = 0.0

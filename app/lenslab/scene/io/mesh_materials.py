@@ -24,7 +24,9 @@ Ns (the Blinn-Phong exponent) becomes roughness through Walter et al. 2007's Bec
 alpha = sqrt(2 / (Ns + 2)) and our perceptual roughness r = sqrt(alpha): Ns 1000 -> 0.21, 100 -> 0.38,
 10 -> 0.64, 0 -> 1. Ks says only whether there is a coating; its strength is the coating's Fresnel term.
 map_Kd is an ImageTexture on the file on disk, relative to the MTL (``-s`` becomes tiles); as with Blender,
-the map replaces Kd rather than multiplying it. map_Pr is a linear roughness texture.
+the map replaces Kd rather than multiplying it (colour space auto: an 8-bit file sRGB, a float one linear).
+map_Pr is a roughness texture, data, read as stored (raw). A bump or normal map (bump, map_Bump, norm) is ignored,
+with a note; were it read, it would be data too.
 
 glTF 2.0 / GLB. Scalars and extensions are read from the file's own JSON (trimesh drops the KHR extensions);
 trimesh reads the geometry. Images are read through OpenImageIO.
@@ -40,6 +42,9 @@ trimesh reads the geometry. Images are read through OpenImageIO.
 metallic and roughness come from the factors times the metallicRoughness texture's B and G channels; the
 G channel (times roughnessFactor) becomes a roughness texture of its own, B decides the material (its mean
 when it varies, with a warning). A base colour factor other than white is baked into the texture's pixels.
+Colour spaces as glTF 2.0 says: baseColorTexture and emissiveTexture are sRGB (decoded, then linear Rec.709, as the
+factors are); metallicRoughnessTexture is data, read as stored (raw); normalTexture and occlusionTexture, data too,
+are ignored with a note.
 """
 
 from __future__ import annotations
@@ -566,7 +571,7 @@ class ObjMaterials:
         pr, pm = number("pr"), number("pm")
         roughness = _unit(pr) if pr is not None else roughness_from_phong(number("ns", 0.0))
         albedo_texture = self._texture(keys, "map_kd", folder, note, "auto")
-        roughness_texture = self._texture(keys, "map_pr", folder, note, "linear")
+        roughness_texture = self._texture(keys, "map_pr", folder, note, "raw")  # data: values as stored
 
         if max(ke) > 0.0:
             # A lamp's diffuser reflects as well as glows (as in Blender, where Ke adds to the surface).
@@ -887,7 +892,7 @@ class GltfMaterials:
                 g, b = rgb[..., 1] * roughness, rgb[..., 2] * metallic
                 if np.ptp(g) > 1.0 / 255.0:
                     pixels = np.repeat(g[..., None], 3, axis=2).astype(np.float32)
-                    roughness_texture = InlineImageTexture(pixels=pixels, name=self._image_label(
+                    roughness_texture = InlineImageTexture(pixels=pixels, color_space="raw", name=self._image_label(
                         pbr["metallicRoughnessTexture"], "roughness"))
                 roughness = _unit(float(g.mean()))
                 metal_varies = bool(np.ptp(b) > 1.0 / 255.0)
@@ -1050,13 +1055,13 @@ class GltfMaterials:
         return self._textures[key]
 
     def _data_texture(self, info: dict, role: str, note) -> np.ndarray | Texture | None:
-        """Linear channels of a data texture; for a missing file an ImageTexture on it (the placeholder)."""
+        """The channels of a data texture as stored; for a missing file an ImageTexture on it (the placeholder)."""
         image_index = self._texture_image(info, role, note)
         if image_index is None:
             return None
         missing = self._missing(image_index, role, note)
         if missing is not None:
-            return ImageTexture(file=str(missing), color_space="linear")
+            return ImageTexture(file=str(missing), color_space="raw")
         try:
             return self._image_pixels(image_index)
         except OSError as exc:

@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from lenslab.image_files import not_found
+from lenslab.image_files import holds_floats, not_found
 from lenslab.limits import LARGEST_NUMBER
 from lenslab.scene.materials import Material
 from lenslab.scene.shapes import Cylinder
@@ -86,9 +86,11 @@ def _choice(p: "Props", name: str, default: str) -> str:
 
 
 def read_bitmap(imp: "MitsubaImporter", node: "XNode") -> ImageTexture:
-    """Mitsuba's bitmap: ``raw`` false reads 8- and 16-bit files as sRGB and float files as linear, as our
-    "auto"; raw true reads every file as linear. A file that is not there is LensLab's usual magenta
-    checkerboard at render time, warned here with the scene file's line (Mitsuba refuses the scene)."""
+    """Mitsuba's bitmap: ``raw`` true reads the file's values as stored ("raw"); raw false decodes 8- and 16-bit
+    files as sRGB and reads float files as linear, in whatever slot the bitmap sits (a mask's opacity included),
+    so it becomes an explicit "srgb" or "linear" (:func:`bitmap_colour_space`). A file that is not there is
+    LensLab's usual magenta checkerboard at render time, warned here with the scene file's line (Mitsuba refuses
+    the scene)."""
     p = _props(imp, node)
     filename = p.string("filename")
     raw = p.bool("raw", False)
@@ -103,8 +105,18 @@ def read_bitmap(imp: "MitsubaImporter", node: "XNode") -> ImageTexture:
     path = imp.resolve_file(node, filename)
     if not os.path.isfile(path):
         imp.warn(node, f"{not_found('texture file', path)}; LensLab shows a magenta checkerboard in its place")
-    return ImageTexture(file=imp.scene_relative_path(path), color_space="linear" if raw else "auto", wrap=wrap_mode,
-                        filter=filter_type, **_texture_fields(imp, node, matrix))
+    return ImageTexture(file=imp.scene_relative_path(path), color_space=bitmap_colour_space(path, raw),
+                        wrap=wrap_mode, filter=filter_type, **_texture_fields(imp, node, matrix))
+
+
+def bitmap_colour_space(path: str | os.PathLike, raw: bool) -> str:
+    """The colour space that reads a bitmap as Mitsuba does. Not "auto" for raw false: in a data slot "auto" means
+    raw, and Mitsuba decodes an 8-bit file's sRGB curve there too. "auto" only for a file whose header cannot be
+    read (it shows as the magenta checkerboard in any case)."""
+    if raw:
+        return "raw"
+    floats = holds_floats(path)
+    return "auto" if floats is None else ("linear" if floats else "srgb")
 
 
 def _unit_colour(imp: "MitsubaImporter", p: "Props", name: str, default: float) -> RGB:
@@ -151,7 +163,7 @@ def mean_colour(imp: "MitsubaImporter", node: "XNode", texture: Texture | None) 
     if isinstance(texture, Checkerboard):
         return tuple((a + b) / 2 for a, b in zip(texture.color_a, texture.color_b))  # type: ignore[return-value]
     if isinstance(texture, ImageTexture):
-        from lenslab.color import srgb_to_linear
+        from lenslab.colour_management.texture_spaces import to_working_space
         from lenslab.image_files import read_pixels
 
         path = imp.resolve_file(node, texture.file)
@@ -160,8 +172,7 @@ def mean_colour(imp: "MitsubaImporter", node: "XNode", texture: Texture | None) 
         except (OSError, ValueError):
             return None
         rgb = pixels[..., :3] if pixels.shape[2] >= 3 else np.repeat(pixels[..., :1], 3, axis=2)
-        if texture.color_space == "srgb" or (texture.color_space == "auto" and not is_float):
-            rgb = srgb_to_linear(rgb)
+        rgb = to_working_space(rgb, texture.color_space, is_float)  # a Mitsuba scene's colours are linear Rec.709
         return tuple(float(v) for v in rgb.reshape(-1, 3).mean(axis=0))  # type: ignore[return-value]
     return None
 

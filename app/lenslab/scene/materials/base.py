@@ -47,7 +47,9 @@ class PackContext(Protocol):
     provides it): texture records and float tables in the texture table, and the Fresnel tables of a rough
     coating (render/fresnel.py). Packing itself stays plain numpy."""
 
-    def index_of(self, texture: Any) -> int: ...  # a texture's record, -1 for None
+    # A texture's record, -1 for None. ``data``: the slot holds numbers (roughness, normals, heights, opacity, a
+    # weight), read as stored; else a colour, read into the working space (colour_management/texture_spaces.py).
+    def index_of(self, texture: Any, data: bool = False) -> int: ...
 
     def add_floats(self, values: Any) -> int: ...  # floats appended to image_data: their offset
 

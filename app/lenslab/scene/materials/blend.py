@@ -34,7 +34,7 @@ class Blend(Material):
 def pack(material: Blend, record: np.ndarray, ctx: PackContext) -> None:
     """Row 0 (weight, its texture, 0); row 2 the two records it holds."""
     record[0, 0] = material.weight
-    record[0, 1] = ctx.index_of(material.weight_texture)
+    record[0, 1] = ctx.index_of(material.weight_texture, data=True)
     record[0, 2] = 0.0
 
 

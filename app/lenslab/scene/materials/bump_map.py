@@ -34,7 +34,7 @@ class BumpMap(Material):
 def pack(material: BumpMap, record: np.ndarray, ctx: PackContext) -> None:
     """Row 0 (scale, height texture, shadowing); row 2, x the record it holds."""
     record[0, 0] = material.scale
-    record[0, 1] = ctx.index_of(material.texture)
+    record[0, 1] = ctx.index_of(material.texture, data=True)
     record[0, 2] = float(material.shadowing)
 
 

@@ -46,7 +46,7 @@ class Conductor(Material):
 
 def pack(material: Conductor, record: np.ndarray, ctx: PackContext) -> None:
     """Rows 2, 3 and 4: eta, k and tint; row 4, w the roughness texture."""
-    record[4, 3] = ctx.index_of(material.roughness_texture)
+    record[4, 3] = ctx.index_of(material.roughness_texture, data=True)
     eta, k = material.complex_ior()
     record[2, :3], record[3, :3], record[4, :3] = eta, k, material.tint
 

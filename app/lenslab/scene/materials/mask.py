@@ -32,7 +32,7 @@ class Mask(Material):
 def pack(material: Mask, record: np.ndarray, ctx: PackContext) -> None:
     """Row 0 (opacity, its texture, 0); row 2, x the record it holds."""
     record[0, 0] = material.opacity
-    record[0, 1] = ctx.index_of(material.opacity_texture)
+    record[0, 1] = ctx.index_of(material.opacity_texture, data=True)
     record[0, 2] = 0.0
 
 

@@ -25,7 +25,7 @@ class NormalMap(Material):
 
     type_name: ClassVar[str] = "normal_map"
     material: Material = field(default_factory=Diffuse)
-    texture: Texture | None = field(default=None, metadata={"doc": "read as linear: set its colour space to linear"})
+    texture: Texture | None = field(default=None, metadata={"doc": "data: read as stored (color_space auto or raw)"})
     shadowing: bool = field(default=True, metadata={
         "doc": "soften the hard shadow line tilted normals leave (Estevez et al. 2019; Mitsuba's default)"})
 
@@ -33,7 +33,7 @@ class NormalMap(Material):
 def pack(material: NormalMap, record: np.ndarray, ctx: PackContext) -> None:
     """Row 0 (0, normal texture, shadowing); row 2, x the record it holds."""
     record[0, 0] = 0.0
-    record[0, 1] = ctx.index_of(material.texture)
+    record[0, 1] = ctx.index_of(material.texture, data=True)
     record[0, 2] = float(material.shadowing)
 
 

@@ -39,7 +39,7 @@ def pack(material: Plastic, record: np.ndarray, ctx: PackContext) -> None:
     internal diffuse reflectance and, when rough, the offset of its transmittance table in image_data."""
     record[0, :3] = material.albedo
     record[3, 3] = ctx.index_of(material.albedo_texture)
-    record[4, 3] = ctx.index_of(material.roughness_texture)
+    record[4, 3] = ctx.index_of(material.roughness_texture, data=True)
     fresnel = ctx.fresnel
     alpha = float(record[2, 3])
     record[2, 0] = material.ior
