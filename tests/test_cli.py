@@ -444,7 +444,8 @@ def test_each_camera_flag_reaches_the_camera(tmp_path, monkeypatch):
 
 @pytest.mark.parametrize("argv, mode", [(["--iso", "400"], "physical"), (["--shutter", "1/60"], "physical"),
                                         (["--iso", "400", "--exposure-mode", "compensated"], "compensated"),
-                                        ([], "compensated")])
+                                        (["--exposure-mode", "compensated"], "compensated"),
+                                        ([], "physical")])  # the scene's own: the Cornell box is shot physically
 def test_an_iso_or_a_shutter_switches_to_a_physical_exposure(argv, mode):
     assert _camera(*argv).exposure_mode == mode
 

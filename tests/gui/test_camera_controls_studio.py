@@ -109,8 +109,8 @@ def test_a_missing_aperture_image_keeps_the_stop_and_says_why(window, tmp_path):
 
 
 def test_physical_exposure_darkens_the_picture_a_stop_per_stop(window, qtbot):
-    window.viewport.set_display(exposure=0.0, operator="clamp")
-    window.controller.set_display(0.0, "clamp")
+    window.set_display_exposure(0.0)
+    window.display.set_view("clamp")  # the old name: the Un-tone-mapped view, linear up to the display's white
 
     def picture(f_number: float, mode: str) -> np.ndarray:
         window.doc.set_camera("test", False, f_number=f_number, exposure_mode=mode, iso=100.0, shutter_s=4.0)

@@ -138,3 +138,14 @@ def test_changing_a_shapes_type_keeps_its_extent_and_its_colour():
     assert convert_type(Sphere(radius=0.25), Box) == Box(size=(0.5, 0.5, 0.5))
     assert convert_type(Sphere(radius=0.25), Rectangle) == Rectangle(size=(0.5, 0.5))
     assert convert_type(Diffuse((0.8, 0.1, 0.1)), Emissive).radiance == (0.8, 0.1, 0.1)
+
+
+def test_changing_an_emitters_type_keeps_its_unit_only_where_the_new_type_has_it():
+    from lenslab.gui.properties import convert_type
+    from lenslab.scene.lights import PointLight, SpotLight
+    from lenslab.scene.scene import ConstantEnvironment, EnvironmentMap
+
+    assert convert_type(PointLight("bulb", unit="lumens"), SpotLight).unit == "lumens"
+    assert convert_type(EnvironmentMap(file="sky.exr", unit="ev"), ConstantEnvironment).unit == "ev"
+    # A map's plain scale is no unit a constant sky has: the new sky takes its own default.
+    assert convert_type(EnvironmentMap(file="sky.exr"), ConstantEnvironment).unit == "nits"

@@ -13,7 +13,7 @@ pytest.importorskip("pyoidn")
 def test_the_denoise_checkbox_is_off_by_default_and_reaches_the_request(window, tmp_path):
     from lenslab.gui.export_dialog import ExportDialog
 
-    dialog = ExportDialog(window.doc, exposure=0.0, tone_map="filmic", samples_per_second=1e5)
+    dialog = ExportDialog(window.doc, window.viewport.view, samples_per_second=1e5)
     dialog.path_edit.setText(str(tmp_path / "a.exr"))
     assert not dialog.denoise_check.isChecked()
     assert dialog.request().denoise is False  # never denoised unless asked

@@ -135,7 +135,7 @@ def test_the_export_dialog_refuses_such_a_folder_and_stays_open(window, tmp_path
     folder = tmp_path / "locked"
     folder.mkdir()
     refuse_files_in(monkeypatch, folder)
-    dialog = ExportDialog(window.doc, exposure=0.0, tone_map="filmic")
+    dialog = ExportDialog(window.doc, window.viewport.view)
     dialog.path_edit.setText(str(folder / "shot.png"))
     dialog.accept()  # refused, with the reason under the settings: the path can be fixed in place
     assert dialog.result() != ExportDialog.Accepted

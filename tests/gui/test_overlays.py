@@ -55,7 +55,7 @@ def keep():
 
 def show_picture(viewport, picture: np.ndarray, depth: np.ndarray | None = None, linear=None):
     """Put a picture (RGBA8) and, if given, a depth buffer in the viewport, as the render worker would."""
-    viewport.set_frame(picture, (viewport.exposure, viewport.tone_map), linear)
+    viewport.set_frame(picture, viewport.view, linear)
     if depth is not None:
         viewport.set_gbuffer(SimpleNamespace(depth=depth, node_index=np.full(depth.shape, -1, np.int32),
                                              generation=0))
@@ -345,8 +345,8 @@ def test_overexposing_lights_the_highlight_warning_and_the_dock_agrees(qtbot, ma
     aids, panel = window.viewing, window.viewing.histogram_panel
     assert window.docks["histogram"].isVisible() and panel.isVisible()
     wait_for_frame(qtbot, window, min_spp=4)
-    window.tone_combo.setCurrentIndex(window.tone_combo.findData("clamp"))
-    window.set_display_exposure(4.0)  # display only: the linear picture is tone-mapped again at once
+    window.display.set_view("Un-tone-mapped")  # the view that clips (an ACES view rolls highlights off)
+    window.set_display_exposure(4.0)  # display only: the linear picture is made again at once
     qtbot.waitUntil(lambda: panel.histogram is not None and panel.histogram.clipped_any > 0.3, timeout=5000)
     aids.actions["clipping"].trigger()
     expected, _ = clipping_masks(qimage_to_array(window.viewport.qimage))

@@ -1,7 +1,7 @@
 """Snapshots and A/B comparison: keep a render at f/1.4 and compare it with the live one at f/4,
 with a split wipe or side by side.
 
-The store's rules (the cap, the labels, the re-tone-mapping) are checked without a window; the rest drives the
+The store's rules (the cap, the labels, the picture made again through another view) are checked without a window; the rest drives the
 studio offscreen. Pixel checks compare a grab of the viewport with the two pictures at 400 %, where the viewport
 draws pixels as they are (no smoothing), so that each screen pixel is one picture pixel exactly.
 """
@@ -9,25 +9,28 @@ draws pixels as they are (no smoothing), so that each screen pixel is one pictur
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 import pytest
 from PySide6.QtCore import QPoint, QPointF, Qt
 
+from lenslab.colour_management.view import ViewTransform
 from lenslab.gui.snapshots import SnapshotStore, camera_label, compare_tags
-from lenslab.render.film import to_8bit, tone_map
+from lenslab.render.film import display_pixels, to_8bit
 from lenslab.scene.camera import ThinLensCamera
 
 from .helpers import hover, press_drag_release, wait_for_frame, wait_for_gbuffer
 
 ZOOM = 4.0
+ACES = ViewTransform().resolved()  # the built-in config's default view (the old "filmic")
 
 
 def picture(h=6, w=8, value=0.5):
     rng = np.random.default_rng(int(value * 1000))
     linear = rng.uniform(0, 2 * value, (h, w, 3)).astype(np.float32)
     rgba = np.empty((h, w, 4), np.uint8)
-    rgba[..., :3] = to_8bit(tone_map(linear, 0.0, "filmic"))
+    rgba[..., :3] = to_8bit(display_pixels(linear, ACES))
     rgba[..., 3] = 255
     return rgba, linear
 
@@ -41,7 +44,7 @@ def test_the_cap_evicts_the_oldest_and_the_newest_is_a():
     taken = []
     for i in range(5):
         rgba, linear = picture(value=0.1 * (i + 1))
-        taken.append(store.take(rgba, (0.0, "filmic"), linear, dataclasses.replace(camera, f_number=2.0 + i), None, 16))
+        taken.append(store.take(rgba, ACES, linear, dataclasses.replace(camera, f_number=2.0 + i), None, 16))
     assert [s.id for s in store.snapshots] == [taken[2].id, taken[3].id, taken[4].id]
     assert store.a is taken[4] and "snapshots" in seen and "a" in seen
     # The camera is a copy: editing the scene's later does not change what the snapshot remembers.
@@ -56,7 +59,7 @@ def test_the_cap_evicts_the_oldest_and_the_newest_is_a():
     small = SnapshotStore(max_count=12, max_bytes=int(2.5 * each))
     rgba, linear = picture()
     for _ in range(4):
-        small.take(rgba, (0.0, "filmic"), linear, camera)
+        small.take(rgba, ACES, linear, camera)
     assert len(small.snapshots) == 2 and small.nbytes == 2 * each
     assert [s.id for s in small.snapshots] == [3, 4]
 
@@ -66,7 +69,7 @@ def test_labels_name_what_a_photographer_reads():
     assert camera_label(camera, 256) == "50 mm f/1.4, focus 2.10 m, 256 spp"
     store = SnapshotStore()
     rgba, linear = picture()
-    snapshot = store.take(rgba, (0.0, "filmic"), linear, camera, None, 256)
+    snapshot = store.take(rgba, ACES, linear, camera, None, 256)
     assert snapshot.label == "50 mm f/1.4, focus 2.10 m, 256 spp"
     live = dataclasses.replace(camera, f_number=4.0)
     assert compare_tags(snapshot, live) == ("A: f/1.4", "B: live f/4")
@@ -79,17 +82,22 @@ def test_labels_name_what_a_photographer_reads():
     assert snapshot.label == snapshot.auto_label
 
 
-def test_a_snapshot_is_re_tone_mapped_for_a_new_look():
+def test_a_snapshot_is_made_again_through_a_new_view():
     rgba, linear = picture(value=0.7)
     store = SnapshotStore()
-    snapshot = store.take(rgba, (0.0, "filmic"), linear, ThinLensCamera())
-    assert snapshot.picture(0.0, "filmic") is snapshot.display  # its own look: the picture as it was shown
-    brighter = snapshot.picture(1.5, "reinhard")
-    assert np.array_equal(brighter[..., :3], to_8bit(tone_map(linear, 1.5, "reinhard")))
+    snapshot = store.take(rgba, ACES, linear, ThinLensCamera())
+    assert snapshot.picture(ACES) is snapshot.display  # its own view: the picture as it was shown
+    other = ViewTransform(view="Un-tone-mapped", exposure_stops=1.5).resolved()
+    brighter = snapshot.picture(other)
+    assert np.array_equal(brighter[..., :3], to_8bit(display_pixels(linear, other)))
     assert (brighter[..., 3] == 255).all() and not np.array_equal(brighter, rgba)
+    # A snapshot keeps its camera's exposure: its radiance is scaled by it, through any view.
+    dim = store.take(rgba, ACES, linear, ThinLensCamera(), exposure_scale=0.25)
+    assert np.array_equal(dim.picture(other)[..., :3],
+                          to_8bit(display_pixels(linear, ViewTransform(view="Un-tone-mapped", exposure_stops=-0.5))))
     # Without radiance (a picture of another size than the radiance at hand) it stays as it was shown.
-    flat = store.take(rgba, (0.0, "filmic"), linear[:3], ThinLensCamera())
-    assert flat.linear is None and flat.picture(1.5, "reinhard") is flat.display
+    flat = store.take(rgba, ACES, linear[:3], ThinLensCamera())
+    assert flat.linear is None and flat.picture(other) is flat.display
 
 
 def test_compare_modes_and_the_quick_toggle():
@@ -97,7 +105,7 @@ def test_compare_modes_and_the_quick_toggle():
     assert store.view == "off"
     store.set_mode("wipe")
     assert store.view == "off"  # nothing to compare with yet
-    store.take(picture()[0], (0.0, "filmic"), None, ThinLensCamera())
+    store.take(picture()[0], ACES, None, ThinLensCamera())
     assert store.view == "wipe"
     store.toggle_a()
     assert store.view == "a" and store.show_a
@@ -357,9 +365,11 @@ def test_a_snapshot_follows_the_viewports_look(qtbot, window):
     comparison = window.snapshots.comparison
     window.snapshots.store.set_mode("wipe")
     window.exposure_slider.setValue(15)
-    window.tone_combo.setCurrentIndex(window.tone_combo.findData("reinhard"))
+    window.display.set_view("Un-tone-mapped")
     a = comparison.a_image()
-    expected = to_8bit(tone_map(snapshot.linear, 1.5, "reinhard"))
+    view = window.viewport.view  # with the snapshot's own camera exposure
+    made = dataclasses.replace(view, exposure_stops=view.exposure_stops + math.log2(snapshot.exposure_scale))
+    expected = to_8bit(display_pixels(snapshot.linear, made))
     w, h = snapshot.size
     for x, y in ((0, 0), (w // 2, h // 2), (w - 1, h - 1)):
         assert tuple(rgb(a, x, y)) == tuple(int(c) for c in expected[y, x])

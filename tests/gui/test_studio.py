@@ -9,6 +9,7 @@ cleanly while rendering.
 from __future__ import annotations
 
 import copy
+import dataclasses
 import math
 from pathlib import Path
 
@@ -77,24 +78,30 @@ def test_choosing_f28_sets_the_f_number_and_restarts_accumulation(qtbot, window)
 
 
 # -- the look on screen ----------------------------------------------------------------------------------------
-def test_the_worker_tone_maps_each_picture_with_the_viewports_look(qtbot, window):
+def test_the_worker_makes_each_picture_through_the_viewports_view(qtbot, window):
     import numpy as np
 
-    from lenslab.render.film import to_8bit, tone_map
+    from lenslab.render.film import display_pixels, to_8bit
 
     window.controller.set_target_spp(6)
     # Frames of the render that began before the new target may come first: wait for the finished one.
     qtbot.waitUntil(lambda: window.controller.last_frame is not None and window.controller.last_frame.converged,
                     timeout=20000)
     first = window.controller.last_frame
-    assert first.samples_per_pixel >= 6 and first.display_settings == (window.viewport.exposure, window.viewport.tone_map)
-    # A finished render makes no more frames by itself: a new look must still reach the screen, from the GPU.
+    assert first.samples_per_pixel >= 6 and first.view == window.viewport.view
+    # A finished render makes no more frames by itself: a new view must still reach the screen, from the GPU.
     window.exposure_slider.setValue(20)
-    window.tone_combo.setCurrentIndex(window.tone_combo.findData("reinhard"))
-    qtbot.waitUntil(lambda: window.controller.last_frame.display_settings == (2.0, "reinhard"), timeout=5000)
+    window.display.set_view("Un-tone-mapped")
+    qtbot.waitUntil(lambda: window.controller.last_frame.view == window.display.view, timeout=5000)
     frame = window.controller.last_frame
+    assert (frame.view.view, frame.view.exposure_stops) == ("Un-tone-mapped", 2.0)
     assert frame.samples_per_pixel == first.samples_per_pixel and frame.image is not None  # no new samples
-    expected = to_8bit(tone_map(frame.image, 2.0, "reinhard"))
+    # OCIO's CPU processor and its GLSL on the GPU agree within a level; the camera's exposure (the Cornell box is
+    # exposed physically) goes into the transform's exposure.
+    camera_stops = math.log2(frame.exposure.scale)
+    made = dataclasses.replace(frame.view, exposure_stops=frame.view.exposure_stops + camera_stops)
+    assert window.viewport.picture_view() == made
+    expected = to_8bit(display_pixels(frame.image, made))
     difference = np.abs(frame.display[..., :3].astype(int) - expected.astype(int))
     assert difference.max() <= 1 and (frame.display[..., 3] == 255).all()
     assert not np.array_equal(frame.display[..., :3], first.display[..., :3])
@@ -107,15 +114,18 @@ def test_the_worker_tone_maps_each_picture_with_the_viewports_look(qtbot, window
 
 def test_a_look_saved_by_hand_or_by_another_version_falls_back_to_the_default(qtbot, make_window, settings,
                                                                               small_scene):
+    from lenslab.colour_management.view import ViewTransform
+
     settings.setValue("viewport/exposure", "bright")
     settings.setValue("viewport/tone_map", "aces")  # not one of ours
     window = make_window(small_scene)
-    assert (window.viewport.exposure, window.viewport.tone_map) == (0.0, "filmic")
-    assert wait_for_frame(qtbot, window).display_settings == (0.0, "filmic")  # the worker renders on
+    default = ViewTransform().resolved()
+    assert window.viewport.view.view == default.view and window.viewport.exposure == 0.0
+    assert wait_for_frame(qtbot, window).view == window.viewport.view  # the worker renders on
     settings.setValue("viewport/exposure", 40.0)  # beyond the slider's six stops
     assert make_window(small_scene).viewport.exposure == 6.0
-    with pytest.raises(ValueError, match="unknown tone map 'aces'"):
-        window.controller.set_display(0.0, "aces")
+    with pytest.raises(ValueError, match="view 'aces' is not one of display"):
+        window.controller.set_display(ViewTransform(view="aces"))
 
 
 # -- lens presets ----------------------------------------------------------------------------------------------
@@ -325,7 +335,7 @@ def test_export_writes_a_valid_file_and_cancelling_writes_none(qtbot, window, tm
 
     png = tmp_path / "shot.png"
     with qtbot.waitSignal(window.controller.export_finished, timeout=30000):
-        window.start_export(export_request(window, png, seconds=0.3, tone_map="filmic"))
+        window.start_export(export_request(window, png, seconds=0.3, view=window.viewport.view))
     assert read_image(png)[0].shape == (24, 32, 3)
 
     cancelled = tmp_path / "cancelled.png"
@@ -341,7 +351,10 @@ def test_export_writes_a_valid_file_and_cancelling_writes_none(qtbot, window, tm
 def test_export_dialog_builds_the_request(window, tmp_path):
     from lenslab.gui.export_dialog import ExportDialog
 
-    dialog = ExportDialog(window.doc, exposure=0.5, tone_map="reinhard", samples_per_second=1e5)
+    from lenslab.colour_management.view import ViewTransform
+
+    dialog = ExportDialog(window.doc, ViewTransform(view="clamp", exposure_stops=0.5), samples_per_second=1e5)
+    assert dialog.view_combo.currentText() == "Un-tone-mapped" and dialog.exposure_spin.value() == 0.5
     dialog.path_edit.setText(str(tmp_path / "a.png"))
     dialog.format_combo.setCurrentIndex(0)  # EXR
     assert dialog.path_edit.text().endswith("a.exr")
@@ -479,6 +492,22 @@ def test_point_lights_and_suns_are_in_the_outliner_editable_and_undoable(qtbot, 
     assert doc.selection == [("light", 1)] and window.properties.title.text() == "point light"
     doc.undo_stack.undo()
     assert len(doc.scene.lights) == 1
+
+
+def test_a_lights_unit_is_a_menu_in_the_property_editor(qtbot, window):
+    """The Cornell box's ceiling light is in lumens: its unit is offered beside its colour, and a change re-renders
+    and undoes (docs/colour.md, "Light units")."""
+    doc = window.doc
+    wait_for_frame(qtbot, window)
+    doc.set_selection([("material", "light")])
+    unit = window.properties._editors[("unit",)].widget
+    assert [unit.itemText(i) for i in range(unit.count())] == ["nits", "lumens"] and unit.currentText() == "lumens"
+    generation = window.controller.generation
+    unit.setCurrentText("nits")
+    assert doc.scene.materials["light"].unit == "nits" and window.controller.generation > generation
+    doc.undo_stack.undo()
+    assert doc.scene.materials["light"].unit == "lumens"
+    wait_for_frame(qtbot, window, generation=window.controller.generation)
 
 
 # -- a million triangles -----------------------------------------------------------------------------------------

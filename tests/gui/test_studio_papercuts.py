@@ -302,7 +302,7 @@ def test_file_dialogs_start_in_the_folder_used_last_even_after_a_restart(qtbot, 
         Accepted = QDialog.Accepted
         started_at = []
 
-        def __init__(self, doc, exposure, tone_map, rate, last_path, parent):
+        def __init__(self, doc, view, rate, last_path, parent):
             Dialog.started_at.append(last_path)
             self.doc = doc
 
@@ -312,8 +312,7 @@ def test_file_dialogs_start_in_the_folder_used_last_even_after_a_restart(qtbot, 
         def request(self):
             scene = copy_scene(self.doc.scene)
             scene.camera = dataclasses.replace(scene.camera, resolution=(16, 12))
-            return ExportRequest(scene=scene, path=images / "shot.png", target_spp=1, seconds=None,
-                                 exposure_stops=0.0, tone_map="filmic")
+            return ExportRequest(scene=scene, path=images / "shot.png", target_spp=1, seconds=None)
 
     monkeypatch.setattr(window.export_flow, "make_dialog", Dialog)  # the export flow's dialog
 
@@ -350,7 +349,7 @@ def test_the_display_exposure_can_be_typed_stepped_and_reset(qtbot, window):
     QTest.keyClicks(spin, "1.5")
     QTest.keyClick(spin, Qt.Key_Return)
     assert window.viewport.exposure == 1.5 and slider.value() == 15 and spin.text() == "+1.5 EV"
-    qtbot.waitUntil(lambda: window.controller.last_frame.display_settings[0] == 1.5, timeout=10000)
+    qtbot.waitUntil(lambda: window.controller.last_frame.view.exposure_stops == 1.5, timeout=10000)
     QTest.keyClick(spin, Qt.Key_Up)
     assert window.viewport.exposure == pytest.approx(1.6) and slider.value() == 16
     slider.setValue(-23)

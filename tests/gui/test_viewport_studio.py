@@ -145,7 +145,7 @@ def test_the_denoised_preview_is_on_by_default_and_one_toggle(make_window, small
     # Another display exposure shows the same denoised image anew (no second denoise needed): brighter.
     before = window.controller.last_frame
     window.set_display_exposure(1.0)
-    qtbot.waitUntil(lambda: window.controller.last_frame.display_settings[0] == 1.0, timeout=20000)
+    qtbot.waitUntil(lambda: window.controller.last_frame.view.exposure_stops == 1.0, timeout=20000)
     after = window.controller.last_frame
     assert after.denoised
     assert after.display[..., :3].astype(float).mean() > before.display[..., :3].astype(float).mean() + 5

@@ -126,8 +126,7 @@ def test_pausing_or_starting_an_export_republishes_the_picture_with_its_linear_i
     loop.handle([Pause(True), Pause(False)])  # already paused: nothing new to show
     assert loop.republished == [True]
 
-    request = ExportRequest(scene=Scene(), path="shot.exr", target_spp=4, seconds=None, exposure_stops=0.0,
-                            tone_map="filmic")
+    request = ExportRequest(scene=Scene(), path="shot.exr", target_spp=4, seconds=None)
     loop.handle([ExportStart(1, request)])
     assert loop.republished == [True, True]
     loop.refuse_exports = True  # the second one fails

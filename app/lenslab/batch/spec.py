@@ -35,7 +35,7 @@ from pathlib import Path
 from lenslab.atomic import check_output_file
 from lenslab.image_files import read_file_bytes
 from lenslab.limits import LARGEST_NUMBER
-from lenslab.render.film import EXPORT_SUFFIXES
+from lenslab.render.film import EXPORT_SUFFIXES, EXPORT_SUFFIXES_TEXT
 from lenslab.colour_management.view import ViewTransform
 from lenslab.scene.options import OLD_NAMES, OPTIONS, SCENE_OPTIONS
 from lenslab.scene.overrides import SceneOverrides
@@ -304,7 +304,7 @@ def _describe(values: dict, keys) -> str:
 def _shot(number: int, index: int, values: dict, swept: list[str], folder: Path, where: str) -> Shot:
     output = folder / _output_name(values, index, where)
     if output.suffix.lower() not in EXPORT_SUFFIXES:
-        raise BatchError(f"{where}: output: {output.name} must be an .exr or a .png")
+        raise BatchError(f"{where}: output: {output.name} must be one of {EXPORT_SUFFIXES_TEXT}")
     try:
         check_output_file(output)  # a named pipe or a device node there: never "exists, skipped", never replaced
     except OSError as exc:

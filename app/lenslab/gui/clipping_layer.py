@@ -1,6 +1,8 @@
-"""Clipping warnings over the viewport's picture: clipped highlights (a channel at 255) in red, crushed shadows
-(black: every channel at 0) in blue, of the picture as displayed, after the display exposure and the tone map
-(:mod:`lenslab.optics.histogram` says which pixels), inside the export frame (the pixels the histogram counts).
+"""Clipping warnings over the viewport's picture: clipped highlights (a channel at display code value 255) in red,
+crushed shadows (black: every channel at 0) in blue, of the picture as displayed, the 8-bit code values the chosen
+view transform gives (OpenColorIO's display, view and look after the display exposure and contrast: an Un-tone-mapped
+view clips where an ACES view rolls the highlight off), :mod:`lenslab.optics.histogram` says which pixels, inside the
+export frame (the pixels the histogram counts).
 Worked out again at most four times a second."""
 
 from __future__ import annotations

@@ -87,13 +87,13 @@ class Comparison(QObject):
         v.update()
 
     def a_image(self) -> QImage | None:
-        """A as the viewport's look (exposure, tone map) shows it."""
+        """A through the viewport's view transform (display, view, look, exposure, contrast)."""
         a: Snapshot | None = self.store.a
         if a is None:
             return None
-        key = (a.id, self.viewport.exposure, self.viewport.tone_map)
+        key = (a.id, self.viewport.view)
         if key != self._image_key:
-            self._image = rgba_to_qimage(a.picture(self.viewport.exposure, self.viewport.tone_map))
+            self._image = rgba_to_qimage(a.picture(self.viewport.view))
             self._image_key = key
         return self._image
 

@@ -18,7 +18,6 @@ from PySide6.QtCore import QObject, Signal
 
 from lenslab.gui.document import copy_scene, listen
 from lenslab.gui.worker import VIEWPORT_DISPATCH_SECONDS, ExportRequest, Frame, RenderWorker
-from lenslab.render.film import check_tone_map
 
 #: Viewport resolution: a fraction of the viewport widget's pixels; "auto" (all of them on a GPU, at most
 #: AUTO_LONG_EDGE on the long side on a CPU device such as llvmpipe); or "export", the export's own pixels.
@@ -178,9 +177,15 @@ class RenderController(QObject):
         self.paused = paused
         self.worker.set_paused(paused)
 
-    def set_display(self, exposure: float, tone_map: str) -> None:
-        """The viewport's look: the worker tone-maps its pictures with it (display only, no restart)."""
-        self.worker.set_display(exposure, check_tone_map(tone_map))
+    def set_display(self, view) -> None:
+        """The viewport's view transform (a ViewTransform): the worker makes its pictures through it (display only,
+        no restart). Checked here, so that a name the OCIO config lacks is refused on the GUI's side (a
+        ColourConfigError) rather than stopping the render thread."""
+        self.worker.set_display(view.resolved())
+
+    def set_meter_spot(self, x: float, y: float) -> None:
+        """Where the spot meter reads (fractions of the frame, top left); the picture is read again there."""
+        self.worker.set_meter_spot(x, y)
 
     def restart(self) -> None:
         self.send_scene()

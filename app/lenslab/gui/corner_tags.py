@@ -26,12 +26,16 @@ MIN_LETTERS = 4  # a tag shortened to fewer letters than this is left out: "f/1�
 BACKGROUND = QColor(20, 20, 22, 200)
 
 
-def camera_tag(camera) -> str:
+def camera_tag(camera, exposure=None) -> str:
     """What the camera tag says of a camera: "50 mm · f/1.8 · focus 1.67 m", with the shutter and ISO in the
-    physical exposure mode."""
+    physical exposure mode, and in the auto mode the shutter the meter chose (``exposure``, the picture's:
+    "A 1/250 s", as a camera's aperture-priority mode shows it) and the ISO."""
     text = format_camera_settings(camera.focal_length_mm, camera.f_number, camera.focus_distance_m)
     if camera.exposure_mode == "physical":
         text += f" \u00b7 {format_shutter(camera.shutter_s)} \u00b7 ISO {camera.iso:g}"
+    elif camera.exposure_mode == "auto":
+        shutter = f"A {format_shutter(exposure.shutter_s)}" if exposure is not None else "auto"
+        text += f" \u00b7 {shutter} \u00b7 ISO {camera.iso:g}"
     return text
 
 

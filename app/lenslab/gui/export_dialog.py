@@ -1,5 +1,7 @@
 """File > Export: render the scene to a file at a chosen size, to a sample count or a time limit, written by the
-same writer and with the same metadata as ``lenslab --headless`` (EXR: linear float; PNG: sRGB, tone mapped)."""
+same writer and with the same metadata as ``lenslab --headless`` (EXR: scene-linear float; a picture, PNG, TIFF or
+JPEG: through the view transform, OpenColorIO's display, view and look with an exposure and contrast, the viewport's
+by default)."""
 
 from __future__ import annotations
 
@@ -28,16 +30,20 @@ from PySide6.QtWidgets import (
 )
 
 from lenslab.atomic import check_output_folder
+from lenslab.colour_management.config import load_config
+from lenslab.colour_management.view import CONTRAST_RANGE, EXPOSURE_RANGE, ViewTransform
 from lenslab.gui.controller import rate_text
 from lenslab.gui.document import copy_scene
 from lenslab.gui.worker import ExportRequest
 from lenslab.messages import one_line
-from lenslab.render.film import TONE_MAPS
 from lenslab.scene.camera import MAX_IMAGE_SIDE
 from lenslab.scene.fields import declared_range
 from lenslab.scene.scene import RenderSettings
 
-FORMATS = (("OpenEXR — linear float, for grading", ".exr"), ("PNG — sRGB, tone mapped", ".png"))
+FORMATS = (("OpenEXR — scene-linear float, for grading", ".exr"), ("PNG — 8-bit picture", ".png"),
+           ("TIFF — 16-bit picture", ".tif"), ("JPEG — 8-bit picture", ".jpg"))
+#: Other spellings of the formats' suffixes.
+SUFFIX_ALIASES = {".tiff": ".tif", ".jpeg": ".jpg"}
 
 
 def default_export_path(doc, suffix: str = ".png") -> Path:
@@ -65,11 +71,13 @@ def estimate_seconds(width: int, height: int, spp: int, samples_per_second: floa
 
 
 class ExportDialog(QDialog):
-    def __init__(self, doc, exposure: float, tone_map: str, samples_per_second: float | None = None,
+    def __init__(self, doc, view: ViewTransform, samples_per_second: float | None = None,
                  last_path: Path | None = None, parent: QWidget | None = None):
+        """``view``: the view transform a PNG is made through to begin with (the viewport's)."""
         super().__init__(parent)
         self.setWindowTitle("Export image")
         self.doc = doc
+        self.view = view.resolved()
         self.rate = samples_per_second
         cam = doc.scene.camera
         self._aspect = cam.resolution[0] / cam.resolution[1]
@@ -127,20 +135,37 @@ class ExportDialog(QDialog):
         quality.addRow(self.by_samples, self.spp_spin)
         quality.addRow(self.by_time, self.seconds_spin)
 
+        # The view transform: the config's displays, the chosen display's views, its looks; exposure and contrast.
+        config = load_config(self.view.config)
+        self.display_combo = QComboBox()
+        self.display_combo.addItems(list(config.getDisplays()))
+        self.display_combo.setCurrentText(self.view.display)
+        self.view_combo = QComboBox()
+        self._fill_views(self.view.view)
+        self.display_combo.currentTextChanged.connect(lambda _d: self._fill_views(self.view_combo.currentText()))
+        self.look_combo = QComboBox()
+        self.look_combo.addItem("None", "")
+        for look in config.getLooks():
+            self.look_combo.addItem(look.getName(), look.getName())
+        self.look_combo.setCurrentIndex(max(0, self.look_combo.findData(self.view.looks)))
         self.exposure_spin = QDoubleSpinBox()
-        self.exposure_spin.setRange(-30, 30)
+        self.exposure_spin.setRange(*EXPOSURE_RANGE)
         self.exposure_spin.setSingleStep(0.1)
         self.exposure_spin.setDecimals(2)
         self.exposure_spin.setSuffix(" EV")
-        self.exposure_spin.setValue(exposure)
-        self.tone_combo = QComboBox()
-        self.tone_combo.addItems(TONE_MAPS)
-        self.tone_combo.setCurrentText(tone_map)
+        self.exposure_spin.setValue(self.view.exposure_stops)
+        self.contrast_spin = QDoubleSpinBox()
+        self.contrast_spin.setRange(*CONTRAST_RANGE)
+        self.contrast_spin.setSingleStep(0.05)
+        self.contrast_spin.setDecimals(2)
+        self.contrast_spin.setValue(self.view.contrast)
+        self.contrast_spin.setToolTip("Contrast about middle grey (1 = as the view makes it)")
         self.denoise_check = QCheckBox("Denoise")  # never on unless asked: an export is the render as it is
         self.denoise_check.setToolTip("Write the image denoised by Intel Open Image Denoise, guided by the albedo "
                                       "and normal rendered beside it. An EXR also keeps the noisy image, the albedo "
                                       "and the normal as layers (noisy, albedo, normal).")
-        self.png_note = QLabel("Exposure and tone map apply to PNG only; EXR keeps the linear radiance.")
+        self.png_note = QLabel("The view transform, exposure and contrast make the picture (PNG, TIFF, JPEG); an EXR "
+                               "keeps the scene-linear radiance, in the scene's working space.")
         self.png_note.setObjectName("hint")
         self.png_note.setWordWrap(True)
 
@@ -155,8 +180,11 @@ class ExportDialog(QDialog):
         form.addRow("Format", self.format_combo)
         form.addRow("Size", size_row)
         form.addRow("Stop at", quality)
+        form.addRow("Display", self.display_combo)
+        form.addRow("View", self.view_combo)
+        form.addRow("Look", self.look_combo)
         form.addRow("Exposure", self.exposure_spin)
-        form.addRow("Tone map", self.tone_combo)
+        form.addRow("Contrast", self.contrast_spin)
         form.addRow("", self.denoise_check)
         form.addRow("", self.png_note)
         buttons = QDialogButtonBox(QDialogButtonBox.Cancel)
@@ -172,11 +200,31 @@ class ExportDialog(QDialog):
         self._update_estimate()
 
     # -- fields ---------------------------------------------------------------------------------------------------
+    def _fill_views(self, keep: str) -> None:
+        """The chosen display's views, keeping ``keep`` where the display has it (else its default view)."""
+        config = load_config(self.view.config)
+        display = self.display_combo.currentText()
+        views = list(config.getViews(display))
+        self.view_combo.blockSignals(True)
+        self.view_combo.clear()
+        self.view_combo.addItems(views)
+        self.view_combo.setCurrentText(keep if keep in views else config.getDefaultView(display))
+        self.view_combo.blockSignals(False)
+
+    def chosen_view(self) -> ViewTransform:
+        """The view transform the fields describe, over the scene's working space."""
+        return dataclasses.replace(
+            self.view, _resolved=False, display=self.display_combo.currentText(),
+            view=self.view_combo.currentText(), looks=self.look_combo.currentData() or "",
+            exposure_stops=self.exposure_spin.value(), contrast=self.contrast_spin.value(),
+            working_space=self.doc.scene.render.working_space).resolved()
+
     def _browse(self) -> None:
         name, _ = QFileDialog.getSaveFileName(self, "Export image", self.path_edit.text(),
-                                              "Images (*.exr *.png);;OpenEXR (*.exr);;PNG (*.png)")
+                                              "Images (*.exr *.png *.tif *.tiff *.jpg *.jpeg);;OpenEXR (*.exr);;"
+                                              "PNG (*.png);;TIFF (*.tif *.tiff);;JPEG (*.jpg *.jpeg)")
         if name:
-            if Path(name).suffix.lower() not in (".exr", ".png"):
+            if not _suffix(name):
                 name += self.format_combo.currentData()
             self.path_edit.setText(name)
 
@@ -188,14 +236,15 @@ class ExportDialog(QDialog):
 
     def _path_edited(self, text: str) -> None:
         suffix = Path(text).suffix.lower()
+        suffix = _suffix(text) or suffix
         for i, (_label, s) in enumerate(FORMATS):
             if s == suffix and self.format_combo.currentIndex() != i:
                 self.format_combo.blockSignals(True)
                 self.format_combo.setCurrentIndex(i)
                 self.format_combo.blockSignals(False)
-        png = suffix == ".png"
-        self.exposure_spin.setEnabled(png)
-        self.tone_combo.setEnabled(png)
+        png = suffix != ".exr"  # a picture: made through the view transform
+        for widget in (self.display_combo, self.view_combo, self.look_combo, self.exposure_spin, self.contrast_spin):
+            widget.setEnabled(png)
         self._update_estimate()  # a complaint about the previous path no longer applies
 
     def _width_changed(self, w: int) -> None:
@@ -242,14 +291,13 @@ class ExportDialog(QDialog):
             scene=scene, path=Path(self.path_edit.text()).expanduser(),
             target_spp=self.spp_spin.value() if by_samples else None,
             seconds=None if by_samples else self.seconds_spin.value(),
-            exposure_stops=self.exposure_spin.value(), tone_map=self.tone_combo.currentText(),
-            denoise=self.denoise_check.isChecked(),
+            view=self.chosen_view(), denoise=self.denoise_check.isChecked(),
         )
 
     def validate(self) -> str | None:
         path = Path(self.path_edit.text()).expanduser()
-        if path.suffix.lower() not in (".exr", ".png"):
-            return f"{path.name}: choose a .exr or .png file name"
+        if not _suffix(path):
+            return f"{path.name}: choose a .exr, .png, .tif or .jpg file name"
         if not path.parent.is_dir():
             return f"The folder {path.parent} does not exist"
         return export_problem(path, self.width_spin.value(), self.height_spin.value(), self.denoise_check.isChecked())
@@ -260,6 +308,13 @@ class ExportDialog(QDialog):
             self.estimate.setText(f"<span style='color:#f0a080'>{problem}</span>")
             return
         super().accept()
+
+
+def _suffix(path) -> str | None:
+    """The format's suffix of a file name (``.tiff`` is ``.tif``), None for one the writer does not take."""
+    suffix = Path(path).suffix.lower()
+    suffix = SUFFIX_ALIASES.get(suffix, suffix)
+    return suffix if suffix in {s for _label, s in FORMATS} else None
 
 
 def _duration(seconds: float) -> str:

@@ -51,8 +51,8 @@ class ExportFlow(QObject):
         frame = self.controller.last_frame
         folder = self.folders.last_folder("images")
         last = self.last_path or (folder / default_export_path(window.doc).name if folder else None)
-        dialog = self.make_dialog(window.doc, viewport.exposure, viewport.tone_map,
-                                  frame.samples_per_second if frame else None, last, window)
+        dialog = self.make_dialog(window.doc, viewport.view, frame.samples_per_second if frame else None, last,
+                                  window)
         if dialog.exec() == ExportDialog.Accepted:
             self.start(dialog.request())
 

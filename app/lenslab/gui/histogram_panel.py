@@ -1,5 +1,6 @@
 """The histogram dock: the red, green, blue and luminance histograms of the picture inside the export frame, as
-displayed (8-bit sRGB after the display exposure and the tone map, :mod:`lenslab.optics.histogram`), with a
+displayed: the 8-bit code values the view transform gives the chosen display (OpenColorIO's display, view and look,
+after the display exposure and contrast; the RGBA8 picture the GPU makes, :mod:`lenslab.optics.histogram`), with a
 clipping indicator at each end that lights up when pixels are crushed to black (left, blue: every channel at 0)
 or clipped (right, red: a channel at 255) and says how many. Clicking an indicator turns the clipping warnings
 on the picture on or off. Worked out again at most four times a second, and only while the dock is shown."""
@@ -141,8 +142,9 @@ class HistogramPanel(QWidget):
         self.histogram: Histogram | None = None
         self._stale = True
         self.view = HistogramView()
-        self.view.setToolTip("The picture inside the frame as displayed: 8-bit sRGB after the display exposure and "
-                             "the tone map. Click a triangle to show the clipped pixels on the picture.")
+        self.view.setToolTip("The picture inside the frame as displayed: the display's 8-bit code values through the "
+                             "chosen view (View > View Transform), after the display exposure and contrast. Click a "
+                             "triangle to show the clipped pixels on the picture.")
         self.view.shadows_clicked.connect(warnings_action.toggle)
         self.view.highlights_clicked.connect(warnings_action.toggle)
         self.shadows_label = QLabel()

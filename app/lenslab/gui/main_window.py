@@ -1,6 +1,7 @@
 """The studio's main window: the viewport in the centre, the outliner and property editor on the left, the camera
 panel on the right, the render status at the bottom; menus for files, editing, the view, the camera and the
-render. The layout, the display settings and the recent files are remembered between runs (QSettings).
+render. The layout, the display settings (the view transform: :mod:`.display_view`) and the recent files are
+remembered between runs (QSettings).
 
 The window assembles the studio; its actions and menus are declared in :mod:`.actions`, its files handled by
 :mod:`.file_controller`, its exports by :mod:`.export_flow` and its edits by :mod:`.edit_controller`; the viewport's
@@ -22,6 +23,7 @@ from lenslab.gui.camera_panel import CameraPanel
 from lenslab.gui.controller import RenderController
 from lenslab.gui.corner_tags import camera_tag
 from lenslab.gui.defaults import studio_scene
+from lenslab.gui.display_view import DisplayView, ViewMenus
 from lenslab.gui.document import Document, is_shipped, listen
 from lenslab.gui.edit_controller import EditController
 from lenslab.gui.export_flow import ExportFlow
@@ -35,7 +37,7 @@ from lenslab.gui.scene_tree import SceneTreeView, node_context_menu
 from lenslab.gui.snapshot_panel import StudioSnapshots
 from lenslab.gui.viewing_aids import ViewingAids
 from lenslab.gui.viewport import Viewport
-from lenslab.gui.viewport_toolbar import ViewportToolbar, saved_look, under_toolbar
+from lenslab.gui.viewport_toolbar import ViewportToolbar, under_toolbar
 from lenslab.gui.viewport_tools import ViewportTools
 from lenslab.gui.warning_bar import WarningBar
 from lenslab.gui.wheel_guard import guard_wheels
@@ -81,8 +83,13 @@ class MainWindow(QMainWindow):
         self.edits = EditController(self, self.doc)  # add, duplicate, delete, rename
 
         self.viewport = Viewport()
-        self.viewport.set_display(*saved_look(self.settings))
-        self.controller.set_display(self.viewport.exposure, self.viewport.tone_map)
+        # The view transform (OCIO's display, view, look, the display exposure and contrast) of the last session,
+        # over the scene's working space; what it could not keep is said in the Log once the Log exists.
+        self.display = DisplayView(self.settings, self.doc.scene.render.working_space, self)
+        self.view_menus = ViewMenus(self.display, self)
+        self.viewport.set_view(self.display.view)
+        self.controller.set_display(self.display.view)
+        self.display.changed.connect(self._view_changed)
         self.controller.set_denoise(self.settings.value("viewport/denoise", True) not in (False, "false", "0", 0))
         self.navigator = CameraNavigator(self.doc, self.viewport, self._view_frame, self)
         # The picture follows the viewport's size, once the size has settled (a window being dragged larger
@@ -98,7 +105,8 @@ class MainWindow(QMainWindow):
         self._install_warnings()
         menus = build_menus(self.menuBar(), self.actions, {
             "examples": self.files.fill_examples_menu, "recent": self.files.fill_recent_menu,
-            "panels": self._add_panel_toggles, "lenses": self._fill_lens_menu})
+            "panels": self._add_panel_toggles, "lenses": self._fill_lens_menu,
+            "view_transform": self.view_menus.fill_window_menu})
         self.shipped_menu, self.recent_menu = menus["examples"], menus["recent"]
         self.render_status = RenderStatus(self, self.viewport, self.controller)  # the status bar's labels
         self._connect()
@@ -126,11 +134,12 @@ class MainWindow(QMainWindow):
     def _central(self) -> QWidget:
         """The viewport between its toolbar (the tools and the display settings) and the readout under the cursor.
         The viewport and the readout are ``viewport.parentWidget()``, in a column; the toolbar is above it."""
-        self.toolbar = ViewportToolbar(self.actions, self.viewport, self.controller, self)
+        self.toolbar = ViewportToolbar(self.actions, self.viewport, self.controller, self.display, self.view_menus,
+                                       self)
         # Its widgets, by the names the studio's panels and the tests know them by.
         t = self.toolbar
         self.exposure_slider, self.exposure_spin = t.exposure_slider, t.exposure_spin
-        self.exposure_reset, self.tone_combo, self.quality_combo = t.exposure_reset, t.tone_combo, t.quality_combo
+        self.exposure_reset, self.view_button, self.quality_combo = t.exposure_reset, t.view_button, t.quality_combo
         self.tools = ViewportTools(self)  # hover readout, click to select, click to focus, render region
         self.readout = self.tools.readout
         central = QWidget()
@@ -178,6 +187,7 @@ class MainWindow(QMainWindow):
         self.warning_bar.log_requested.connect(lambda: show_dock(self.docks["log"]))
         self.files.scene_opened_with_warnings.connect(self.report_warnings)
         self.controller.render_warnings.connect(self.report_render_warnings)
+        self._log_display_notes()
 
     def _default_dock_layout(self) -> None:
         for dock in self.docks.values():
@@ -225,7 +235,7 @@ class MainWindow(QMainWindow):
         doc.undo_stack.indexChanged.connect(lambda _i: self._update_actions())
         status, tools = self.render_status, self.tools
         # A frame: the picture and the status first, then the zoom and the readout that read it.
-        for slot in (status.show_frame, self.toolbar.frame_shown, tools.refresh_readout):
+        for slot in (status.show_frame, self.toolbar.frame_shown, tools.refresh_readout, self.camera_panel.show_frame):
             c.frame_ready.connect(slot)
         c.gbuffer_ready.connect(status.show_gbuffer)
         c.gbuffer_ready.connect(tools.refresh_focus_overlay)
@@ -256,8 +266,7 @@ class MainWindow(QMainWindow):
         s = self.settings
         s.setValue("window/geometry", self.saveGeometry())
         s.setValue("window/state", self.saveState())
-        s.setValue("viewport/exposure", self.viewport.exposure)
-        s.setValue("viewport/tone_map", self.viewport.tone_map)
+        self.display.save(s)
         s.setValue("viewport/quality", self.controller.quality)
         s.setValue("viewport/sample_limit", self.controller.target_spp or "none")
         s.sync()
@@ -290,7 +299,8 @@ class MainWindow(QMainWindow):
         comes the work banner says one is on its way."""
         frame = self.controller.last_frame
         cam = frame.camera if frame is not None and frame.camera is not None else self.doc.scene.camera
-        self.viewport.hud_text = camera_tag(cam)  # as a snapshot's is written (the A/B comparison)
+        exposure = frame.exposure if frame is not None and frame.camera is cam else None
+        self.viewport.hud_text = camera_tag(cam, exposure)  # as a snapshot's is written (the A/B comparison)
         self.viewport.update()
 
     # -- document events ---------------------------------------------------------------------------------------
@@ -307,6 +317,9 @@ class MainWindow(QMainWindow):
                 self.tools.show_focus_overlay(self.doc.scene.camera.plane_of_focus_m)
         if change.kind == "scene":
             self.update_camera_tag()
+        if change.kind == "scene" or (change.kind == "render" and change.field[:1] == ("working_space",)):
+            if self.display.set_working_space(self.doc.scene.render.working_space) or self.display.notes:
+                self._log_display_notes()
         self._update_actions()
 
     def _selection_changed(self) -> None:
@@ -325,6 +338,20 @@ class MainWindow(QMainWindow):
 
     def set_display_exposure(self, stops: float) -> None:
         self.toolbar.set_display_exposure(stops)
+
+    def _view_changed(self, view) -> None:
+        """A new view transform: the viewport shows it at once (from the radiance it has), the worker makes its
+        pictures through it, and the status bar names it for a moment."""
+        self.viewport.set_view(view)
+        self.controller.set_display(view)
+        self.statusBar().showMessage(f"View: {self.display.describe()}, exposure {view.exposure_stops:+.1f} EV, "
+                                     f"contrast {view.contrast:.2f}", 4000)
+
+    def _log_display_notes(self) -> None:
+        """What restoring the view transform, or the scene's working space, could not keep: in the Log."""
+        notes, self.display.notes = self.display.notes, []
+        if notes:
+            self.log_panel.add("OpenColorIO", notes)
 
     # -- the viewport's picture: size, render region, denoiser, camera moves ----------------------------------------
     def _viewport_resized(self, width: int, height: int) -> None:

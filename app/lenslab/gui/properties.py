@@ -49,9 +49,10 @@ TAGGED_TYPES: dict[type, dict[str, type]] = {Shape: SHAPE_TYPES, Material: MATER
                                              Environment: ENVIRONMENT_TYPES, Light: LIGHT_TYPES,
                                              Texture: TEXTURE_TYPES}
 #: What each kind of light is, under its name in the property editor.
-LIGHT_SUBTITLES = {"point": "Point light: intensity in W/sr, the same in every direction",
-                   "spot": "Spot light: intensity in W/sr along its axis, fading to nothing at the cutoff angle",
-                   "sun": "Sun: parallel light from a direction, irradiance in W/m²"}
+LIGHT_SUBTITLES = {"point": "Point light: intensity in candela (or lumens), the same in every direction",
+                   "spot": "Spot light: intensity in candela (or lumens) along its axis, fading to nothing at the "
+                           "cutoff angle",
+                   "sun": "Sun: parallel light from a direction, irradiance in lux"}
 
 #: Fields whose RGB triple is a colour (the scene model's RGB alias is a plain tuple, so the name tells).
 COLOUR_FIELDS = {"albedo", "radiance", "color", "colour", "reflectance", "transmittance", "specular", "tint",
@@ -105,7 +106,9 @@ def convert_type(old: Any, new_cls: type) -> Any:
         hints = typing.get_type_hints(new_cls)
         for name in new_fields:
             if name in old_fields and type(old_fields[name]) is type(getattr(new_cls(), name)):
-                kwargs[name] = old_fields[name]
+                choices = new_fields[name].metadata.get("choices")
+                if choices is None or old_fields[name] in choices:  # a map's unit "scale" is no constant sky's
+                    kwargs[name] = old_fields[name]
         old_colour = next((v for k, v in old_fields.items() if k in COLOUR_FIELDS), None)
         new_colour = next((k for k in new_fields if k in COLOUR_FIELDS and k not in kwargs), None)
         if old_colour is not None and new_colour is not None and typing.get_origin(hints[new_colour]) is tuple:

@@ -44,7 +44,8 @@ class RenderStatus(QObject):
         self.viewport.gate_rect = QRectF(*frame.gate) if frame.gate is not None and not export_pixels else None
         self.viewport.region_rect = QRectF(*frame.region) if frame.region is not None else None
         self.viewport.worth_judging = frame.worth_judging
-        self.viewport.set_frame(frame.display, frame.display_settings, frame.image)
+        self.viewport.set_frame(frame.display, frame.view, frame.image,
+                                frame.exposure.scale if frame.exposure is not None else 1.0)
         self.spp_label.setText(samples_text(frame))
         if frame.target_spp:
             self.progress_bar.setValue(round(1000 * min(1.0, frame.samples_per_pixel / frame.target_spp)))

@@ -303,8 +303,9 @@ class StudioSnapshots(QObject):
             w.statusBar().showMessage("Nothing to keep yet: the renderer has not shown a picture", 4000)
             return None
         linear = frame.image if frame.image is not None else w.viewport.linear
-        snapshot = self.store.take(frame.display, frame.display_settings, linear, w.doc.scene.camera, w.doc.lens,
-                                   frame.samples_per_pixel)
+        snapshot = self.store.take(frame.display, frame.view, linear, w.doc.scene.camera, w.doc.lens,
+                                   frame.samples_per_pixel,
+                                   exposure_scale=frame.exposure.scale if frame.exposure is not None else 1.0)
         hint = ""
         if self.store.mode == "off":
             hint = " Change the camera, then compare: View > Compare, or \\ for A alone."

@@ -1,8 +1,8 @@
 """Snapshots: renders kept to compare with the live one (A/B), and the comparison's state. No Qt here.
 
-A :class:`Snapshot` keeps the picture as it was shown (RGBA8, with the exposure and tone map it was made with), the
-linear radiance behind it (so that a new display look re-tone-maps it exactly as the viewport does the live
-picture, and the readout still reads it), a copy of the camera and of the mounted lens, the sample count, the
+A :class:`Snapshot` keeps the picture as it was shown (RGBA8, with the view transform it was made through and the
+camera's exposure on its radiance), the linear radiance behind it (so that a new view transform makes it again
+exactly as the viewport does the live picture, and the readout still reads it), a copy of the camera and of the mounted lens, the sample count, the
 time, and a name the user may give it. A :class:`SnapshotStore` holds the last :data:`MAX_SNAPSHOTS` of them within
 :data:`MAX_BYTES`, oldest evicted first, which one is the A side, and how A meets the live picture (B): not at all,
 a split wipe with a divider, or side by side. Observers (the snapshot dock, the viewport's comparison) connect to
@@ -14,7 +14,9 @@ Snapshots live for the session: they are not saved with the scene.
 from __future__ import annotations
 
 import copy
+import dataclasses
 import itertools
+import math
 import time
 from dataclasses import dataclass, field
 
@@ -22,7 +24,8 @@ import numpy as np
 
 from lenslab.optics import format_distance, format_f_number, format_focal_length
 from lenslab.optics.exposure import format_shutter
-from lenslab.render.film import to_8bit, tone_map
+from lenslab.colour_management.view import EXPOSURE_RANGE, ViewTransform
+from lenslab.render.film import display_pixels, to_8bit
 from lenslab.scene.events import EventEmitter
 
 #: How a snapshot (A) meets the live picture (B) in the viewport.
@@ -43,6 +46,8 @@ def camera_label(camera, samples_per_pixel: int | None = None) -> str:
              f"focus {format_distance(camera.focus_distance_m)}"]
     if camera.exposure_mode == "physical":
         parts.append(f"{format_shutter(camera.shutter_s)} ISO {camera.iso:g}")
+    elif camera.exposure_mode == "auto":
+        parts.append(f"auto ISO {camera.iso:g}")
     if samples_per_pixel is not None:
         parts.append(f"{samples_per_pixel} spp")
     return ", ".join(parts)
@@ -72,14 +77,15 @@ def compare_tags(snapshot: Snapshot, live_camera) -> tuple[str, str]:
 class Snapshot:
     id: int
     display: np.ndarray  # (H, W, 4) uint8: the picture as it was shown
-    display_settings: tuple[float, str]  # (exposure in stops, tone map) ``display`` was made with
+    view: ViewTransform  # the viewport's view transform ``display`` was made through
     linear: np.ndarray | None  # (H, W, 3) float32 radiance behind it; None: only the picture was there to keep
     camera: object  # a copy of the scene's camera when it was taken
     lens: object = None  # the lens preset mounted then (None: free)
     samples_per_pixel: int = 0
     taken: float = field(default_factory=time.time)  # seconds since the epoch
     name: str = ""  # the user's name for it; empty: the settings speak for it
-    _look: tuple = field(default=(), repr=False)  # (settings, RGBA8) of the last other look asked for
+    exposure_scale: float = 1.0  # the camera's exposure on ``linear`` when it was shown (physical, auto)
+    _look: tuple = field(default=(), repr=False)  # (view, RGBA8) of the last other view asked for
 
     @property
     def size(self) -> tuple[int, int]:
@@ -97,19 +103,20 @@ class Snapshot:
     def nbytes(self) -> int:
         return self.display.nbytes + (self.linear.nbytes if self.linear is not None else 0)
 
-    def picture(self, exposure: float, operator: str) -> np.ndarray:
-        """The snapshot as RGBA8 with this display look: re-tone-mapped from its radiance as the viewport does the
-        live picture (``lenslab.render.film``); the picture as taken when the look is its own or no radiance
-        was kept."""
-        settings = (float(exposure), operator)
-        if self.linear is None or settings == tuple(self.display_settings):
+    def picture(self, view: ViewTransform) -> np.ndarray:
+        """The snapshot as RGBA8 through the view transform ``view``: made again from its radiance, with its own
+        camera exposure, as the viewport does the live picture (``lenslab.render.film.display_pixels``); the
+        picture as taken when the view is its own or no radiance was kept."""
+        if self.linear is None or view == self.view:
             return self.display
-        if self._look and self._look[0] == settings:
+        if self._look and self._look[0] == view:
             return self._look[1]
+        stops = view.exposure_stops + math.log2(max(self.exposure_scale, 1e-30))
+        made = dataclasses.replace(view, exposure_stops=min(max(stops, EXPOSURE_RANGE[0]), EXPOSURE_RANGE[1]))
         rgba = np.empty(self.display.shape, np.uint8)
-        rgba[..., :3] = to_8bit(tone_map(self.linear, *settings))
+        rgba[..., :3] = to_8bit(display_pixels(self.linear, made))
         rgba[..., 3] = 255
-        self._look = (settings, rgba)
+        self._look = (view, rgba)
         return rgba
 
 
@@ -128,15 +135,16 @@ class SnapshotStore:
         self._ids = itertools.count(1)
 
     # -- the snapshots -----------------------------------------------------------------------------------------
-    def take(self, display: np.ndarray, display_settings: tuple[float, str], linear: np.ndarray | None, camera,
-             lens=None, samples_per_pixel: int = 0, name: str = "") -> Snapshot:
-        """Keep a copy of a picture and what made it, as the new A side; the oldest go beyond the cap."""
+    def take(self, display: np.ndarray, view: ViewTransform, linear: np.ndarray | None, camera,
+             lens=None, samples_per_pixel: int = 0, name: str = "", exposure_scale: float = 1.0) -> Snapshot:
+        """Keep a copy of a picture and what made it (``view``, and the camera's ``exposure_scale`` on its
+        radiance), as the new A side; the oldest go beyond the cap."""
         if linear is not None and linear.shape[:2] != display.shape[:2]:
             linear = None  # radiance of another frame: the picture alone is true to what was shown
-        snapshot = Snapshot(next(self._ids), np.array(display, np.uint8, copy=True),
-                            (float(display_settings[0]), str(display_settings[1])),
+        snapshot = Snapshot(next(self._ids), np.array(display, np.uint8, copy=True), view,
                             None if linear is None else np.array(linear, np.float32, copy=True),
-                            copy.deepcopy(camera), lens, int(samples_per_pixel), name=name)
+                            copy.deepcopy(camera), lens, int(samples_per_pixel), name=name,
+                            exposure_scale=float(exposure_scale))
         self.snapshots.append(snapshot)
         self._evict(keep=snapshot)
         self.a_id = snapshot.id

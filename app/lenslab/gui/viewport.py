@@ -1,13 +1,16 @@
-"""The viewport: the converging image, its display (exposure, tone map, fit / zoom / pan), the selection
+"""The viewport: the converging image, its display (the view transform, fit / zoom / pan), the selection
 outline, the plane-of-focus overlay, and the tools that act on the picture (select, focus, pan).
 
-The image arrives as linear float radiance from the render worker; the display transform (exposure in stops,
-then clamp / Reinhard / filmic, then sRGB) is applied here, so changing exposure never restarts the render, and
-the readout under the cursor shows the linear values, not the displayed ones.
+The picture arrives from the render worker already made through the view transform (OpenColorIO's display, view
+and look, the display exposure and contrast, on the GPU), with the linear radiance behind it; a new view
+transform chosen before the worker's next picture is applied here to that radiance (OCIO's CPU processor, the same
+transform), so changing the view never restarts the render, and the readout under the cursor shows the linear
+values, not the displayed ones.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 
@@ -16,9 +19,10 @@ from PySide6.QtCore import QPointF, QRectF, Qt, QTimer, Signal
 from PySide6.QtGui import QColor, QFont, QImage, QPainter, QPen
 from PySide6.QtWidgets import QWidget
 
+from lenslab.colour_management.view import EXPOSURE_RANGE, ViewTransform
 from lenslab.gui import theme
 from lenslab.gui.corner_tags import CAMERA, FOCUS_PLANE, FOCUSING, STATE, TagBoard
-from lenslab.render.film import to_8bit, tone_map
+from lenslab.render.film import display_pixels, to_8bit
 from lenslab.scene.navigation import MouseTravel
 
 ZOOM_STEPS = (0.125, 0.25, 1 / 3, 0.5, 2 / 3, 1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0)
@@ -90,8 +94,8 @@ class Viewport(QWidget):
         self.setAttribute(Qt.WA_OpaquePaintEvent)
         self.linear: np.ndarray | None = None
         self.qimage: QImage | None = None
-        self.exposure = 0.0
-        self.tone_map = "filmic"
+        self.view = ViewTransform()  # the view transform the window chose (gui/display_view.py)
+        self.exposure_scale = 1.0  # the camera's exposure of the last picture (physical, auto): scales its radiance
         self.zoom: float | None = None  # None: fit the window
         # Space left around a fitted picture: none when the picture is rendered at the widget's size (it
         # carries its own margin around the sensor's gate), some when it is the export's pixels.
@@ -135,39 +139,50 @@ class Viewport(QWidget):
         self._fade_timer.timeout.connect(self._fade_tick)
 
     # -- content ---------------------------------------------------------------------------------------------
-    def set_frame(self, picture: np.ndarray, settings: tuple[float, str], linear: np.ndarray | None) -> None:
-        """Show a picture the render worker already tone-mapped (RGBA8, made with ``settings``: exposure and
-        tone map). ``linear`` is the radiance behind it for the pixel readout, or None to keep the last one
-        (the render worker sends a picture of a new size with its own)."""
+    @property
+    def exposure(self) -> float:
+        """The display exposure in stops (the view transform's)."""
+        return self.view.exposure_stops
+
+    def set_frame(self, picture: np.ndarray, view: ViewTransform, linear: np.ndarray | None,
+                  exposure_scale: float = 1.0) -> None:
+        """Show a picture the render worker already made through ``view`` (RGBA8), with the camera's exposure
+        ``exposure_scale`` on its radiance. ``linear`` is the radiance behind it for the pixel readout, or None to
+        keep the last one (the render worker sends a picture of a new size with its own)."""
         h, w = picture.shape[:2]
         size_changed = self.linear is None or self.linear.shape[:2] != (h, w)
+        self.exposure_scale = float(exposure_scale)
         if linear is not None:
             self.linear = linear
         if self.linear is None or self.linear.shape[:2] != (h, w):
             self.linear = None  # no readout until one comes; the picture is still shown
             self.qimage = rgba_to_qimage(picture)
             self.update()
-        elif settings == (self.exposure, self.tone_map):
+        elif view == self.view:
             self.qimage = rgba_to_qimage(picture)
             self.update()
-        else:  # the user changed the look since the worker made it: the next frame will have it
+        else:  # the user changed the view since the worker made it: the next frame will have it
             self._redisplay()
         if size_changed:
             self._rebuild_outline()
 
+    def picture_view(self) -> ViewTransform:
+        """The view transform with the camera's exposure added, as the worker made the last picture."""
+        stops = self.view.exposure_stops + math.log2(max(self.exposure_scale, 1e-30))
+        return dataclasses.replace(self.view, exposure_stops=min(max(stops, EXPOSURE_RANGE[0]), EXPOSURE_RANGE[1]))
+
     def _redisplay(self) -> None:
         # Without a linear image (none yet, or the worker's newest picture came without one) the picture stays
-        # as it is until the worker's next one, made with the new look.
+        # as it is until the worker's next one, made with the new view.
         if self.linear is not None:
-            self.qimage = numpy_to_qimage(to_8bit(tone_map(self.linear, self.exposure, self.tone_map)))
+            self.qimage = numpy_to_qimage(to_8bit(display_pixels(self.linear, self.picture_view())))
         self.update()
 
-    def set_display(self, exposure: float | None = None, operator: str | None = None) -> None:
-        if exposure is not None:
-            self.exposure = float(exposure)
-        if operator is not None:
-            self.tone_map = operator
-        self._redisplay()
+    def set_view(self, view: ViewTransform) -> None:
+        """Show the picture through ``view`` (a resolved ViewTransform) from now on."""
+        if view != self.view:
+            self.view = view
+            self._redisplay()
 
     def display_image(self) -> QImage | None:
         return self.qimage

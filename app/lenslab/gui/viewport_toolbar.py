@@ -1,39 +1,25 @@
 """The viewport's toolbar: the tools, fit and the zoom, the display exposure (a slider, a field and a reset, one
-setting), the tone map, the viewport's resolution, the denoiser, the sample limit, pause and restart. The
-display settings change what the picture looks like, never what is rendered.
+setting), the view transform's button (it names the display and view, and opens the View, Display and Look menus
+and the contrast: :mod:`.display_view`), the viewport's resolution, the denoiser, the sample limit, pause and
+restart. The display settings change what the picture looks like, never what is rendered.
 
 Where the window is too narrow for all of it, the toolbar's extension button (») at its right end opens it into
 more rows over the top of the picture (:func:`under_toolbar`)."""
 
 from __future__ import annotations
 
-import math
-
-from PySide6.QtCore import QObject, QSettings, QSize, Qt
-from PySide6.QtGui import QAction
-from PySide6.QtWidgets import QComboBox, QLabel, QMainWindow, QSizePolicy, QToolBar, QToolButton, QWidget
+from PySide6.QtCore import QObject, QSize, Qt
+from PySide6.QtGui import QAction, QFontMetrics
+from PySide6.QtWidgets import QComboBox, QLabel, QMainWindow, QMenu, QSizePolicy, QToolBar, QToolButton, QWidget
 
 from lenslab.gui import theme
 from lenslab.gui.controller import SAMPLE_LIMITS, RenderController
+from lenslab.gui.display_view import DISPLAY_EXPOSURE_STOPS, DisplayView, ViewMenus, saved_view
 from lenslab.gui.viewport import Viewport
 from lenslab.gui.widgets import ResetSlider, SignedNumberEdit
-from lenslab.render.film import TONE_MAPS
 
-DISPLAY_EXPOSURE_STOPS = 6.0  # the display exposure slider reaches this many stops either way
-
-
-def saved_look(settings: QSettings) -> tuple[float, str]:
-    """The viewport's exposure and tone map from the last session; a value edited by hand or written by
-    another version falls back to the default rather than stopping the studio."""
-    try:
-        exposure = float(settings.value("viewport/exposure", 0.0))
-    except (TypeError, ValueError):
-        exposure = 0.0
-    if not math.isfinite(exposure):
-        exposure = 0.0
-    exposure = min(DISPLAY_EXPOSURE_STOPS, max(-DISPLAY_EXPOSURE_STOPS, exposure))
-    tone_map = str(settings.value("viewport/tone_map", "filmic"))
-    return exposure, tone_map if tone_map in TONE_MAPS else "filmic"
+#: The view button's text is cut to this width (the whole of it is its tooltip).
+VIEW_BUTTON_TEXT_PX = 150
 
 
 def under_toolbar(bar: QToolBar, picture: QWidget) -> QMainWindow:
@@ -59,14 +45,17 @@ def under_toolbar(bar: QToolBar, picture: QWidget) -> QMainWindow:
 
 class ViewportToolbar(QObject):
     """The toolbar above the viewport (``bar``, named "viewportBar") and what its own widgets do: the display
-    exposure and tone map go to the viewport (and the controller), the resolution and sample limit to the
-    controller. The window's actions (tools, fit, denoise, pause, restart) are placed on it as they are."""
+    exposure and the view transform go to ``display`` (the window's :class:`DisplayView`, which the viewport and
+    the controller follow), the resolution and sample limit to the controller. The window's actions (tools, fit,
+    denoise, pause, restart) are placed on it as they are."""
 
     def __init__(self, actions: dict[str, QAction], viewport: Viewport, controller: RenderController,
-                 parent: QObject | None = None):
+                 display: DisplayView, menus: ViewMenus, parent: QObject | None = None):
         super().__init__(parent)
         self.viewport = viewport
         self.controller = controller
+        self.display = display
+        self.menus = menus
         bar = self.bar = QToolBar()
         bar.setObjectName("viewportBar")
         bar.setMovable(False)
@@ -88,7 +77,7 @@ class ViewportToolbar(QObject):
         self.exposure_slider = ResetSlider(Qt.Horizontal, default=0)
         self.exposure_slider.setRange(round(-10 * DISPLAY_EXPOSURE_STOPS), round(10 * DISPLAY_EXPOSURE_STOPS))
         self.exposure_slider.setFixedWidth(84)
-        self.exposure_slider.setValue(round(self.viewport.exposure * 10))
+        self.exposure_slider.setValue(round(display.view.exposure_stops * 10))
         self.exposure_slider.setToolTip("Display exposure in stops (display only: the render is not restarted); "
                                         "double-click: back to 0")
         self.exposure_spin = SignedNumberEdit(-DISPLAY_EXPOSURE_STOPS, DISPLAY_EXPOSURE_STOPS, 1, 0.1, " EV")
@@ -105,14 +94,17 @@ class ViewportToolbar(QObject):
         bar.addWidget(self.exposure_slider)
         bar.addWidget(self.exposure_spin)
         bar.addWidget(self.exposure_reset)
-        self.tone_combo = QComboBox()
-        self.tone_combo.setObjectName("toneMap")
-        for name in TONE_MAPS:
-            self.tone_combo.addItem(name.capitalize(), name)
-        self.tone_combo.setCurrentIndex(max(0, self.tone_combo.findData(self.viewport.tone_map)))
-        self.tone_combo.setToolTip("Tone map: how radiance above 1 is brought into the displayable range "
-                                   "(filmic by default)")
-        bar.addWidget(self.tone_combo)
+        # The view transform: the button names the display and view, its menu chooses them, the look and contrast.
+        self.view_button = QToolButton()
+        self.view_button.setObjectName("viewButton")
+        self.view_button.setPopupMode(QToolButton.InstantPopup)
+        self.view_button.setToolButtonStyle(Qt.ToolButtonTextOnly)
+        self.view_menu = QMenu(self.view_button)
+        self.view_menu.setObjectName("viewButtonMenu")
+        self.view_menu.aboutToShow.connect(lambda: self.menus.fill_button_menu(self.view_menu))
+        self.menus.fill_button_menu(self.view_menu)
+        self.view_button.setMenu(self.view_menu)
+        bar.addWidget(self.view_button)
         spacer = QWidget()
         spacer.setSizePolicy(QSizePolicy.Expanding, QSizePolicy.Preferred)
         bar.addWidget(spacer)
@@ -135,12 +127,13 @@ class ViewportToolbar(QObject):
         bar.addAction(actions["pause"])
         bar.addAction(actions["restart"])
         self._update_exposure_label()
+        self._update_view_button()
+        display.changed.connect(self._view_changed)
         v = viewport
         v.zoom_changed.connect(lambda s: self.zoom_label.setText("Fit" if v.zoom is None else f"{s * 100:.0f}%"))
         self.exposure_slider.valueChanged.connect(lambda tenths: self.set_display_exposure(tenths / 10))
         self.exposure_spin.valueChanged.connect(self.set_display_exposure)
         self.exposure_reset.clicked.connect(lambda: self.set_display_exposure(0.0))
-        self.tone_combo.currentIndexChanged.connect(self._tone_changed)
         self.quality_combo.currentIndexChanged.connect(self._quality_changed)
         self.limit_combo.currentIndexChanged.connect(self._limit_changed)
 
@@ -151,24 +144,32 @@ class ViewportToolbar(QObject):
 
     def set_display_exposure(self, stops: float) -> None:
         """The viewport's display exposure, from the slider, the field or the reset: each shows it after."""
-        stops = min(DISPLAY_EXPOSURE_STOPS, max(-DISPLAY_EXPOSURE_STOPS, round(float(stops), 1)))
-        if stops != self.viewport.exposure:
-            self.viewport.set_display(exposure=stops)
-            self.controller.set_display(self.viewport.exposure, self.viewport.tone_map)
+        self.display.set_exposure(stops)
         self._update_exposure_label()
+
+    def _view_changed(self, _view=None) -> None:
+        self._update_exposure_label()
+        self._update_view_button()
 
     def _update_exposure_label(self) -> None:
         """The slider and the field show the viewport's exposure (without telling anyone again)."""
-        for widget, value in ((self.exposure_slider, round(self.viewport.exposure * 10)),
-                              (self.exposure_spin, self.viewport.exposure)):
+        exposure = self.display.view.exposure_stops
+        for widget, value in ((self.exposure_slider, round(exposure * 10)), (self.exposure_spin, exposure)):
             widget.blockSignals(True)
             widget.setValue(value)
             widget.blockSignals(False)
-        self.exposure_reset.setEnabled(self.viewport.exposure != 0)
+        self.exposure_reset.setEnabled(exposure != 0)
 
-    def _tone_changed(self, _index: int) -> None:
-        self.viewport.set_display(operator=self.tone_combo.currentData())
-        self.controller.set_display(self.viewport.exposure, self.viewport.tone_map)
+    def _update_view_button(self) -> None:
+        """The button names the display and view (cut to its width); its tooltip says all of it."""
+        text = self.display.short_text()
+        metrics = QFontMetrics(self.view_button.font())
+        self.view_button.setText(metrics.elidedText(text, Qt.ElideRight, VIEW_BUTTON_TEXT_PX))
+        view = self.display.view
+        self.view_button.setToolTip(
+            f"<b>{self.display.describe()}</b><br>contrast {view.contrast:.2f}, exposure {view.exposure_stops:+.1f} "
+            "EV<br>The view transform (OpenColorIO): click to choose the view, the display, a look and the "
+            "contrast. Display only: the render goes on.")
 
     def _quality_changed(self, _index: int) -> None:
         self.controller.set_quality(self.quality_combo.currentData())
@@ -177,4 +178,4 @@ class ViewportToolbar(QObject):
         self.controller.set_target_spp(self.limit_combo.currentData())
 
 
-__all__ = ["ViewportToolbar", "DISPLAY_EXPOSURE_STOPS", "saved_look", "under_toolbar"]
+__all__ = ["ViewportToolbar", "DISPLAY_EXPOSURE_STOPS", "saved_view", "under_toolbar"]

@@ -10,7 +10,7 @@ import math
 from PySide6.QtCore import QObject, Qt
 from PySide6.QtWidgets import QLabel, QMainWindow
 
-from lenslab.color import luminance
+from lenslab.colour_management.working_space import luminance
 from lenslab.optics import format_distance
 from lenslab.scene import editing
 
@@ -26,6 +26,9 @@ class ViewportTools(QObject):
         super().__init__(window)
         self.window = window
         self.structure_generation = 0
+        # Where the spot meter reads: the point last clicked with the focus tool, as fractions of the frame (the
+        # sensor's gate), as a camera's spot meter follows its focus point; the frame's centre until then.
+        self.meter_spot = (0.5, 0.5)
         self._hover: tuple[int, int] | None = None
         self.readout = QLabel(" ")
         self.readout.setObjectName("readout")
@@ -59,7 +62,7 @@ class ViewportTools(QObject):
             self.readout.setText(" ")
             return
         r, g, b = (float(c) for c in image[y, x])
-        lum = luminance((r, g, b))
+        lum = luminance((r, g, b), self.window.doc.scene.render.working_space)
         parts = [f"x {x}  y {y}",
                  f"<span style='color:#e06c6c'>R</span> {r:.4f}  <span style='color:#7fc56b'>G</span> {g:.4f}  "
                  f"<span style='color:#6b9be0'>B</span> {b:.4f}",
@@ -105,6 +108,23 @@ class ViewportTools(QObject):
     # -- focus -----------------------------------------------------------------------------------------------------
     def focus_clicked(self, u: float, v: float) -> None:
         self.window.controller.pick(u, v, self._focus_answered)
+        self.set_meter_spot(*self.frame_fraction(u, v))
+
+    def frame_fraction(self, u: float, v: float) -> tuple[float, float]:
+        """Image point (u, v) of the viewport's picture as fractions of the frame (the sensor's gate) it shows."""
+        viewport = self.window.viewport
+        w, h = viewport.image_size()
+        gate = viewport.gate_rect
+        if gate is None or w <= 0 or h <= 0 or gate.width() <= 0 or gate.height() <= 0:
+            return min(max(u, 0.0), 1.0), min(max(v, 0.0), 1.0)
+        x = (u * w - gate.x()) / gate.width()
+        y = (v * h - gate.y()) / gate.height()
+        return min(max(x, 0.0), 1.0), min(max(y, 0.0), 1.0)
+
+    def set_meter_spot(self, x: float, y: float) -> None:
+        """The spot meter reads at (x, y), fractions of the frame from its top left."""
+        self.meter_spot = (float(x), float(y))
+        self.window.controller.set_meter_spot(*self.meter_spot)
 
     def _focus_answered(self, result) -> None:
         self.window.viewport.focus_pending = False

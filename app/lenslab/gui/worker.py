@@ -40,6 +40,8 @@ from lenslab.gui.render_loop import (  # noqa: F401
     ExportStart,
     Frame,
     GBuffer,
+    MeterReading,
+    MeterSpot,
     Pause,
     PickRequest,
     PickResult,
@@ -105,9 +107,14 @@ class RenderWorker(QThread):
     def set_paused(self, paused: bool) -> None:
         self._queue.put(Pause(bool(paused)))
 
-    def set_display(self, exposure: float, tone_map: str) -> None:
-        """The viewport's exposure and tone curve, for the pictures the worker makes from now on."""
-        self._queue.put(DisplayEdit(float(exposure), str(tone_map)))
+    def set_display(self, view) -> None:
+        """The viewport's view transform (a resolved lenslab.colour_management.view.ViewTransform), for the
+        pictures the worker makes from now on."""
+        self._queue.put(DisplayEdit(view))
+
+    def set_meter_spot(self, x: float, y: float) -> None:
+        """Where the spot meter reads: fractions of the frame's width and height from its top left."""
+        self._queue.put(MeterSpot((float(x), float(y))))
 
     def set_target_spp(self, spp: int | None) -> None:
         self._queue.put(TargetSpp(spp))

@@ -1,10 +1,11 @@
 """The histogram of a displayed picture and its clipping: how many pixels sit at each level, and how many are
 lost at either end.
 
-The picture is **display-referred**: 8-bit sRGB after the display exposure and the tone map, exactly what the
-viewport shows and what a PNG export writes. (The linear radiance behind it has no top: with the filmic or
-Reinhard tone map nothing clips until the radiance is far above 1, and this histogram shows that, as a camera's
-histogram shows its JPEG and not its raw file.)
+The picture is **display-referred**: the display's 8-bit code values after the view transform (OpenColorIO's
+display, view and look, with the display exposure and contrast: lenslab.colour_management.view), exactly what the
+viewport shows and what a PNG export writes. (The linear radiance behind it has no top: through an ACES view
+nothing clips until the radiance is far above 1, through an un-tone-mapped one everything above 1 does, and this
+histogram shows which, as a camera's histogram shows its JPEG and not its raw file.)
 
 * The red, green and blue histograms count the pixels at each of the 256 levels of each channel; the luminance
   histogram counts Rec. 709 luma of the encoded values (:data:`LUMA_WEIGHTS_256`), rounded.
@@ -22,7 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 
 #: Rec. 709 luma weights (0.2126, 0.7152, 0.0722) in 256ths, summing to 256 so that white is 255, applied to the
-#: display-encoded values (a histogram judges the picture as shown).
+#: display-encoded values (a histogram judges the picture as shown; a wide-gamut display's luma weights differ a
+#: little, which a histogram's shape does not show).
 LUMA_WEIGHTS_256 = (54, 183, 19)
 LEVELS = 256
 HIGHLIGHT_LEVEL = 255

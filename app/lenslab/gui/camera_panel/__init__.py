@@ -21,7 +21,8 @@ from lenslab.gui.camera_panel.aperture import (
 )
 from lenslab.gui.camera_panel.bokeh import BokehSection
 from lenslab.gui.camera_panel.depth_of_field import DepthOfFieldSection, DofDiagram
-from lenslab.gui.camera_panel.exposure import ISO_SPEEDS, SHUTTER_SCALES, SHUTTER_SPEEDS, ExposureSection, step_shutter
+from lenslab.gui.camera_panel.exposure import (ISO_SPEEDS, SHUTTER_SCALES, SHUTTER_SPEEDS, ExposureSection,
+                                               metered_shutter, step_shutter)
 from lenslab.gui.camera_panel.focal_length import COMMON_FOCAL_LENGTHS, FOCAL_RANGE, FocalLengthSection
 from lenslab.gui.camera_panel.focus import FOCUS_RANGE, FocusSection
 from lenslab.gui.camera_panel.lens import LensSection, lens_short_name
@@ -36,7 +37,8 @@ __all__ = [
     "CameraPanel", "CameraSection", "LensSection", "ApertureSection", "BokehSection", "FocalLengthSection",
     "FocusSection", "DepthOfFieldSection", "ExposureSection", "SensorSection",
     # What this module held before its sections had modules of their own.
-    "AutoNumberEdit", "IrisGlyph", "DofDiagram", "StopSlider", "lens_short_name", "step_shutter", "FULL_STOPS",
+    "AutoNumberEdit", "IrisGlyph", "DofDiagram", "StopSlider", "lens_short_name", "step_shutter",
+    "metered_shutter", "FULL_STOPS",
     "STOP_SCALE_NAMES", "STEP_WORDS", "SENSOR_FIT_NAMES", "ISO_SPEEDS", "SHUTTER_SCALES", "SHUTTER_SPEEDS",
     "COMMON_FOCAL_LENGTHS", "FOCAL_RANGE", "FOCUS_RANGE",
 ]
@@ -104,6 +106,9 @@ class CameraPanel(QWidget):
     shutter_shorter = _SectionWidget("exposure")
     shutter_longer = _SectionWidget("exposure")
     exposure_info = _SectionWidget("exposure")
+    metering = _SectionWidget("exposure")
+    meter_label = _SectionWidget("exposure")
+    meter_apply = _SectionWidget("exposure")
     sensor_combo = _SectionWidget("sensor")
     sensor_w = _SectionWidget("sensor")
     sensor_h = _SectionWidget("sensor")
@@ -175,6 +180,10 @@ class CameraPanel(QWidget):
 
     def step_shutter(self, steps: int) -> None:
         self.exposure_section.step_shutter(steps)
+
+    def show_frame(self, frame) -> None:
+        """A new picture from the render: the meter's reading and the auto exposure's shutter follow it."""
+        self.exposure_section.show_frame(frame)
 
     # -- the stop scale, which the aperture and the shutter step on -----------------------------------------------
     def stop_scale(self) -> tuple[float, ...]:

@@ -237,8 +237,9 @@ class ApertureSection(CameraSection):
             self.open_up.setEnabled(cam.f_number > stops[0] * 1.0001)
             self.stop_down.setEnabled(cam.f_number < stops[-1] * 0.9999)
             diameter = cam.focal_length_mm / cam.f_number
-            brightness = ("Brightness stays the same at every aperture (exposure is compensated)."
-                          if cam.exposure_mode != "physical" else "Each stop is a stop of light (physical exposure).")
+            brightness = {"physical": "Each stop is a stop of light (physical exposure).",
+                          "auto": "The auto exposure's shutter makes up for each stop (aperture priority)."}.get(
+                cam.exposure_mode, "Brightness stays the same at every aperture (exposure is compensated).")
             if cam.aperture_image:
                 iris = f"the stop is {Path(cam.aperture_image).name}"
             else:

@@ -1,18 +1,25 @@
-"""The camera panel's exposure section: compensated (the brightness holds at every aperture) or physical, with the
-ISO and the shutter speed on the dial of the chosen stop scale, and the exposure value they make."""
+"""The camera panel's exposure section: compensated (the brightness holds at every aperture), physical (the ISO and
+the shutter speed on the dial of the chosen stop scale, and the exposure value they make) or auto (aperture
+priority: the meter chooses the shutter); and the light meter.
+
+The meter reads the render's scene-linear luminance inside the frame (the render loop meters each linear image it
+reads, a few times a second: ``Frame.meter``), centre-weighted or at a spot (the frame's centre, or the point last
+clicked with the focus tool), and suggests the shutter at the camera's f-number and ISO, on a third stop;
+**Apply** sets it, as one undo step (a camera in another mode turns physical: the exposure is held)."""
 
 from __future__ import annotations
 
 import math
 from typing import TYPE_CHECKING
 
-from PySide6.QtWidgets import QComboBox, QGridLayout, QHBoxLayout, QLabel, QToolButton
+from PySide6.QtWidgets import QComboBox, QGridLayout, QHBoxLayout, QLabel, QPushButton, QToolButton
 
 from lenslab.gui.camera_panel.aperture import STEP_WORDS
 from lenslab.gui.camera_panel.section import CameraSection
 from lenslab.gui.widgets import hint
-from lenslab.optics.exposure import ev100, format_shutter, parse_shutter
-from lenslab.optics.stops import DEFAULT_STOP_SCALE
+from lenslab.optics.exposure import (SHUTTER_RANGE_S, ev100, format_shutter, metered_ev100,
+                                     nearest_third_stop_shutter, parse_shutter, shutter_for)
+from lenslab.optics.stops import DEFAULT_STOP_SCALE, format_f_number
 from lenslab.scene.camera import ThinLensCamera
 from lenslab.scene.fields import control_range
 
@@ -34,6 +41,15 @@ SHUTTER_SCALES = {
               1 / 1600, 1 / 2000, 1 / 2500, 1 / 3200, 1 / 4000, 1 / 5000, 1 / 6400, 1 / 8000),
 }
 SHUTTER_SPEEDS = SHUTTER_SCALES["full"]
+
+
+def metered_shutter(reading_cd_m2: float, f_number: float, iso: float, light_fraction: float = 1.0) -> tuple[float, float]:
+    """(EV100, shutter seconds) a meter reading of ``reading_cd_m2`` suggests at ``f_number`` and ``iso``: the EV100
+    of the reading (the light the aperture passes counted, as the auto exposure counts it) and the shutter time
+    that gives it, on the nearest third stop, within the shutter's range."""
+    ev = metered_ev100(reading_cd_m2) - math.log2(light_fraction)
+    seconds = nearest_third_stop_shutter(shutter_for(ev, f_number, iso))
+    return ev, min(max(seconds, SHUTTER_RANGE_S[0]), SHUTTER_RANGE_S[1])
 
 
 def step_shutter(seconds: float, steps: int, scale: str = DEFAULT_STOP_SCALE) -> float:
@@ -65,9 +81,11 @@ class ExposureSection(CameraSection):
         self.exposure_mode = QComboBox()
         self.exposure_mode.addItem("Compensated", "compensated")
         self.exposure_mode.addItem("Physical (ISO, shutter)", "physical")
+        self.exposure_mode.addItem("Auto (aperture priority)", "auto")
         self.exposure_mode.setToolTip("Compensated: the brightness stays the same at every aperture, to judge "
                                       "depth of field. Physical: each stop of aperture, shutter or ISO is a stop "
-                                      "of light (radiance in cd/m²)")
+                                      "of light (radiance in cd/m²). Auto: the meter chooses the shutter at the "
+                                      "f-number and ISO you set")
         self.exposure_mode.currentIndexChanged.connect(
             lambda i: self._updating or self.doc.set_camera("Exposure mode", False,
                                                             exposure_mode=self.exposure_mode.itemData(i)))
@@ -103,10 +121,36 @@ class ExposureSection(CameraSection):
         grid.addWidget(self.iso, 1, 1)
         grid.addWidget(QLabel("Shutter"), 2, 0)
         grid.addLayout(shutter_row, 2, 1)
+        # The meter: how it reads, what it read, and the button that takes its suggestion.
+        self.metering = QComboBox()
+        self.metering.setObjectName("metering")
+        self.metering.addItem("Average (centre-weighted)", "average")
+        self.metering.addItem("Spot", "spot")
+        self.metering.setToolTip("How the meter reads the frame: the mean weighted towards its centre, or a spot of "
+                                 "5 % of its diagonal at the centre (or where the focus tool last clicked)")
+        self.metering.currentIndexChanged.connect(
+            lambda i: self._updating or self.doc.set_camera("Metering", False, metering=self.metering.itemData(i)))
+        grid.addWidget(QLabel("Meter"), 3, 0)
+        grid.addWidget(self.metering, 3, 1)
         grid.setColumnStretch(1, 1)
         self.add(grid)
+        self.meter_label = hint("Meter: waiting for the picture")
+        self.meter_label.setObjectName("meterReading")
+        self.meter_apply = QPushButton("Apply")
+        self.meter_apply.setObjectName("meterApply")
+        self.meter_apply.setToolTip("Set the shutter to the meter's suggestion (one undo step); a compensated or auto "
+                                    "camera turns physical at that exposure")
+        self.meter_apply.setEnabled(False)
+        self.meter_apply.clicked.connect(self.apply_meter)
+        meter_row = QHBoxLayout()
+        meter_row.setSpacing(6)
+        meter_row.addWidget(self.meter_label, 1)
+        meter_row.addWidget(self.meter_apply)
+        self.add(meter_row)
         self.exposure_info = hint("")
         self.add(self.exposure_info)
+        self.reading = None  # the meter's latest reading (render_loop.MeterReading), from the frames
+        self.auto_exposure = None  # the auto exposure of the latest picture (lenslab.optics.exposure.Exposure)
 
     # -- edits ----------------------------------------------------------------------------------------------------
     def _set_iso(self, value) -> None:
@@ -154,29 +198,107 @@ class ExposureSection(CameraSection):
         if not math.isclose(seconds, self.doc.scene.camera.shutter_s, rel_tol=1e-6):
             self._set_shutter(seconds)
 
+    # -- the meter --------------------------------------------------------------------------------------------------
+    def suggestion(self) -> tuple[float, float] | None:
+        """(EV100, shutter seconds) the meter's latest reading suggests at the camera's f-number and ISO; None
+        before a reading, or when it read nothing (a black frame)."""
+        reading = self.reading
+        if reading is None or not reading.luminance > 0:
+            return None
+        cam = self.doc.scene.camera
+        return metered_shutter(reading.luminance, cam.f_number, cam.iso, self.panel.light_fraction())
+
+    def apply_meter(self) -> None:
+        """Set the shutter the meter suggests, as one undo step (a camera in another mode turns physical)."""
+        suggested = self.suggestion()
+        if suggested is None:
+            return
+        _ev, seconds = suggested
+        cam = self.doc.scene.camera
+        changes = {"shutter_s": seconds}
+        if cam.exposure_mode != "physical":
+            changes["exposure_mode"] = "physical"
+        if math.isclose(seconds, cam.shutter_s, rel_tol=1e-9) and len(changes) == 1:
+            self.panel.status_message.emit(f"The shutter is already the meter's {format_shutter(seconds)}")
+            return
+        self.doc.set_camera(f"Shutter {format_shutter(seconds)} (meter)", False, **changes)
+
+    def show_frame(self, frame) -> None:
+        """A new picture from the render: the meter's reading, and in the auto mode the shutter it chose."""
+        self.reading = getattr(frame, "meter", None)
+        exposure = getattr(frame, "exposure", None)
+        camera = getattr(frame, "camera", None)
+        self.auto_exposure = exposure if camera is not None and camera.exposure_mode == "auto" else None
+        self._show_meter()
+        cam = self.doc.scene.camera
+        if cam.exposure_mode == "auto":  # the shutter alone: a refresh would overwrite an ISO being typed
+            with self._showing_camera():
+                self._show_shutter(cam, SHUTTER_SCALES[self.panel.scale_name])
+
+    def _show_meter(self) -> None:
+        reading = self.reading
+        cam = self.doc.scene.camera
+        suggested = self.suggestion()
+        where = "spot" if cam.metering == "spot" else "average"
+        if reading is None:
+            text = "Meter: waiting for the picture"
+        elif suggested is None:
+            text = f"Meter ({where}): nothing to read, the frame is black"
+        else:
+            ev, seconds = suggested
+            text = (f"Meter ({where}): EV {ev:.1f} → {format_shutter(seconds)} at {format_f_number(cam.f_number)}"
+                    f", ISO {cam.iso:g}")
+            self.meter_label.setToolTip(f"The render's scene-linear luminance inside the frame reads "
+                                        f"{reading.luminance:.4g} cd/m² ({where}"
+                                        + (f" at {reading.spot[0]:.0%}, {reading.spot[1]:.0%} of the frame"
+                                           if where == "spot" else ", weighted towards the centre")
+                                        + "); the shutter on the nearest third stop")
+        self.meter_label.setText(text)
+        self.meter_apply.setEnabled(suggested is not None)
+
     # -- following the document ---------------------------------------------------------------------------------
     def refresh(self, cam: ThinLensCamera, scale_name: str) -> None:
-        """Show ``cam``'s exposure, the shutter on the dial of the stop scale ``scale_name``."""
+        """Show ``cam``'s exposure, the shutter on the dial of the stop scale ``scale_name`` (in the auto mode, the
+        one the meter chose for the latest picture, read-only)."""
         with self._showing_camera():
             physical = cam.exposure_mode == "physical"
+            auto = cam.exposure_mode == "auto"
             self.exposure_mode.setCurrentIndex(self.exposure_mode.findData(cam.exposure_mode))
+            self.metering.setCurrentIndex(max(0, self.metering.findData(cam.metering)))
             self.iso.setEditText(f"{cam.iso:g}")
             dial = SHUTTER_SCALES[scale_name]
             if [self.shutter.itemData(i) for i in range(self.shutter.count())] != [float(t) for t in dial]:
                 self.shutter.clear()
                 for seconds in dial:
                     self.shutter.addItem(format_shutter(seconds), float(seconds))
-            self.shutter.setCurrentIndex(next((i for i, t in enumerate(dial)
-                                               if math.isclose(t, cam.shutter_s, rel_tol=1e-3)), -1))
-            self.shutter.setEditText(format_shutter(cam.shutter_s))
             step = STEP_WORDS[scale_name]
             self.shutter_shorter.setToolTip(f"Shorter by {step}: less light")
             self.shutter_longer.setToolTip(f"Longer by {step}: more light")
             self.shutter_shorter.setEnabled(physical and cam.shutter_s > dial[-1] * 1.0001)
             self.shutter_longer.setEnabled(physical and cam.shutter_s < dial[0] * 0.9999)
-            self.iso.setEnabled(physical)
+            self.iso.setEnabled(physical or auto)
             self.shutter.setEnabled(physical)
-            ev = ev100(cam.f_number, cam.shutter_s, cam.iso)
-            self.exposure_info.setText(
-                f"EV₁₀₀ {ev:.1f}: a reflected-light meter calls {0.125 * 2 ** ev:.3g} cd/m² mid-grey."
-                if physical else "The picture keeps its brightness whatever the aperture, shutter and ISO.")
+            self.shutter.setToolTip("The shutter the meter chose for the picture (auto exposure: read-only)" if auto
+                                    else "Exposure time: choose a speed of the dial or type any (1/125, 0.5, 2 s)")
+            self._show_shutter(cam, dial)
+        self._show_meter()
+
+    def _show_shutter(self, cam: ThinLensCamera, dial) -> None:
+        """The shutter (in the auto mode the meter's choice for the latest picture) and the line under it."""
+        physical = cam.exposure_mode == "physical"
+        auto = cam.exposure_mode == "auto"
+        shown = self.auto_exposure.shutter_s if auto and self.auto_exposure is not None else cam.shutter_s
+        self.shutter.setCurrentIndex(next((i for i, t in enumerate(dial)
+                                           if math.isclose(t, shown, rel_tol=1e-3)), -1))
+        self.shutter.setEditText(format_shutter(shown))
+        ev = ev100(cam.f_number, shown, cam.iso)
+        if physical:
+            info = f"EV₁₀₀ {ev:.1f}: a reflected-light meter calls {0.125 * 2 ** ev:.3g} cd/m² mid-grey."
+        elif auto and self.auto_exposure is not None:
+            info = (f"Auto: the meter chose {format_shutter(shown)} at {format_f_number(cam.f_number)}, ISO "
+                    f"{cam.iso:g} (EV₁₀₀ {ev:.1f}), putting its reading at middle grey.")
+        elif auto:
+            info = "Auto: the meter chooses the shutter once it has read the picture."
+        else:
+            info = "The picture keeps its brightness whatever the aperture, shutter and ISO."
+        self.exposure_info.setText(info)
