@@ -50,7 +50,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("scene", nargs="?", help="a scene file (.json), a folder holding scene.json, or a shipped scene name")
     p.add_argument("--headless", action="store_true", help="render to a file without opening a window")
-    p.add_argument("-o", "--output", metavar="FILE", help="with --headless: where to write the image, .exr (linear, float) or .png (sRGB)")
+    p.add_argument("-o", "--output", metavar="FILE",
+                   help="with --headless: where to write the image: .exr (scene-linear float), or a picture through "
+                        "the view transform: .png, .tif/.tiff (16-bit), .jpg/.jpeg")
     for name in ("spp", "time_limit", "width", "height", "f_number", "focal_length", "focus_distance"):
         add_option(p, name)
     camera = p.add_argument_group("camera and lens")
@@ -93,15 +95,15 @@ def _print_info(device: int | None) -> int:
 
 def _check_output(path_text: str | None) -> Path:
     from lenslab.atomic import check_output_folder
-    from lenslab.render.film import EXPORT_SUFFIXES
+    from lenslab.render.film import EXPORT_SUFFIXES, EXPORT_SUFFIXES_TEXT
 
     if not path_text:
-        raise CliError("--headless needs an output file: -o OUT.exr or -o OUT.png", EXIT_USAGE)
+        raise CliError("--headless needs an output file: -o OUT.exr, OUT.png, OUT.tif or OUT.jpg", EXIT_USAGE)
     path = Path(path_text)
     if path.is_dir():
         raise CliError(f"{path} is a folder: name the image file, e.g. {path / 'render.exr'}", EXIT_USAGE)
     if path.suffix.lower() not in EXPORT_SUFFIXES:
-        raise CliError(f"{path}: unsupported output type '{path.suffix}' (use .exr or .png)", EXIT_USAGE)
+        raise CliError(f"{path}: unsupported output type '{path.suffix}' (use {EXPORT_SUFFIXES_TEXT})", EXIT_USAGE)
     folder = path.parent if str(path.parent) else Path(".")
     if folder.exists() and not folder.is_dir():
         raise CliError(f"{path}: '{folder}' is a file, not a folder")
