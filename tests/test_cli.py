@@ -161,7 +161,7 @@ def test_scene_errors_found_when_packing_name_the_scene_file(tmp_path, capsys):
 def test_exposure_on_an_exr_is_a_warning(tmp_path, capsys):
     status, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "x.exr", "--exposure", "1",
                           "--spp", "1", "--width", "8")
-    assert status == 0 and "lenslab: warning: --exposure applies to PNG only" in err
+    assert status == 0 and "lenslab: warning: --exposure applies to pictures only" in err
 
 
 def test_broken_scene_exits_with_file_and_key(tmp_path, capsys):

@@ -113,7 +113,9 @@ def test_physical_exposure_darkens_the_picture_a_stop_per_stop(window, qtbot):
     window.display.set_view("clamp")  # the old name: the Un-tone-mapped view, linear up to the display's white
 
     def picture(f_number: float, mode: str) -> np.ndarray:
-        window.doc.set_camera("test", False, f_number=f_number, exposure_mode=mode, iso=100.0, shutter_s=4.0)
+        # The Cornell box's lamp is lit in nits (its walls about 50 cd/m²): 1/60 s at ISO 100 exposes it about
+        # right at f/2.8, and a stop less at f/4.
+        window.doc.set_camera("test", False, f_number=f_number, exposure_mode=mode, iso=100.0, shutter_s=1 / 60)
         # The generation this edit started, not the first restart signalled: on a cold start the window's first
         # scene may still be on its way to the worker, and its restart, with the old camera, comes first.
         edit = window.controller.generation
@@ -125,7 +127,8 @@ def test_physical_exposure_darkens_the_picture_a_stop_per_stop(window, qtbot):
         return float(srgb_to_linear(a[unclipped] / 255.0).mean() / srgb_to_linear(b[unclipped] / 255.0).mean())
 
     physical = ratio(picture(2 ** 1.5, "physical"), picture(4.0, "physical"))
-    assert "f/4 · focus" in window.viewport.hud_text and window.viewport.hud_text.endswith("4 s · ISO 100")
+    assert "f/4 · focus" in window.viewport.hud_text and window.viewport.hud_text.endswith("1/60 s · ISO 100")
+    window.set_display_exposure(-6.0)  # compensated: the scene's nits as they are, 6 stops down to be seen
     compensated = ratio(picture(2 ** 1.5, "compensated"), picture(4.0, "compensated"))
     assert physical == pytest.approx(2.0, rel=0.12)
     assert compensated == pytest.approx(1.0, rel=0.08)

@@ -14,8 +14,8 @@ from pathlib import Path
 
 from PySide6.QtCore import QSettings, Qt, QTimer, Signal
 from PySide6.QtGui import QAction, QKeySequence
-from PySide6.QtWidgets import (QDockWidget, QMainWindow, QMenu, QMessageBox, QProgressDialog, QUndoView, QVBoxLayout,
-                               QWidget)
+from PySide6.QtWidgets import (QDockWidget, QLabel, QMainWindow, QMenu, QMessageBox, QProgressDialog, QSizePolicy,
+                               QUndoView, QVBoxLayout, QWidget)
 
 from lenslab import __version__
 from lenslab.gui.actions import build_menus, create_actions, make_action, selection_has_nodes, update_enabled
@@ -109,6 +109,7 @@ class MainWindow(QMainWindow):
             "view_transform": self.view_menus.fill_window_menu})
         self.shipped_menu, self.recent_menu = menus["examples"], menus["recent"]
         self.render_status = RenderStatus(self, self.viewport, self.controller)  # the status bar's labels
+        self._install_view_label()
         self._connect()
         self.snapshots = StudioSnapshots(self)  # its dock exists before the saved layout is restored
         self.docks["snapshots"].setWidget(PanelScroll(self.snapshots.panel))
@@ -346,6 +347,25 @@ class MainWindow(QMainWindow):
         self.controller.set_display(view)
         self.statusBar().showMessage(f"View: {self.display.describe()}, exposure {view.exposure_stops:+.1f} EV, "
                                      f"contrast {view.contrast:.2f}", 4000)
+
+    def _install_view_label(self) -> None:
+        """The status bar names the display and view ("sRGB / ACES 2.0 SDR"; the toolbar's button the view alone),
+        first of its permanent labels; it gives way before the window does."""
+        self.view_label = QLabel()
+        self.view_label.setObjectName("viewLabel")
+        self.view_label.setSizePolicy(QSizePolicy.Ignored, QSizePolicy.Preferred)
+        self.view_label.setMinimumWidth(0)
+        self.statusBar().insertPermanentWidget(0, self.view_label)
+        self._show_view_label()
+        self.display.changed.connect(self._show_view_label)
+
+    def _show_view_label(self, *_args) -> None:
+        text = self.display.short_text()
+        self.view_label.setText(text)
+        self.view_label.setFixedWidth(self.view_label.fontMetrics().horizontalAdvance(text) + 16)
+        self.view_label.setMinimumWidth(0)
+        self.view_label.setToolTip(f"The view transform: {self.display.describe()} (View > Display, View Transform, "
+                                   "Look)")
 
     def _log_display_notes(self) -> None:
         """What restoring the view transform, or the scene's working space, could not keep: in the Log."""

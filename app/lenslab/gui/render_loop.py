@@ -744,6 +744,8 @@ class RenderLoop:
         stride = max(1, math.ceil(math.sqrt(lum.size / METER_MAX_PIXELS)))
         if stride > 1:
             lum = lum[stride // 2::stride, stride // 2::stride]
+        if not np.isfinite(lum).any():
+            return  # nothing rendered in the frame yet: the last reading stands
         reading = meter_luminance(lum, camera.metering, self._spot)
         if not math.isfinite(reading):
             return
@@ -778,17 +780,20 @@ class RenderLoop:
         if with_linear or converged or self._paused or not self.busy or auto_unmetered \
                 or now - self._last_linear >= LINEAR_INTERVAL:
             image = session.image()  # resolved from the read-back itself, without a copy of the sums
-            self._meter(image, empty if has_empty else None)
+            _fill, fill_linear = self._fill_pictures()
+            if has_empty and fill_linear is not None:
+                image[empty] = fill_linear[empty]
+            # The meter reads the whole frame: where nothing is rendered yet, what shows there (the preview, the
+            # last picture); pixels with neither do not count.
+            self._meter(image, empty if has_empty and fill_linear is None else None)
             if self._exposure_moved(used):  # auto: the reading moved; the picture is made at the new exposure
                 picture = session.display(self._picture_view())
             self._last_linear = now
-        fill, fill_linear = self._fill_pictures()
+        fill, _fill_linear = self._fill_pictures()
         if has_empty and fill is not None:
             picture[empty] = fill[empty]
         elif has_empty:
             picture[empty, 3] = 255  # black
-        if image is not None and has_empty and fill_linear is not None:
-            image[empty] = fill_linear[empty]
         self._offer(picture, image, preview=False, converged=converged)
 
     def _fill_pictures(self) -> tuple[np.ndarray | None, np.ndarray | None]:

@@ -61,6 +61,11 @@ QProgressBar {{ background: {BASE}; border: 1px solid #3a3b3f; border-radius: 3p
 QProgressBar::chunk {{ background: #6b5a3e; }}
 QMenu::item:selected {{ background: #4a3d28; }}
 QToolButton#qt_toolbar_ext_button {{ min-width: 16px; padding: 2px; }}
+QToolButton#viewButton {{ background: {BASE}; border: 1px solid #3a3b3f; border-radius: 3px;
+    padding: 2px 16px 2px 5px; min-height: 18px; }}
+QToolButton#viewButton:hover {{ border-color: #55575c; }}
+QToolButton#viewButton::menu-indicator {{ subcontrol-origin: padding; subcontrol-position: right center;
+    right: 5px; }}
 """
 
 

@@ -19,7 +19,15 @@ from lenslab.gui.viewport import Viewport
 from lenslab.gui.widgets import ResetSlider, SignedNumberEdit
 
 #: The view button's text is cut to this width (the whole of it is its tooltip).
-VIEW_BUTTON_TEXT_PX = 150
+VIEW_BUTTON_TEXT_PX = 130
+
+
+class _Spacer(QWidget):
+    """The room between the display controls and the render's: as wide as the bar leaves, and asking for none (a
+    plain widget's size hint would push the bar's last controls behind its » first)."""
+
+    def sizeHint(self) -> QSize:
+        return QSize(0, 0)
 
 
 def under_toolbar(bar: QToolBar, picture: QWidget) -> QMainWindow:
@@ -69,26 +77,26 @@ class ViewportToolbar(QObject):
         self.zoom_label.setMinimumWidth(40)
         bar.addWidget(self.zoom_label)
         bar.addSeparator()
-        exposure_label = QLabel(" EV ")
+        exposure_label = QLabel("EV")
         exposure_label.setToolTip("Display exposure")
         bar.addWidget(exposure_label)
         # The slider, a field to type a value into (1.5 is +1.5 EV; the arrows step a tenth) and a reset to 0,
         # all three the same setting (display only).
         self.exposure_slider = ResetSlider(Qt.Horizontal, default=0)
         self.exposure_slider.setRange(round(-10 * DISPLAY_EXPOSURE_STOPS), round(10 * DISPLAY_EXPOSURE_STOPS))
-        self.exposure_slider.setFixedWidth(84)
+        self.exposure_slider.setFixedWidth(64)
         self.exposure_slider.setValue(round(display.view.exposure_stops * 10))
         self.exposure_slider.setToolTip("Display exposure in stops (display only: the render is not restarted); "
                                         "double-click: back to 0")
         self.exposure_spin = SignedNumberEdit(-DISPLAY_EXPOSURE_STOPS, DISPLAY_EXPOSURE_STOPS, 1, 0.1, " EV")
         self.exposure_spin.setObjectName("displayExposure")
-        self.exposure_spin.setFixedWidth(64)
+        self.exposure_spin.setFixedWidth(58)
         self.exposure_spin.setToolTip("Display exposure in stops: type a value (1.5 is +1.5 EV); the arrow keys "
                                       "and the wheel step a tenth")
         self.exposure_reset = QToolButton()
         self.exposure_reset.setObjectName("exposureReset")
         self.exposure_reset.setText("\u21ba")  # ↺
-        self.exposure_reset.setStyleSheet("QToolButton { border: 1px solid #45464b; padding: 0px 5px; }"
+        self.exposure_reset.setStyleSheet("QToolButton { border: 1px solid #45464b; padding: 0px 2px; }"
                                           "QToolButton:disabled { color: #5c5e62; border-color: #38393c; }")
         self.exposure_reset.setToolTip("Display exposure back to 0 EV (or double-click the slider)")
         bar.addWidget(self.exposure_slider)
@@ -105,7 +113,7 @@ class ViewportToolbar(QObject):
         self.menus.fill_button_menu(self.view_menu)
         self.view_button.setMenu(self.view_menu)
         bar.addWidget(self.view_button)
-        spacer = QWidget()
+        spacer = _Spacer()
         spacer.setSizePolicy(QSizePolicy.Expanding, QSizePolicy.Preferred)
         bar.addWidget(spacer)
         self.quality_combo = QComboBox()
@@ -161,8 +169,9 @@ class ViewportToolbar(QObject):
         self.exposure_reset.setEnabled(exposure != 0)
 
     def _update_view_button(self) -> None:
-        """The button names the display and view (cut to its width); its tooltip says all of it."""
-        text = self.display.short_text()
+        """The button names the view (cut to its width: "ACES 2.0 SDR"), as a viewer's view menu does; its
+        tooltip names the display and the view in full. The status bar names both (RenderStatus)."""
+        text = self.display.short_view_text()
         metrics = QFontMetrics(self.view_button.font())
         self.view_button.setText(metrics.elidedText(text, Qt.ElideRight, VIEW_BUTTON_TEXT_PX))
         view = self.display.view

@@ -22,7 +22,7 @@ from lenslab.gui.camera_panel.aperture import (
 from lenslab.gui.camera_panel.bokeh import BokehSection
 from lenslab.gui.camera_panel.depth_of_field import DepthOfFieldSection, DofDiagram
 from lenslab.gui.camera_panel.exposure import (ISO_SPEEDS, SHUTTER_SCALES, SHUTTER_SPEEDS, ExposureSection,
-                                               metered_shutter, step_shutter)
+                                               dial_mark, metered_shutter, step_shutter)
 from lenslab.gui.camera_panel.focal_length import COMMON_FOCAL_LENGTHS, FOCAL_RANGE, FocalLengthSection
 from lenslab.gui.camera_panel.focus import FOCUS_RANGE, FocusSection
 from lenslab.gui.camera_panel.lens import LensSection, lens_short_name
@@ -38,7 +38,7 @@ __all__ = [
     "FocusSection", "DepthOfFieldSection", "ExposureSection", "SensorSection",
     # What this module held before its sections had modules of their own.
     "AutoNumberEdit", "IrisGlyph", "DofDiagram", "StopSlider", "lens_short_name", "step_shutter",
-    "metered_shutter", "FULL_STOPS",
+    "metered_shutter", "dial_mark", "FULL_STOPS",
     "STOP_SCALE_NAMES", "STEP_WORDS", "SENSOR_FIT_NAMES", "ISO_SPEEDS", "SHUTTER_SCALES", "SHUTTER_SPEEDS",
     "COMMON_FOCAL_LENGTHS", "FOCAL_RANGE", "FOCUS_RANGE",
 ]

@@ -43,13 +43,22 @@ SHUTTER_SCALES = {
 SHUTTER_SPEEDS = SHUTTER_SCALES["full"]
 
 
-def metered_shutter(reading_cd_m2: float, f_number: float, iso: float, light_fraction: float = 1.0) -> tuple[float, float]:
+def metered_shutter(reading_cd_m2: float, f_number: float, iso: float,
+                    light_fraction: float = 1.0) -> tuple[float, float]:
     """(EV100, shutter seconds) a meter reading of ``reading_cd_m2`` suggests at ``f_number`` and ``iso``: the EV100
     of the reading (the light the aperture passes counted, as the auto exposure counts it) and the shutter time
-    that gives it, on the nearest third stop, within the shutter's range."""
+    that gives it on the nearest third stop (``nearest_third_stop_shutter``), as the third-stop dial marks it
+    (2^-7 s is the mark 1/125: a camera's speeds are its marks), within the shutter's range."""
     ev = metered_ev100(reading_cd_m2) - math.log2(light_fraction)
     seconds = nearest_third_stop_shutter(shutter_for(ev, f_number, iso))
-    return ev, min(max(seconds, SHUTTER_RANGE_S[0]), SHUTTER_RANGE_S[1])
+    return ev, dial_mark(min(max(seconds, SHUTTER_RANGE_S[0]), SHUTTER_RANGE_S[1]))
+
+
+def dial_mark(seconds: float) -> float:
+    """The third-stop dial's mark for a third-stop time (1/125 for 2^-7 s, 1/8 for 2^-3): the mark within a sixth of
+    a stop of it; the time itself off the dial's ends (beyond 30 s or 1/8000 s)."""
+    mark = min(SHUTTER_SCALES["third"], key=lambda t: abs(math.log2(t / seconds)))
+    return float(mark) if abs(math.log2(mark / seconds)) < 1 / 6 else float(seconds)
 
 
 def step_shutter(seconds: float, steps: int, scale: str = DEFAULT_STOP_SCALE) -> float:
@@ -243,10 +252,10 @@ class ExposureSection(CameraSection):
         if reading is None:
             text = "Meter: waiting for the picture"
         elif suggested is None:
-            text = f"Meter ({where}): nothing to read, the frame is black"
+            text = "Meter: nothing to read, the frame is black"
         else:
             ev, seconds = suggested
-            text = (f"Meter ({where}): EV {ev:.1f} → {format_shutter(seconds)} at {format_f_number(cam.f_number)}"
+            text = (f"Meter: EV {ev:.1f} → {format_shutter(seconds)} at {format_f_number(cam.f_number)}"
                     f", ISO {cam.iso:g}")
             self.meter_label.setToolTip(f"The render's scene-linear luminance inside the frame reads "
                                         f"{reading.luminance:.4g} cd/m² ({where}"
