@@ -1,8 +1,8 @@
 """Snapshots and A/B comparison: keep a render at f/1.4 and compare it with the live one at f/4,
 with a split wipe or side by side.
 
-The store's rules (the cap, the labels, the picture made again through another view) are checked without a window; the rest drives the
-studio offscreen. Pixel checks compare a grab of the viewport with the two pictures at 400 %, where the viewport
+The store's rules (the cap, the labels, the picture made again through another view) are checked without a window;
+the rest drives the studio offscreen. Pixel checks compare a grab of the viewport with the two pictures at 400 %, where the viewport
 draws pixels as they are (no smoothing), so that each screen pixel is one picture pixel exactly.
 """
 

@@ -353,8 +353,8 @@ class MainWindow(QMainWindow):
         first of its permanent labels; it gives way before the window does."""
         self.view_label = QLabel()
         self.view_label.setObjectName("viewLabel")
-        self.view_label.setSizePolicy(QSizePolicy.Ignored, QSizePolicy.Preferred)
-        self.view_label.setMinimumWidth(0)
+        self.view_label.setSizePolicy(QSizePolicy.Preferred, QSizePolicy.Preferred)
+        self.view_label.setMinimumWidth(1)  # not its text's: a narrow window cuts it rather than growing
         self.statusBar().insertPermanentWidget(0, self.view_label)
         self._show_view_label()
         self.display.changed.connect(self._show_view_label)
@@ -362,8 +362,6 @@ class MainWindow(QMainWindow):
     def _show_view_label(self, *_args) -> None:
         text = self.display.short_text()
         self.view_label.setText(text)
-        self.view_label.setFixedWidth(self.view_label.fontMetrics().horizontalAdvance(text) + 16)
-        self.view_label.setMinimumWidth(0)
         self.view_label.setToolTip(f"The view transform: {self.display.describe()} (View > Display, View Transform, "
                                    "Look)")
 

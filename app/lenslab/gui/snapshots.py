@@ -2,8 +2,8 @@
 
 A :class:`Snapshot` keeps the picture as it was shown (RGBA8, with the view transform it was made through and the
 camera's exposure on its radiance), the linear radiance behind it (so that a new view transform makes it again
-exactly as the viewport does the live picture, and the readout still reads it), a copy of the camera and of the mounted lens, the sample count, the
-time, and a name the user may give it. A :class:`SnapshotStore` holds the last :data:`MAX_SNAPSHOTS` of them within
+exactly as the viewport does the live picture, and the readout still reads it), a copy of the camera and of the
+mounted lens, the sample count, the time, and a name the user may give it. A :class:`SnapshotStore` holds the last :data:`MAX_SNAPSHOTS` of them within
 :data:`MAX_BYTES`, oldest evicted first, which one is the A side, and how A meets the live picture (B): not at all,
 a split wipe with a divider, or side by side. Observers (the snapshot dock, the viewport's comparison) connect to
 ``store.events`` and are told which part changed: ``"snapshots"``, ``"a"``, ``"mode"`` or ``"divider"``.
