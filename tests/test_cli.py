@@ -544,3 +544,52 @@ def test_a_reader_that_stops_reading_gets_no_error_line(tmp_path):
     finally:
         os.close(write_end)
     assert result.stderr == "" and result.returncode == 141
+
+
+STUDIO_CONFIG = """ocio_profile_version: 2
+roles: {default: Linear Rec.709 (sRGB), scene_linear: Linear Rec.709 (sRGB)}
+file_rules:
+  - !<Rule> {name: Default, colorspace: default}
+displays:
+  Studio Monitor:
+    - !<View> {name: Gamma 2.2, colorspace: Studio Display}
+colorspaces:
+  - !<ColorSpace> {name: Linear Rec.709 (sRGB), isdata: false}
+  - !<ColorSpace>
+    name: Studio Display
+    from_scene_reference: !<ExponentTransform> {value: 2.2, direction: inverse}
+"""
+
+
+def test_a_studios_own_config_from_ocio_rules_the_picture(renderer, tmp_path, capsys, monkeypatch):
+    """$OCIO as every OCIO application reads it: its display and view make the PNG (here a plain gamma 2.2 of the
+    exposed EXR), and the file says so; --ocio-config names one for a single render, before $OCIO."""
+    config = tmp_path / "studio.ocio"
+    config.write_text(STUDIO_CONFIG)
+    monkeypatch.setenv("OCIO", str(config))
+    for suffix in (".exr", ".png"):
+        status, err = run_cli(capsys, "dof_chart", "--headless", "-o", tmp_path / f"shot{suffix}", *SMALL)
+        assert status == 0, err
+    linear, _ = read_image(tmp_path / "shot.exr")
+    picture, metadata = read_image(tmp_path / "shot.png")
+    assert np.abs(picture - np.clip(linear, 0, 1) ** (1 / 2.2)).max() <= 0.5 / 255 + 1e-4
+    assert metadata["lenslab:Display"] == "Studio Monitor" and metadata["lenslab:View"] == "Gamma 2.2"
+    assert metadata["lenslab:OCIOConfig"] == str(config)
+    # The built-in config for one render, by its URI, whatever $OCIO says.
+    status, err = run_cli(capsys, "dof_chart", "--headless", "-o", tmp_path / "aces.png", *SMALL,
+                          "--ocio-config", "ocio://cg-config-v4.0.0_aces-v2.0_ocio-v2.5")
+    assert status == 0, err
+    _, metadata = read_image(tmp_path / "aces.png")
+    assert metadata["lenslab:Display"] == "sRGB - Display" and metadata["lenslab:View"].startswith("ACES 2.0")
+
+
+def test_a_broken_ocio_config_stops_the_render_naming_the_file(renderer, tmp_path, capsys, monkeypatch):
+    broken = tmp_path / "broken.ocio"
+    broken.write_text("ocio_profile_version: 2\nroles: [\n")
+    monkeypatch.setenv("OCIO", str(broken))
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "c.png", *SMALL)
+    assert status == 1 and f"{broken} (from $OCIO): not a usable OCIO config" in err
+    assert err.count("\n") == 1 and not (tmp_path / "c.png").exists()
+    status, err = run_cli(capsys, "cornell_box", "--headless", "-o", tmp_path / "c.png", *SMALL,
+                          "--ocio-config", tmp_path / "none.ocio")
+    assert status == 2 and "--ocio-config: no such file" in err

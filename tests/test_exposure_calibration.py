@@ -97,3 +97,11 @@ def test_an_auto_exposed_file_says_what_the_meter_chose(renderer, tmp_path, caps
     assert float(metadata["ExposureTime"]) == pytest.approx(shutter_for(metered_ev100(reading), 4.0, 200), rel=1e-5)
     assert float(metadata["lenslab:EV100"]) == pytest.approx(metered_ev100(reading), abs=1e-5)
     assert metadata["Exif:ExposureProgram"] == 3 and metadata["lenslab:ExposureMode"] == "auto"
+
+
+def test_a_reading_taken_already_is_the_same_as_metering_the_image():
+    image = np.full((20, 30), 75.0)
+    assert camera_exposure("auto", 2.8, 1 / 60, 100, reading=75.0) == camera_exposure("auto", 2.8, 1 / 60, 100,
+                                                                                      luminance=image)
+    with pytest.raises(ValueError, match="needs the image to meter"):
+        camera_exposure("auto", 2.8, 1 / 60, 100)

@@ -212,10 +212,9 @@ def render_headless(args) -> int:
                  "exposure": args.exposure != 0.0, "contrast": args.contrast != 1.0}
         for name in (name for name, yes in given.items() if yes):
             _warn(f"--{name} applies to pictures only: an EXR keeps the scene-linear values")
-    if args.ocio_config:  # the config of the whole render: its textures as well as its picture
-        from lenslab.colour_management.config import use_config
+    from lenslab.colour_management.config import use_config
 
-        use_config(args.ocio_config)
+    use_config(args.ocio_config or "")  # the config of the whole render, textures and picture ("": $OCIO's)
     overrides = scene_overrides(args)
     if args.denoise:  # a denoiser that cannot run says so now, not after the render
         from lenslab.render.denoise import DenoiseError, describe

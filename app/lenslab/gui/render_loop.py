@@ -716,8 +716,7 @@ class RenderLoop:
         reading = self._reading
         if reading is None or not reading.luminance > 0:
             return dataclasses.replace(camera, exposure_mode="physical").exposure(light)
-        # The meter's reading stands for the frame it read: metered again here as a one-pixel picture of it.
-        return camera.exposure(light, np.full((1, 1), reading.luminance, np.float64))
+        return camera.exposure(light, reading=reading.luminance)
 
     def _picture_view(self) -> ViewTransform:
         """The viewport's view transform with the camera's exposure added to its exposure (so a stop of aperture

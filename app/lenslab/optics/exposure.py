@@ -129,11 +129,11 @@ class Exposure:
 
 def camera_exposure(mode: str, f_number: float, shutter_s: float, iso: float, light_fraction: float = 1.0,
                     luminance: np.ndarray | None = None, meter_mode: str = "average",
-                    spot: tuple[float, float] = (0.5, 0.5)) -> Exposure:
+                    spot: tuple[float, float] = (0.5, 0.5), reading: float | None = None) -> Exposure:
     """The exposure of a camera in ``mode`` (EXPOSURE_MODES). ``auto`` reads ``luminance`` (H, W: the render's
-    scene-linear luminance) with the meter and sets the shutter so that its reading lands at middle grey, the
-    f-number and ISO as given (aperture priority). The aperture's ``light_fraction`` counts in both physical
-    modes, as the light a camera's through-the-lens meter sees."""
+    scene-linear luminance) with the meter, or takes the meter's ``reading`` (cd/m^2) made already, and sets the
+    shutter so that it lands at middle grey, the f-number and ISO as given (aperture priority). The aperture's
+    ``light_fraction`` counts in both physical modes, as the light a camera's through-the-lens meter sees."""
     if mode not in EXPOSURE_MODES:
         raise ValueError(f"unknown exposure mode '{mode}' (choose from {', '.join(EXPOSURE_MODES)})")
     if mode == "compensated":
@@ -141,9 +141,10 @@ def camera_exposure(mode: str, f_number: float, shutter_s: float, iso: float, li
     if mode == "physical":
         return Exposure(exposure_scale(f_number, shutter_s, iso, light_fraction), shutter_s,
                         ev100(f_number, shutter_s, iso))
-    if luminance is None:
-        raise ValueError("auto exposure needs the image to meter")
-    reading = meter_luminance(luminance, meter_mode, spot)
+    if reading is None:
+        if luminance is None:
+            raise ValueError("auto exposure needs the image to meter, or a reading")
+        reading = meter_luminance(luminance, meter_mode, spot)
     if not reading > 0.0:  # a black frame: nothing to meter, the camera's own shutter stays
         return Exposure(exposure_scale(f_number, shutter_s, iso, light_fraction), shutter_s,
                         ev100(f_number, shutter_s, iso), 0.0)

@@ -249,11 +249,12 @@ class ThinLensCamera:
         return exposure_scale(self.f_number, self.shutter_s, self.iso, light_fraction)
 
     def exposure(self, light_fraction: float = 1.0, luminance: np.ndarray | None = None,
-                 spot: tuple[float, float] = (0.5, 0.5)) -> Exposure:
+                 spot: tuple[float, float] = (0.5, 0.5), reading: float | None = None) -> Exposure:
         """This camera's exposure of a picture whose scene-linear luminance is ``luminance`` (H, W; the auto mode
-        meters it with ``metering``): lenslab.optics.exposure.camera_exposure."""
+        meters it with ``metering``), or of which the meter's ``reading`` was taken already:
+        lenslab.optics.exposure.camera_exposure."""
         return camera_exposure(self.exposure_mode, self.f_number, self.shutter_s, self.iso, light_fraction,
-                               luminance, self.metering, spot)
+                               luminance, self.metering, spot, reading)
 
     def depth_of_field(self, width: int | None = None, height: int | None = None,
                        light_fraction: float = 1.0, reference: str | None = None) -> DepthOfField:

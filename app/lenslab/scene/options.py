@@ -184,6 +184,16 @@ def _existing_file(text: str) -> str:
     return str(path.resolve())
 
 
+def _ocio_config(text: str) -> str:
+    """An OCIO config file named relative to the current folder (made absolute), or a built-in config by its URI
+    (``ocio://cg-config-latest``); read now, so that a broken one is the option's error."""
+    from lenslab.colour_management.config import load_config
+
+    source = text.strip() if text.strip().startswith("ocio://") else _existing_file(text)
+    load_config(source)  # ColourConfigError, a ValueError, names the file and OCIO's reason
+    return source
+
+
 def _aperture_image_file(text: str) -> str:
     """An aperture image named on the command line or in a batch file: read now, so that a file that is missing,
     unreadable or black is blamed on the option that named it, not on the scene it is rendered with."""
@@ -271,8 +281,9 @@ _ROWS = (
            unit="stops", metavar="STOPS", bounds=EXPOSURE_RANGE, metadata="lenslab:DisplayExposureStops", scene=False),
     Option("contrast", float, "pictures only: contrast about middle grey (1 = as the view makes it)",
            metavar="C", bounds=CONTRAST_RANGE, metadata="lenslab:Contrast", scene=False),
-    Option("ocio_config", str, "an OpenColorIO config file (default: $OCIO, else the built-in ACES config)",
-           metavar="FILE", parse_text=_existing_file, metadata="lenslab:OCIOConfig", scene=False),
+    Option("ocio_config", str, "an OpenColorIO config file, or a built-in one by its ocio:// URI (default: $OCIO, "
+           "else the built-in ACES config)", metavar="FILE", parse_text=_ocio_config, metadata="lenslab:OCIOConfig",
+           scene=False),
 )
 
 #: Every option by its name.
