@@ -282,18 +282,3 @@ def test_a_picture_cut_short_is_not_whole(tmp_path, suffix):
         with open(cut, "r+b") as file:
             file.truncate(keep)
         assert film._incompleteness(cut, spec) is not None
-
-
-@pytest.mark.parametrize("suffix", [".tif", ".jpg"])
-@pytest.mark.parametrize("limit", [0, 16384], ids=["nothing-fits", "part-fits"])
-def test_a_picture_that_does_not_fit_is_an_error_and_leaves_the_old_file(tmp_path, suffix, limit):
-    """For a JPEG this is also the process surviving: libjpeg, as OpenImageIO sets it up, exits on a failed write."""
-    from tests.test_output_faults import file_size_limit, noise
-
-    target = tmp_path / f"shot{suffix}"
-    write_image(target, noise(8, 8, seed=1))
-    old = target.read_bytes()
-    with file_size_limit(limit), pytest.raises(ExportError) as failure:
-        write_image(target, noise(128, 128))
-    assert str(failure.value).startswith(f"{target}: cannot ") and str(failure.value).endswith("(File too large)")
-    assert [p.name for p in tmp_path.iterdir()] == [target.name] and target.read_bytes() == old
