@@ -105,3 +105,12 @@ def test_a_reading_taken_already_is_the_same_as_metering_the_image():
                                                                                       luminance=image)
     with pytest.raises(ValueError, match="needs the image to meter"):
         camera_exposure("auto", 2.8, 1 / 60, 100)
+
+
+def test_a_meter_behind_a_smaller_aperture_asks_for_a_longer_shutter():
+    """Half the round stop's light (an aperture image, a cat's eye): the meter reads a stop less, and the shutter it
+    suggests, in the auto mode and in the studio's meter alike, doubles."""
+    assert metered_ev100(400.0, light_fraction=0.5) == pytest.approx(metered_ev100(400.0) - 1.0)
+    full = camera_exposure("auto", 4.0, 1 / 60, 100, reading=400.0)
+    half = camera_exposure("auto", 4.0, 1 / 60, 100, light_fraction=0.5, reading=400.0)
+    assert half.shutter_s == pytest.approx(2 * full.shutter_s)

@@ -224,3 +224,13 @@ def test_auto_exposure_makes_a_uniform_sky_middle_grey(qtbot, make_window):
     assert np.abs(frame.display[..., :3].astype(int) - 118).max() <= 1
     # The settings it chose make the meter's EV100 (log2(L S / K), 14.6 here: sunny 16's).
     assert frame.exposure.ev100 == pytest.approx(math.log2(3200 * 100 / 12.5), abs=0.01)
+
+
+def test_the_panels_suggestion_counts_the_light_the_aperture_passes():
+    """The studio's meter and the auto exposure agree on an aperture passing half the light: a stop longer."""
+    from lenslab.gui.camera_panel.exposure import metered_shutter
+
+    full_ev, full = metered_shutter(400.0, 4.0, 100)
+    half_ev, half = metered_shutter(400.0, 4.0, 100, light_fraction=0.5)
+    assert half_ev == pytest.approx(full_ev - 1.0)
+    assert math.log2(half / full) == pytest.approx(1.0, abs=1 / 6)  # on the dial's marks

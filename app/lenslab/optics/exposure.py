@@ -73,9 +73,18 @@ def exposure_scale(f_number: float, shutter_s: float, iso: float, light_fraction
     return MIDDLE_GREY * t * s * light_fraction / (REFLECTED_METER_K * n * n)
 
 
-def metered_ev100(luminance_cd_m2: float) -> float:
-    """The EV100 a reflected-light meter suggests for a reading of ``luminance_cd_m2``: ``log2(L 100 / K)``."""
-    return math.log2(require_positive("metered luminance", luminance_cd_m2) * 100.0 / REFLECTED_METER_K)
+def metered_ev100(luminance_cd_m2: float, light_fraction: float = 1.0) -> float:
+    """The EV100 a reflected-light meter suggests for a reading of ``luminance_cd_m2``: ``log2(L 100 / K)``. A
+    meter behind an aperture that passes ``light_fraction`` of the round stop's light sees that much less: the EV
+    is lower by log2 of it, and the shutter it asks for longer."""
+    return (math.log2(require_positive("metered luminance", luminance_cd_m2) * 100.0 / REFLECTED_METER_K)
+            + math.log2(require_positive("light_fraction", light_fraction)))
+
+
+def ev100_to_luminance(ev: float) -> float:
+    """The luminance (cd/m^2) a reflected-light meter reads as ``ev`` at ISO 100, the inverse of metered_ev100:
+    (K / 100) 2^EV. EV 0: 0.125 cd/m^2."""
+    return REFLECTED_METER_K / 100.0 * 2.0 ** ev
 
 
 def shutter_for(ev: float, f_number: float, iso: float) -> float:
@@ -96,8 +105,9 @@ def nearest_third_stop_shutter(seconds: float) -> float:
 def meter_luminance(luminance: np.ndarray, mode: str = "average", spot: tuple[float, float] = (0.5, 0.5)) -> float:
     """A meter's reading (cd/m^2 on a photometric scene) of the image's luminance (H, W): ``average``, the mean
     weighted towards the frame's centre (a gaussian CENTRE_WEIGHT_SIGMA of the frame wide, as a camera's
-    centre-weighted average), or ``spot``, the mean over a disk of SPOT_FRACTION of the diagonal at ``spot`` (x, y as fractions of
-    the width and height from the top left). Pixels with no value (NaN) do not count; 0 for an image with none."""
+    centre-weighted average), or ``spot``, the mean over a disk of SPOT_FRACTION of the diagonal at ``spot`` (x, y
+    as fractions of the width and height from the top left). Pixels with no value (NaN) do not count; 0 for an
+    image with none."""
     if mode not in METER_MODES:
         raise ValueError(f"unknown meter mode '{mode}' (choose from {', '.join(METER_MODES)})")
     lum = np.asarray(luminance, np.float64)
@@ -148,8 +158,7 @@ def camera_exposure(mode: str, f_number: float, shutter_s: float, iso: float, li
     if not reading > 0.0:  # a black frame: nothing to meter, the camera's own shutter stays
         return Exposure(exposure_scale(f_number, shutter_s, iso, light_fraction), shutter_s,
                         ev100(f_number, shutter_s, iso), 0.0)
-    # The meter sees the light the aperture passes: a fraction of it reads as that much less luminance.
-    ev = metered_ev100(reading) + math.log2(require_positive("light_fraction", light_fraction))
+    ev = metered_ev100(reading, light_fraction)
     chosen = min(max(shutter_for(ev, f_number, iso), SHUTTER_RANGE_S[0]), SHUTTER_RANGE_S[1])
     return Exposure(exposure_scale(f_number, chosen, iso, light_fraction), chosen, ev100(f_number, chosen, iso),
                     reading)

@@ -35,7 +35,7 @@ import math
 import numpy as np
 
 from lenslab.colour_management.working_space import DEFAULT_WORKING_SPACE, luminance
-from lenslab.optics.exposure import REFLECTED_METER_K
+from lenslab.optics.exposure import ev100_to_luminance
 from lenslab.scene.fields import declared_choices
 from lenslab.scene.lights import Light, PointLight, SpotLight
 from lenslab.scene.materials import Emissive, Material, inner_materials
@@ -53,12 +53,6 @@ ENVIRONMENT_MAP_UNITS = declared_choices(EnvironmentMap, "unit")
 
 
 # -- the formulas -------------------------------------------------------------------------------------------------
-def ev100_to_luminance(ev: float) -> float:
-    """The luminance (cd/m^2) a reflected-light meter reads as ``ev`` at ISO 100: (K / 100) 2^EV, K = 12.5 (ISO
-    2720; HDRP's ConvertEvToLuminance). EV 0: 0.125 cd/m^2."""
-    return REFLECTED_METER_K / 100.0 * 2.0 ** ev
-
-
 def area_lumens_to_nits(rgb: RGB, area_m2: float, two_sided: bool = False) -> RGB:
     """The radiance (cd/m^2) of a Lambertian emitter of total flux ``rgb`` (lm) over ``area_m2``: Phi / (pi A),
     halved when it emits from both faces (each side then carries half the flux)."""

@@ -17,7 +17,7 @@ from PySide6.QtWidgets import QComboBox, QGridLayout, QHBoxLayout, QLabel, QPush
 from lenslab.gui.camera_panel.aperture import STEP_WORDS
 from lenslab.gui.camera_panel.section import CameraSection
 from lenslab.gui.widgets import hint
-from lenslab.optics.exposure import (SHUTTER_RANGE_S, ev100, format_shutter, metered_ev100,
+from lenslab.optics.exposure import (SHUTTER_RANGE_S, ev100, ev100_to_luminance, format_shutter, metered_ev100,
                                      nearest_third_stop_shutter, parse_shutter, shutter_for)
 from lenslab.optics.stops import DEFAULT_STOP_SCALE, format_f_number
 from lenslab.scene.camera import ThinLensCamera
@@ -49,7 +49,7 @@ def metered_shutter(reading_cd_m2: float, f_number: float, iso: float,
     of the reading (the light the aperture passes counted, as the auto exposure counts it) and the shutter time
     that gives it on the nearest third stop (``nearest_third_stop_shutter``), as the third-stop dial marks it
     (2^-7 s is the mark 1/125: a camera's speeds are its marks), within the shutter's range."""
-    ev = metered_ev100(reading_cd_m2) - math.log2(light_fraction)
+    ev = metered_ev100(reading_cd_m2, light_fraction)
     seconds = nearest_third_stop_shutter(shutter_for(ev, f_number, iso))
     return ev, dial_mark(min(max(seconds, SHUTTER_RANGE_S[0]), SHUTTER_RANGE_S[1]))
 
@@ -302,7 +302,7 @@ class ExposureSection(CameraSection):
         self.shutter.setEditText(format_shutter(shown))
         ev = ev100(cam.f_number, shown, cam.iso)
         if physical:
-            info = f"EV₁₀₀ {ev:.1f}: a reflected-light meter calls {0.125 * 2 ** ev:.3g} cd/m² mid-grey."
+            info = f"EV₁₀₀ {ev:.1f}: a reflected-light meter calls {ev100_to_luminance(ev):.3g} cd/m² mid-grey."
         elif auto and self.auto_exposure is not None:
             info = (f"Auto: the meter chose {format_shutter(shown)} at {format_f_number(cam.f_number)}, ISO "
                     f"{cam.iso:g} (EV₁₀₀ {ev:.1f}), putting its reading at middle grey.")
