@@ -779,7 +779,7 @@ class RenderLoop:
         if with_linear or converged or self._paused or not self.busy or auto_unmetered \
                 or now - self._last_linear >= LINEAR_INTERVAL:
             image = session.image()  # resolved from the read-back itself, without a copy of the sums
-            _fill, fill_linear = self._fill_pictures()
+            fill_linear = self._fill_linear()
             if has_empty and fill_linear is not None:
                 image[empty] = fill_linear[empty]
             # The meter reads the whole frame: where nothing is rendered yet, what shows there (the preview, the
@@ -788,22 +788,31 @@ class RenderLoop:
             if self._exposure_moved(used):  # auto: the reading moved; the picture is made at the new exposure
                 picture = session.display(self._picture_view())
             self._last_linear = now
-        fill, _fill_linear = self._fill_pictures()
+        fill = self._fill_picture() if has_empty else None
         if has_empty and fill is not None:
             picture[empty] = fill[empty]
         elif has_empty:
             picture[empty, 3] = 255  # black
         self._offer(picture, image, preview=False, converged=converged)
 
-    def _fill_pictures(self) -> tuple[np.ndarray | None, np.ndarray | None]:
+    def _fill_picture(self) -> np.ndarray | None:
         """What shows where the render has no sample yet: this edit's preview, else the last picture shown."""
-        w, h = self._size
         if self._preview_image is not None:
-            return self._preview_picture(), self._preview_linear
-        if self._backdrop is not None and self._backdrop.shape[:2] == (h, w):
-            linear = self._backdrop_linear
-            return self._backdrop, linear if linear is not None and linear.shape[:2] == (h, w) else None
-        return None, None
+            return self._preview_picture()
+        return self._backdrop if self._has_backdrop() else None
+
+    def _fill_linear(self) -> np.ndarray | None:
+        """The linear image of :meth:`_fill_picture`'s picture (None where there is none), without making the
+        picture: the pixel readout and the meter need only this."""
+        if self._preview_image is not None:
+            return self._preview_linear
+        linear = self._backdrop_linear
+        fits = self._has_backdrop() and linear is not None and linear.shape[:2] == self._backdrop.shape[:2]
+        return linear if fits else None
+
+    def _has_backdrop(self) -> bool:
+        w, h = self._size
+        return self._backdrop is not None and self._backdrop.shape[:2] == (h, w)
 
     # -- the denoiser ------------------------------------------------------------------------------------------
     def _denoise_image(self, image: np.ndarray, albedo: np.ndarray, normal: np.ndarray) -> np.ndarray:
@@ -833,7 +842,7 @@ class RenderLoop:
         x, y, w, h = session.region_pixels
         crop = self._denoise_image(image[y:y + h, x:x + w], albedo[y:y + h, x:x + w], normal[y:y + h, x:x + w])
         if session.region is not None:  # outside the region: the last picture shown
-            _fill, fill_linear = self._fill_pictures()
+            fill_linear = self._fill_linear()
             if fill_linear is not None:
                 image = fill_linear.copy()
         image[y:y + h, x:x + w] = crop
