@@ -273,12 +273,10 @@ def render_headless(args) -> int:
 def _view_transform(args, working_space: str):
     """The view transform the command line asks for, checked against its OCIO config before anything renders."""
     from lenslab.colour_management.config import ColourConfigError
-    from lenslab.colour_management.view import ViewTransform
+    from lenslab.scene.options import view_transform
 
-    view = ViewTransform(display=args.display or "", view=args.view or "", looks=args.look or "",
-                         exposure_stops=args.exposure, contrast=args.contrast, working_space=working_space)
     try:
-        return view.resolved()
+        return view_transform(vars(args), working_space).resolved()
     except ColourConfigError as exc:
         raise CliError(str(exc)) from None
 

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lenslab.colour_management.view import ViewTransform
+from lenslab.colour_management.view import METADATA, ViewTransform
 from lenslab.optics import format_camera_settings
 from lenslab.render import film
 
@@ -108,7 +108,7 @@ def _thumbnail(frame: Frame, width: int) -> np.ndarray | None:
     resized = oiio.ImageBufAlgo.resize(source, roi=oiio.ROI(0, width, 0, height, 0, 1, 0, 3))
     small = resized.get_pixels(oiio.FLOAT).reshape(height, width, 3)
     if frame.image.suffix.lower() == ".exr":  # scene-linear (resized as light adds up): through the view transform
-        space = str(metadata.get("lenslab:WorkingSpace", frame.view.working_space))
+        space = str(metadata.get(METADATA["working_space"], frame.view.working_space))
         return film.display_pixels(small, replace(frame.view, working_space=space))
     return np.clip(small, 0.0, 1.0)
 

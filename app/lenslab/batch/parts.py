@@ -231,5 +231,5 @@ class ShotAssembly:
         return write_image(self.shot.output, image, metadata,
                            sensor_exposure=float(metadata.get("lenslab:ExposureScale", 1.0)),
                            view=dataclasses.replace(self.shot.view,
-                                                    working_space=str(metadata["lenslab:WorkingSpace"])))
+                                                    working_space=str(metadata[OPTIONS["working_space"].metadata])))
 

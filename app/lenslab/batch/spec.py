@@ -37,7 +37,7 @@ from lenslab.image_files import read_file_bytes
 from lenslab.limits import LARGEST_NUMBER
 from lenslab.render.film import EXPORT_SUFFIXES, EXPORT_SUFFIXES_TEXT
 from lenslab.colour_management.view import ViewTransform
-from lenslab.scene.options import OLD_NAMES, OPTIONS, SCENE_OPTIONS
+from lenslab.scene.options import OLD_NAMES, OPTIONS, SCENE_OPTIONS, VIEW_OPTIONS, view_transform
 from lenslab.scene.overrides import SceneOverrides
 
 #: Parts one shot may be split into (one per worker).
@@ -336,11 +336,7 @@ def _shot(number: int, index: int, values: dict, swept: list[str], folder: Path,
 def _view_transform(values: dict) -> ViewTransform:
     """The view transform a shot's pictures are made with, checked against its OCIO config (its working space is
     the scene's, set when the image is written)."""
-    checked = {name: OPTIONS[name].check(values[name]) for name in ("display", "view", "look", "exposure",
-                                                                    "contrast", "ocio_config") if name in values}
-    view = ViewTransform(display=checked.get("display", ""), view=checked.get("view", ""),
-                         looks=checked.get("look", ""), exposure_stops=checked.get("exposure", 0.0),
-                         contrast=checked.get("contrast", 1.0), config=checked.get("ocio_config", ""))
+    view = view_transform({name: OPTIONS[name].check(values[name]) for name in VIEW_OPTIONS if name in values})
     view.resolved()
     return view
 

@@ -27,6 +27,11 @@ VIEW_ALIASES = {"filmic": "", "clamp": "Un-tone-mapped"}
 #: Contrast about middle grey, as OCIO's ExposureContrastTransform pivots it.
 CONTRAST_PIVOT = 0.18
 EXPOSURE_RANGE = (-30.0, 30.0)
+#: The name a picture's metadata gives each part of the transform (the options that set them record the same:
+#: scene/options.py reads them here).
+METADATA = {"config": "lenslab:OCIOConfig", "display": "lenslab:Display", "view": "lenslab:View",
+            "looks": "lenslab:Looks", "exposure_stops": "lenslab:DisplayExposureStops", "contrast": "lenslab:Contrast",
+            "working_space": "lenslab:WorkingSpace"}
 CONTRAST_RANGE = (0.1, 10.0)
 
 
@@ -62,13 +67,15 @@ class ViewTransform:
         views = list(config.getViews(display))
         view = VIEW_ALIASES.get(self.view, self.view) or config.getDefaultView(display)
         if view not in views:
-            hint = " ('reinhard' was a tone curve of earlier versions: choose a view)" if self.view == "reinhard" else ""
+            hint = (" ('reinhard' was a tone curve of earlier versions: choose a view)" if self.view == "reinhard"
+                    else "")
             raise ColourConfigError(f"view '{self.view}' is not one of display '{display}''s views{hint} "
                                     f"(it has: {', '.join(views)})")
         for look in _look_names(self.looks):
             if config.getLook(look) is None:
                 have = [look.getName() for look in config.getLooks()]
-                raise ColourConfigError(f"look '{look}' is not in the OCIO config (it has: {', '.join(have) or 'none'})")
+                raise ColourConfigError(f"look '{look}' is not in the OCIO config "
+                                        f"(it has: {', '.join(have) or 'none'})")
         ocio_space_of(self.working_space, config)  # raises for a config without the working space
         return replace(self, display=display, view=view, looks=",".join(_look_names(self.looks)), _resolved=True)
 
@@ -88,10 +95,10 @@ class ViewTransform:
     def metadata(self) -> dict[str, object]:
         """What an exported picture says about how it was made from the render."""
         done = self.resolved()
-        return {"lenslab:OCIOConfig": config_name(done.config), "lenslab:Display": done.display,
-                "lenslab:View": done.view, "lenslab:Looks": done.looks,
-                "lenslab:DisplayExposureStops": float(done.exposure_stops), "lenslab:Contrast": float(done.contrast),
-                "lenslab:WorkingSpace": done.working_space}
+        values = {"config": config_name(done.config), "display": done.display, "view": done.view,
+                  "looks": done.looks, "exposure_stops": float(done.exposure_stops), "contrast": float(done.contrast),
+                  "working_space": done.working_space}
+        return {METADATA[part]: value for part, value in values.items()}
 
     # -- the transform -------------------------------------------------------------------------------------------
     def apply(self, linear: np.ndarray) -> np.ndarray:

@@ -301,8 +301,8 @@ def exposure_metadata(metadata: dict[str, object], image: np.ndarray) -> dict[st
     exposure = camera_exposure("auto", float(metadata[OPTIONS["f_number"].metadata]),
                                float(metadata[OPTIONS["shutter"].metadata]), float(metadata[OPTIONS["iso"].metadata]),
                                float(metadata["lenslab:ApertureLightFraction"]),
-                               luminance(image, str(metadata["lenslab:WorkingSpace"])),
-                               str(metadata["lenslab:Metering"]))
+                               luminance(image, str(metadata[OPTIONS["working_space"].metadata])),
+                               str(metadata[OPTIONS["metering"].metadata]))
     return {"lenslab:ExposureScale": exposure.scale, OPTIONS["shutter"].metadata: exposure.shutter_s,
             "lenslab:EV100": exposure.ev100, "lenslab:MeteredLuminance": exposure.metered_cd_m2}
 

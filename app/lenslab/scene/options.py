@@ -17,9 +17,10 @@ import math
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Mapping
 
-from lenslab.colour_management.view import CONTRAST_RANGE, EXPOSURE_RANGE
+from lenslab.colour_management.view import CONTRAST_RANGE, EXPOSURE_RANGE, METADATA as VIEW_METADATA, ViewTransform
+from lenslab.colour_management.working_space import DEFAULT_WORKING_SPACE
 from lenslab.scene.camera import MAX_IMAGE_SIDE, ThinLensCamera
 from lenslab.scene.fields import declared_choices, declared_range
 from lenslab.scene.scene import RenderSettings
@@ -263,7 +264,7 @@ _ROWS = (
     Option("metering", str, "how the auto exposure meters: average (centre-weighted) or spot (the frame's centre)",
            "camera.metering", metadata="lenslab:Metering"),
     Option("working_space", str, "the RGB the scene's colours are in and the renderer computes in",
-           "render.working_space", metadata="lenslab:WorkingSpace"),
+           "render.working_space", metadata=VIEW_METADATA["working_space"]),
     # How the image is made and written, not the scene: the render job's and the output's.
     Option("time_limit", float, "stop after this many seconds, keeping what has been rendered (at least one "
            "sample in every pixel)", unit="s", metavar="SECONDS", bounds=(0.001, 1e7), scene=False),
@@ -271,18 +272,19 @@ _ROWS = (
     # the built-in ACES config (lenslab.colour_management.view). Names are checked against the config when the
     # transform is made, where the config is known.
     Option("display", str, "the display a picture is made for (default: the OCIO config's first, sRGB)",
-           metavar="NAME", metadata="lenslab:Display", scene=False),
+           metavar="NAME", metadata=VIEW_METADATA["display"], scene=False),
     Option("view", str, "the display's view (default: its first, ACES 2.0 SDR in the built-in config; 'filmic' and "
            "'clamp' name that and 'Un-tone-mapped')", metavar="NAME", old_names=("tone_map",),
-           metadata="lenslab:View", scene=False),
+           metadata=VIEW_METADATA["view"], scene=False),
     Option("look", str, "OCIO looks applied before the view, comma separated", metavar="NAMES",
-           metadata="lenslab:Looks", scene=False),
+           metadata=VIEW_METADATA["looks"], scene=False),
     Option("exposure", float, "pictures only: brighten (+) or darken (-) by this many stops, in the view transform",
-           unit="stops", metavar="STOPS", bounds=EXPOSURE_RANGE, metadata="lenslab:DisplayExposureStops", scene=False),
+           unit="stops", metavar="STOPS", bounds=EXPOSURE_RANGE, metadata=VIEW_METADATA["exposure_stops"],
+           scene=False),
     Option("contrast", float, "pictures only: contrast about middle grey (1 = as the view makes it)",
-           metavar="C", bounds=CONTRAST_RANGE, metadata="lenslab:Contrast", scene=False),
+           metavar="C", bounds=CONTRAST_RANGE, metadata=VIEW_METADATA["contrast"], scene=False),
     Option("ocio_config", str, "an OpenColorIO config file, or a built-in one by its ocio:// URI (default: $OCIO, "
-           "else the built-in ACES config)", metavar="FILE", parse_text=_ocio_config, metadata="lenslab:OCIOConfig",
+           "else the built-in ACES config)", metavar="FILE", parse_text=_ocio_config, metadata=VIEW_METADATA["config"],
            scene=False),
 )
 
@@ -299,3 +301,16 @@ OLD_NAMES: dict[str, str] = {old: option.name for option in _ROWS for old in opt
 def option_named(name: str) -> Option:
     """The option called ``name`` or by an older spelling of it; KeyError for neither."""
     return OPTIONS[OLD_NAMES.get(name, name)]
+
+
+#: The options that make a picture's view transform, and the ViewTransform field each sets.
+VIEW_OPTIONS = {"display": "display", "view": "view", "look": "looks", "exposure": "exposure_stops",
+                "contrast": "contrast", "ocio_config": "config"}
+
+
+def view_transform(values: Mapping[str, object], working_space: str = DEFAULT_WORKING_SPACE) -> ViewTransform:
+    """The view transform the picture options among ``values`` (by option name; missing or None: the default)
+    describe, over ``working_space``: the command line's and a batch shot's alike. Not yet checked against its
+    config (``resolved()`` does that)."""
+    given = {field: values[name] for name, field in VIEW_OPTIONS.items() if values.get(name) is not None}
+    return ViewTransform(working_space=working_space, **given)
