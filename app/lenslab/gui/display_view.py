@@ -313,7 +313,7 @@ class ViewMenus(QObject):
         return actions
 
     def _changed(self, view: ViewTransform) -> None:
-        if [a for a in self.view_actions] != self.state.views():
+        if list(self.view_actions) != self.state.views():
             self._fill_views()  # another display: its views
         for actions, current in ((self.display_actions, view.display), (self.view_actions, view.view),
                                  (self.look_actions, view.looks)):
