@@ -36,6 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lenslab.colour_management.working_space import luminance
 from lenslab.render import denoise as oidn
 from lenslab.render.film import display_pixels
 from lenslab.render.gl import glsl_dir
@@ -44,6 +45,19 @@ from lenslab.scene.io.loader import open_scene, shipped_scene_names
 
 REFERENCE_SEED_OFFSETS = (1000, 2000)  # the reference's two halves: not the compared renders' samples
 TRIMMED = 0.001  # relMSE leaves out this share of pixels, those where it is largest
+
+
+def camera_exposure_of(scene, halves: np.ndarray) -> float:
+    """What the scene's camera multiplies its radiance by (lenslab.optics.exposure: 1 when compensated, its f-number,
+    shutter and ISO when physical, the meter's choice on the converged ``halves`` when auto). Every image here is
+    compared as the camera records it, where middle grey is 0.18: so relMSE's 0.01 and the display's values mean
+    the same whether the lights are written in nits or in plain numbers."""
+    camera = scene.camera
+    light = camera.aperture(scene.base_dir()).light_fraction
+    if camera.exposure_mode != "auto":
+        return camera.exposure(light).scale
+    converged = halves.mean(axis=0)
+    return camera.exposure(light, luminance=luminance(converged, scene.render.working_space)).scale
 
 
 def rel_mse(image: np.ndarray, halves: np.ndarray) -> float:
@@ -99,11 +113,12 @@ def reference(renderer, name: str, scene, spp: int, cache: Path) -> np.ndarray:
     return np.load(file)
 
 
-def progression(renderer, scene, ref: np.ndarray, seconds: float, denoised: bool,
-                quality: str = "fast") -> list[tuple[float, float, int, dict]]:
+def progression(renderer, scene, ref: np.ndarray, seconds: float, denoised: bool, quality: str = "fast",
+                exposure: float = 1.0) -> list[tuple[float, float, int, dict]]:
     """(seconds until shown, seconds sampled, spp, {metric: error}) at checkpoints sqrt(2) apart in sampling time,
     from the first full pass. A denoised image is shown once it is denoised: its time adds one denoise (what the
-    viewport pays for the frame it shows; how often it denoises while sampling is the viewport's choice)."""
+    viewport pays for the frame it shows; how often it denoises while sampling is the viewport's choice). Each image
+    is compared times ``exposure``, the camera's (``ref`` is exposed already)."""
     session = RenderSession(renderer, scene, feature_buffers=denoised)
     while session.samples_per_pixel < 1:
         session.step(1.0, 1)
@@ -116,7 +131,7 @@ def progression(renderer, scene, ref: np.ndarray, seconds: float, denoised: bool
             image = oidn.denoise(image, albedo, normal, quality=quality)
             extra = time.perf_counter() - start
         points.append((session.elapsed_seconds + extra, session.elapsed_seconds, session.samples_per_pixel,
-                       {metric: error(image, ref) for metric, error in METRICS.items()}))
+                       {metric: error(image * exposure, ref) for metric, error in METRICS.items()}))
         if session.elapsed_seconds >= seconds:
             break
         checkpoint = min(seconds, checkpoint * math.sqrt(2))
@@ -192,9 +207,12 @@ def main() -> None:
     for name in [name for name in args.scenes.split(",") if name]:
         scene = sized(open_scene(name), args.size)
         ref = reference(renderer, name, scene, args.reference_spp, args.cache)
+        exposure = camera_exposure_of(scene, ref)
+        ref = ref * exposure
         floor = reference_floor(ref)
-        plain = progression(renderer, scene, ref, args.seconds, denoised=False)
-        guided = progression(renderer, scene, ref, args.seconds, denoised=True, quality=args.quality)
+        plain = progression(renderer, scene, ref, args.seconds, denoised=False, exposure=exposure)
+        guided = progression(renderer, scene, ref, args.seconds, denoised=True, quality=args.quality,
+                             exposure=exposure)
         size = "x".join(map(str, scene.camera.resolution))
         for metric, threshold in thresholds:
             print(f"{name:<16} {size:>8} {metric:<12} {threshold:>7g} {seconds_to(plain, metric, threshold, True):>8} "

@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from denoise_convergence import REFERENCE_SEED_OFFSETS, rel_mse  # noqa: E402
+from denoise_convergence import REFERENCE_SEED_OFFSETS, camera_exposure_of, rel_mse  # noqa: E402
 
 from lenslab.gui.controller import VIEW_MARGIN  # noqa: E402
 from lenslab.gui.render_loop import CameraEdit, DenoiseEdit, RenderLoop, SceneEdit, TargetSpp  # noqa: E402
@@ -50,7 +50,8 @@ class QuietEvents:
 
 
 def reference(renderer, scene, size, spp: int, cache: Path) -> np.ndarray:
-    """The edited camera's converged viewport picture as two halves (2, H, W, 3), framed as the viewport frames."""
+    """The edited camera's converged viewport picture as two halves (2, H, W, 3), framed as the viewport frames,
+    exposed as its camera exposes it."""
     kernels = b"".join(p.read_bytes() for p in sorted(glsl_dir().glob("*.*")))
     key = hashlib.sha256(scene.source_path.read_bytes() + kernels + repr(
         (scene.camera, size, spp, VIEW_MARGIN, REFERENCE_SEED_OFFSETS)).encode()).hexdigest()[:16]
@@ -68,7 +69,8 @@ def reference(renderer, scene, size, spp: int, cache: Path) -> np.ndarray:
             halves.append(session.image())
             session.release()
         np.save(file, np.stack(halves))
-    return np.load(file)
+    halves = np.load(file)
+    return halves * camera_exposure_of(scene, halves)
 
 
 def time_edit(loop: RenderLoop, camera, size, generation: int, halves, seconds: float, threshold: float) -> dict:
@@ -82,7 +84,8 @@ def time_edit(loop: RenderLoop, camera, size, generation: int, halves, seconds: 
         if frame is None or frame.generation != generation:
             continue
         now = time.perf_counter() - start
-        error = rel_mse(frame.image, halves) if frame.image is not None else None
+        exposure = frame.exposure.scale if frame.exposure is not None else 1.0
+        error = rel_mse(frame.image * exposure, halves) if frame.image is not None else None
         if not frame.denoised:
             result["raw shown"] += 1
         if result["first"] is None:

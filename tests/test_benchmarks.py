@@ -111,3 +111,27 @@ def test_edit_to_clean_times_every_edit_and_counts_raw_pictures(renderer, tmp_pa
     assert len(rows) == 3
     assert all(cells[-1].strip() == "0" for cells in rows)  # no raw picture shown with the denoiser on
     assert len(list(tmp_path.glob("edit_reference_*.npy"))) == 3
+
+
+def test_the_convergence_errors_compare_pictures_as_the_camera_exposes_them():
+    # relMSE's 0.01 and the display MAE assume the picture's scale (middle grey 0.18); a scene lit in nits has
+    # radiance in the hundreds, which only the camera's exposure brings there.
+    import dataclasses
+
+    import numpy as np
+
+    from lenslab.scene.io.loader import open_scene
+
+    sys.path.insert(0, str(BENCHMARKS))
+    from denoise_convergence import camera_exposure_of
+
+    scene = open_scene("cornell_box")
+    camera = scene.camera
+    assert camera.exposure_mode == "physical"
+    halves = np.full((2, 4, 4, 3), 100.0, np.float32)  # 100 cd/m^2 everywhere
+    light = camera.aperture(scene.base_dir()).light_fraction
+    assert camera_exposure_of(scene, halves) == pytest.approx(camera.exposure_scale(light))
+    compensated = dataclasses.replace(scene, camera=dataclasses.replace(camera, exposure_mode="compensated"))
+    assert camera_exposure_of(compensated, halves) == 1.0
+    auto = dataclasses.replace(scene, camera=dataclasses.replace(camera, exposure_mode="auto"))
+    assert 100.0 * camera_exposure_of(auto, halves) == pytest.approx(0.18, rel=0.01)  # the meter's middle grey
