@@ -135,3 +135,15 @@ def test_the_convergence_errors_compare_pictures_as_the_camera_exposes_them():
     assert camera_exposure_of(compensated, halves) == 1.0
     auto = dataclasses.replace(scene, camera=dataclasses.replace(camera, exposure_mode="auto"))
     assert 100.0 * camera_exposure_of(auto, halves) == pytest.approx(0.18, rel=0.01)  # the meter's middle grey
+
+
+@pytest.mark.gl
+def test_studio_edit_latency_times_each_edit_in_the_window(renderer, tmp_path, monkeypatch):
+    pytest.importorskip("pyoidn")
+    monkeypatch.setenv("QT_QPA_PLATFORM", "offscreen")
+    out = run("studio_edit_latency.py", "--repeat", 1, tmp_path=tmp_path)
+    rows = [line.split("|")[1:-1] for line in out.splitlines() if line.startswith(("| f", "| focus"))]
+    assert len(rows) == 3
+    for cells in rows:
+        assert float(cells[1].split()[0]) > 0 and float(cells[3].split()[0]) > 0  # seconds, first and full
+        assert cells[-1].strip() == "0"  # no raw picture shown with the denoiser on

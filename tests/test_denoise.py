@@ -255,3 +255,40 @@ def test_an_image_too_large_for_its_feature_buffers_is_refused_in_one_line():
     with pytest.raises(SceneTooLarge, match=r"and 1\.0 GiB for the denoiser\); this machine holds at most"):
         check_image_size(4000, 4000, LLVMPIPE_BUFFER_BYTES, memory_bytes=4 << 30, feature_buffers=True)
     check_image_size(4000, 4000, LLVMPIPE_BUFFER_BYTES, memory_bytes=4 << 30)
+
+
+def test_a_denoiser_of_ones_own_denoises_as_the_shared_one_does_and_beside_it():
+    import threading
+
+    from lenslab.render.denoise import Denoiser, denoise
+
+    rng = np.random.default_rng(5)
+    color = rng.random((40, 56, 3), dtype=np.float32)
+    albedo = np.full_like(color, 0.5)
+    normal = np.zeros_like(color)
+    normal[..., 2] = 1.0
+    expected = denoise(color, albedo, normal, quality="fast")
+    own = Denoiser()
+    try:
+        results, errors = {}, []
+
+        def run(name, fn):
+            try:
+                results[name] = fn(color, albedo, normal, quality="fast")
+            except Exception as exc:  # reported below, not lost in the thread
+                errors.append(exc)
+
+        threads = [threading.Thread(target=run, args=("own", own.denoise)),
+                   threading.Thread(target=run, args=("shared", denoise))]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join(60)
+        assert not errors and set(results) == {"own", "shared"}
+        np.testing.assert_allclose(results["own"], expected, rtol=1e-4, atol=1e-5)
+        np.testing.assert_allclose(results["shared"], expected, rtol=1e-4, atol=1e-5)
+        with pytest.raises(ValueError, match="unknown denoise quality"):
+            own.denoise(color, quality="best")
+    finally:
+        own.release()
+    own.release()  # twice is harmless

@@ -135,6 +135,7 @@ def test_banner_text_names_the_stage_and_how_far_along_it_is():
     assert banner_text(state(current=True, preview=True, stale_seconds=0.0)) == \
         "Preview at ¼ resolution: full resolution under way"
     assert banner_text(state(paused=True)).startswith("Paused")
+    assert banner_text(state(paused=True, snapshot_alone=True)) is None  # A/B's A is shown: nothing live in sight
 
 
 class FakeController(QObject):
@@ -157,7 +158,7 @@ def test_the_banner_follows_the_controller_and_dims_another_scenes_picture(qtbot
     viewport = Viewport()
     qtbot.addWidget(viewport)
     controller = FakeController()
-    banner = WorkBanner(viewport, controller)
+    banner = WorkBanner(viewport, controller, viewport)  # goes with the viewport
     banner.refresh()
     assert banner.text == "Opening the scene…" and viewport.idle_text == "Opening the scene…"
     controller.working.emit(WorkNote(1, "building the kd-tree", 2, 5))
@@ -167,3 +168,178 @@ def test_the_banner_follows_the_controller_and_dims_another_scenes_picture(qtbot
     controller.picture_is_current = True
     banner.refresh()
     assert banner.text is None and not banner.dim
+
+
+def test_the_banners_seconds_count_from_the_newest_edit_not_from_when_the_picture_was_last_current(
+        qtbot, monkeypatch):
+    from lenslab.gui import work_banner
+    from lenslab.gui.viewport import Viewport
+
+    clock = [100.0]
+    monkeypatch.setattr(work_banner.time, "perf_counter", lambda: clock[0])
+    viewport = Viewport()
+    qtbot.addWidget(viewport)
+    controller = FakeController()
+    banner = WorkBanner(viewport, controller, viewport)  # goes with the viewport
+    controller.generation = 2  # an edit the picture does not show
+    banner.refresh()
+    clock[0] += 5.0
+    assert banner.state().stale_seconds == pytest.approx(5.0)
+    controller.generation = 3  # another edit before the first one's picture came
+    banner.refresh()
+    clock[0] += 1.0
+    assert banner.state().stale_seconds == pytest.approx(1.0)
+    banner.refresh()
+    assert banner.text.endswith("· 1 s")
+
+
+def test_a_note_left_from_before_another_scene_was_opened_is_not_shown_as_the_new_ones(qtbot):
+    from lenslab.gui.viewport import Viewport
+
+    viewport = Viewport()
+    qtbot.addWidget(viewport)
+    controller = FakeController()
+    banner = WorkBanner(viewport, controller, viewport)  # goes with the viewport
+    controller.work_note = WorkNote(2, "preparing the kernel", 5, 5)  # the last edit's, finished
+    controller.generation = controller.scene_generation = 3  # File > Open: the new scene's notes are not in yet
+    banner.refresh()
+    assert banner.text == "Opening the scene…"
+
+
+def test_an_edit_that_sends_the_same_scene_again_is_not_opening_another_one(window, qtbot):
+    controller = window.controller
+    wait_for_frame(qtbot, window)
+    opened = controller.scene_generation
+    controller.set_quality("auto")  # the picture's size changes: the scene goes to the worker again
+    assert controller.generation > opened and controller.scene_generation == opened
+    window.doc.set_camera(f_number=8.0)
+    state = window.render_status.work_banner.state()
+    assert not state.new_scene  # no "Opening the scene", no dimming: it is this scene's picture
+    window.doc.replace(dataclasses.replace(window.doc.scene), None)  # File > New / Open: another scene
+    assert controller.scene_generation == controller.generation
+    assert window.render_status.work_banner.state().new_scene
+
+
+def test_the_frames_label_describes_the_picture_shown_not_the_newest_resolution(window, qtbot):
+    wait_for_frame(qtbot, window)
+    framing = window.viewing.framing
+    before = framing.label()
+    window.render_status.set_paused(True)
+    qtbot.waitUntil(lambda: window.controller.paused)
+    w, h = window.doc.scene.camera.resolution
+    window.doc.set_camera(resolution=(w * 2, h))
+    assert framing.label() == before, "the label changed while the picture still has the old frame"
+    window.render_status.set_paused(False)
+    wait_for_frame(qtbot, window, generation=window.controller.generation)
+    qtbot.waitUntil(lambda: framing.label().endswith(f"{w * 2} × {h}"), timeout=10000)
+
+
+@pytest.mark.smoke
+def test_an_edit_made_while_a_picture_is_denoised_is_rendered_at_once(gl_available, small_scene, monkeypatch):
+    """The full-resolution pictures are denoised off the render thread: an edit that comes while one is being
+    denoised gets its own denoised preview without waiting for that picture, which it has made stale and which
+    is never shown."""
+    import threading
+
+    from lenslab.gui.render_loop import CameraEdit, DenoiseEdit, RenderLoop, SceneEdit, TargetSpp
+    from lenslab.render import denoise as oidn
+    from lenslab.render.tracer import Renderer
+
+    size = (320, 240)  # large enough for a quarter-resolution preview
+    entered, release = threading.Event(), threading.Event()
+    held_back = []
+
+    def held(real):
+        """The denoiser, held on a full-resolution picture until the test lets it go (or 20 s pass)."""
+        def denoise(*args, **kwargs):
+            color = args[-3] if len(args) >= 3 else args[0]
+            if color.shape[:2] == size[::-1]:
+                entered.set()
+                held_back.append(not release.wait(20))
+            return real(*args, **kwargs)
+        return denoise
+
+    monkeypatch.setattr(oidn, "denoise", held(oidn.denoise))
+    monkeypatch.setattr(oidn.Denoiser, "denoise", held(oidn.Denoiser.denoise))
+
+    class Events:
+        def __getattr__(self, name):
+            return lambda *args: None
+
+    loop = RenderLoop(Renderer(), Events())
+    try:
+        loop.handle([DenoiseEdit(True), TargetSpp(None), SceneEdit(small_scene, size, 1)])
+        while not entered.is_set():  # the preview, the first full pass, and its denoising begun
+            loop.step()
+        camera = dataclasses.replace(small_scene.camera, f_number=small_scene.camera.f_number * 2)
+        loop.handle([CameraEdit(camera, size, 2, False)])
+        first = None
+        while first is None or first.generation != 2:
+            loop.step()
+            first = loop.take_frame() or first
+        assert not release.is_set() and not any(held_back), "the edit waited for the stale picture's denoising"
+        assert first.preview and first.denoised
+        release.set()
+        shown = []
+        while not shown or shown[-1].preview:
+            loop.step()
+            frame = loop.take_frame()
+            if frame is not None:
+                shown.append(frame)
+        assert all(f.generation == 2 and f.denoised for f in shown), "a picture of the edit before was shown"
+        assert shown[-1].samples_per_pixel >= 1 and not any(held_back)
+    finally:
+        release.set()
+        loop.release()
+
+
+@pytest.mark.smoke
+def test_a_preview_held_back_for_the_picture_on_screen_is_shown_when_the_hold_ends(gl_available, small_scene,
+                                                                                   monkeypatch):
+    """An edit's preview that comes sooner than the hold (the picture on screen is kept for a moment after an
+    edit, so that a drag does not flash worse pictures) is shown when the hold ends, not dropped for the long
+    wait until the full pass is denoised."""
+    import threading
+
+    from lenslab.gui import render_loop
+    from lenslab.gui.render_loop import CameraEdit, DenoiseEdit, RenderLoop, SceneEdit, TargetSpp
+    from lenslab.render import denoise as oidn
+    from lenslab.render.tracer import Renderer
+
+    size = (320, 240)
+    monkeypatch.setattr(render_loop, "HOLD_SECONDS", 0.5)  # longer than this preview takes
+    let_go, timed_out = threading.Event(), []
+
+    def slowed(real):
+        """The full pass's denoising, made to take up to 5 s (the preview's is left alone)."""
+        def denoise(*args, **kwargs):
+            color = args[-3] if len(args) >= 3 else args[0]
+            if color.shape[:2] == size[::-1] and not let_go.is_set():
+                timed_out.append(not let_go.wait(5))
+            return real(*args, **kwargs)
+        return denoise
+
+    class Events:
+        def __getattr__(self, name):
+            return lambda *args: None
+
+    loop = RenderLoop(Renderer(), Events())
+    try:
+        loop.handle([DenoiseEdit(True), TargetSpp(None), SceneEdit(small_scene, size, 1)])
+        frame = None
+        while frame is None or frame.preview:  # a full-resolution denoised picture on screen
+            loop.step()
+            frame = loop.take_frame() or frame
+        monkeypatch.setattr(oidn, "denoise", slowed(oidn.denoise))
+        monkeypatch.setattr(oidn.Denoiser, "denoise", slowed(oidn.Denoiser.denoise))
+        camera = dataclasses.replace(small_scene.camera, f_number=small_scene.camera.f_number * 2)
+        loop.handle([CameraEdit(camera, size, 2, False)])
+        first = None
+        while first is None or first.generation != 2:
+            loop.step()
+            first = loop.take_frame() or first
+        assert first.preview and first.denoised, "the preview was dropped for the full pass's picture"
+        assert not any(timed_out), "the edit showed nothing until its full pass was denoised"
+    finally:
+        let_go.set()
+        loop.release()

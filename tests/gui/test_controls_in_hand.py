@@ -137,7 +137,8 @@ def test_a_focal_length_drag_through_a_long_lens_leaves_the_focus_as_it_was(stud
     studio.scroll.ensureWidgetVisible(panel.focal_slider)
     slider = panel.focal_slider
     rows = doc.undo_stack.count()
-    seen = []
+    seen, said = [], []
+    panel.status_message.connect(said.append)
     out = list(range(slider.value(), slider.maximum() + 1, 25)) + [slider.maximum()]
     back = list(range(slider.maximum(), log_to_slider(31.0, 8.0, 800.0) - 1, -25)) + [log_to_slider(31.0, 8.0, 800.0)]
     drag_slider(slider, out + back,
@@ -148,6 +149,9 @@ def test_a_focal_length_drag_through_a_long_lens_leaves_the_focus_as_it_was(stud
     camera = doc.scene.camera
     assert camera.focal_length_mm == pytest.approx(31.0, abs=0.2)
     assert camera.focus_distance_m == 3.09
+    # The status bar said the focus moved out, and then that it is back: its last word is not the long lens's.
+    assert any("focuses no nearer" in line for line in said)
+    assert said[-1] == "Focus back at 3.09 m, where it was set"
     # One step, which undoes to where the drag began.
     assert doc.undo_stack.count() == rows + 1
     assert doc.undo_stack.text(rows).startswith("Focal length ")

@@ -146,6 +146,10 @@ def test_the_export_dialog_refuses_such_a_folder_and_stays_open(window, tmp_path
     assert "not enough space" in dialog.validate()
     dialog.width_spin.setValue(200)
     assert dialog.validate() is None
+    not_a_folder = tmp_path / "notes.txt"
+    not_a_folder.write_text("a file where a folder is named")
+    dialog.path_edit.setText(str(not_a_folder / "shot.png"))
+    assert f"{not_a_folder} is a file, not a folder" in dialog.validate()  # not "does not exist": it does
 
 
 def test_only_a_written_export_makes_its_folder_the_next_ones(qtbot, window, tmp_path, monkeypatch):

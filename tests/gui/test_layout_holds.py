@@ -177,7 +177,8 @@ def overlaps(boxes: list[QRectF]) -> list[tuple[QRectF, QRectF]]:
 @pytest.mark.gl
 def test_the_viewports_tags_never_cover_one_another(qtbot, window, monkeypatch):
     """Every tag at once: the camera's in the physical exposure mode (its longest), the render paused, the plane of
-    focus's distance, "focusing…", the frame's size and the sensor's outline (a 4:3 frame on a 3:2 sensor)."""
+    focus's distance, "focusing…", the frame's size and the sensor's outline (a 4:3 frame on a 3:2 sensor); and the
+    work banner over them, an edit made while paused."""
     window.doc.set_camera(exposure_mode="physical")
     wait_for_frame(qtbot, window, generation=window.controller.generation)
     qtbot.waitUntil(lambda: "ISO" in window.viewport.hud_text, timeout=10000)
@@ -187,6 +188,9 @@ def test_the_viewports_tags_never_cover_one_another(qtbot, window, monkeypatch):
     v.show_focus_overlay(1.6, 1.2, 2.2, hold=True)
     v.set_tool("focus")
     v.focus_pending = True
+    window.doc.set_camera(f_number=window.doc.scene.camera.f_number * 2)
+    banner = window.render_status.work_banner
+    qtbot.waitUntil(lambda: (banner.text or "").startswith("Paused"), timeout=5000)
     for size in ("minimum", "default", "4K"):
         size_to(qtbot, window, SIZES[size])
         with tags_drawn(monkeypatch) as (boxes, texts):
@@ -254,8 +258,12 @@ def combo_texts(combo) -> list[str]:
 
 @pytest.mark.gl
 def test_the_aspect_list_names_a_preset_as_itself(qtbot, window):
+    from lenslab.gui.framing_overlay import FramingLayer
+
     aspect = window.viewing.aspect
+    wait_for_frame(qtbot, window)
     window.set_paused(True)  # the shapes are all this is about: no need to render 1920 x 1280 on the CPU
+    on_screen = window.viewing.framing.label()
     for resolution, shown in (((1920, 1280), "3:2"), ((1919, 1280), "3:2"), ((1080, 1350), "4:5"),
                               ((101, 100), "1:1")):
         window.doc.set_camera(resolution=resolution)
@@ -263,7 +271,10 @@ def test_the_aspect_list_names_a_preset_as_itself(qtbot, window):
         assert aspect.actions[shown].isChecked() and not aspect.custom_action.isVisible()
         assert combo_texts(aspect.combo) == ["3:2", "4:5", "1:1", "16:9"], \
             f"at {resolution} the list offers {combo_texts(aspect.combo)}"
-        assert window.viewing.framing.label().startswith(shown + "  ")  # the frame's label agrees
+        label = FramingLayer()
+        label.set_camera(window.doc.scene.camera)
+        assert label.label().startswith(shown + "  ")  # the frame's label, once a picture of it shows, agrees
+        assert window.viewing.framing.label() == on_screen  # until then it is the paused picture's
     window.doc.set_camera(resolution=(640, 480))
     assert aspect.combo.currentText() == "Custom (4:3)" and aspect.custom_action.isChecked()
     assert combo_texts(aspect.combo) == ["3:2", "4:5", "1:1", "16:9", "Custom (4:3)"]
@@ -288,10 +299,23 @@ def test_the_ab_tags_read_the_picture_shown(qtbot, window, monkeypatch):
         window.viewport.grab()
     assert any("f/1.4" in t and "50 mm" in t for t in texts), f"no tag gives A's settings: {texts}"
     assert not any("f/8" in t for t in texts), f"a tag reads the live f/8 over snapshot A: {texts}"
+    # The live picture falls behind an edit (paused) while A is shown: no banner over A speaks of it.
     store.toggle_a(False)
+    window.set_paused(True)
+    window.doc.set_camera(f_number=11.0)
+    banner = window.render_status.work_banner
+    qtbot.waitUntil(lambda: (banner.text or "").startswith("Paused"), timeout=5000)
+    store.toggle_a(True)
+    banner.refresh()
+    assert banner.text is None, f"the banner speaks of the live picture over snapshot A: {banner.text}"
+    store.toggle_a(False)
+    banner.refresh()
+    assert (banner.text or "").startswith("Paused")  # the live picture is back in sight, behind the edit
+    window.set_paused(False)
+    wait_for_frame(qtbot, window, generation=window.controller.generation)
     store.set_mode("wipe")
     with tags_drawn(monkeypatch) as (_boxes, texts):
         window.viewport.grab()
-    assert "A: f/1.4" in texts and "B: live f/8" in texts
-    assert any(t.startswith("B: ") and "f/8" in t and "50 mm" in t for t in texts), \
+    assert "A: f/1.4" in texts and "B: live f/11" in texts
+    assert any(t.startswith("B: ") and "f/11" in t and "50 mm" in t for t in texts), \
         f"in the wipe the camera's tag, over A's side, does not say it is B's: {texts}"

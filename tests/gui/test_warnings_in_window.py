@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 from PySide6.QtCore import QMimeData, QPoint, QPointF, Qt, QUrl
 from PySide6.QtGui import QDragEnterEvent, QDropEvent
-from PySide6.QtWidgets import QFileDialog, QMessageBox
+from PySide6.QtWidgets import QApplication, QFileDialog, QMessageBox
 
 pytestmark = pytest.mark.gl
 
@@ -68,6 +68,12 @@ def test_a_mitsuba_scene_with_an_unknown_plugin_shows_its_warning_in_the_bar_and
     assert log_dock.toggleViewAction() in view.actions()
     bar.log_button.click()
     assert log_dock.isVisible()
+    # Each line is read from its start: long lines wrap, nothing is scrolled out of sight sideways.
+    for text_view in (window.log_panel.view, bar.details):
+        qtbot.waitUntil(lambda v=text_view: v.viewport().width() > 0)
+        text_view.resize(320, text_view.height())  # narrower than the line
+        QApplication.processEvents()
+        assert text_view.horizontalScrollBar().maximum() == 0
     bar.close_button.click()
     assert not bar.isVisible()
     assert window.log_panel.lines() == log  # the log keeps what the bar said

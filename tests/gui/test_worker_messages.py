@@ -169,3 +169,28 @@ def test_the_render_loop_imports_no_qt():
             "print([m for m in sys.modules if m.startswith(('PySide6', 'shiboken6'))])")
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert result.stdout.strip() == "[]"
+
+
+@pytest.mark.smoke
+def test_the_preview_is_enlarged_bilinearly_between_pixel_centres():
+    import numpy as np
+
+    from lenslab.gui.render_loop import upscale_smooth
+
+    rng = np.random.default_rng(3)
+    small = rng.random((5, 7, 3), dtype=np.float32)
+    big = upscale_smooth(small, 28, 20)  # four times each way
+    assert big.shape == (20, 28, 3) and big.dtype == np.float32
+    # Each enlarged pixel's centre maps to (x + 0.5) / 4 - 0.5 in the small one: blended from its four neighbours.
+    for y, x in [(0, 0), (3, 5), (10, 13), (19, 27), (7, 2)]:
+        sy, sx = min(max((y + 0.5) / 4 - 0.5, 0), 4), min(max((x + 0.5) / 4 - 0.5, 0), 6)
+        y0, x0 = int(sy), int(sx)
+        y1, x1 = min(y0 + 1, 4), min(x0 + 1, 6)
+        fy, fx = sy - y0, sx - x0
+        expected = ((1 - fy) * ((1 - fx) * small[y0, x0] + fx * small[y0, x1])
+                    + fy * ((1 - fx) * small[y1, x0] + fx * small[y1, x1]))
+        np.testing.assert_allclose(big[y, x], expected, rtol=1e-5, atol=1e-6)
+    quantised = (small * 255).astype(np.uint8)
+    eight = upscale_smooth(quantised, 28, 20)  # 8-bit in, 8-bit out, rounded to the nearest
+    exact = upscale_smooth(quantised.astype(np.float32), 28, 20)
+    assert eight.dtype == np.uint8 and np.abs(eight - exact).max() <= 0.5 + 1e-4

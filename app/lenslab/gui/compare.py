@@ -76,6 +76,10 @@ class Comparison(QObject):
     def side_by_side(self) -> bool:
         return self.store.view == "side"
 
+    def shows_a_alone(self) -> bool:
+        """The snapshot is shown in place of the live picture (the quick A/B toggle): nothing live is in sight."""
+        return self.store.view == "a" and self.store.a is not None
+
     def _store_changed(self, _what: str) -> None:
         v = self.viewport
         side = self.side_by_side()
@@ -146,10 +150,9 @@ class Comparison(QObject):
         A's own while A is shown alone; the live ones, marked B, beside A in the wipe, whose left side (where the
         camera tag sits) shows A."""
         a = self.store.a
-        view = self.view()
-        if view == "a" and a is not None:
+        if self.shows_a_alone():
             return f"A: {camera_tag(a.camera)}", f"A: {a.samples_per_pixel} spp"
-        if view == "wipe" and camera:
+        if self.view() == "wipe" and camera:
             return f"B: {camera}", state
         return camera, state
 

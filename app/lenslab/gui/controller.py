@@ -64,7 +64,7 @@ class RenderController(QObject):
         self.target_spp = target_spp
         self.paused = False
         self.generation = 0
-        self.scene_generation = 0  # the generation of the last whole scene sent (not a camera or settings edit)
+        self.scene_generation = 0  # the generation that sent another scene (File > Open, New): not an edit of this one
         self.work_note = None  # the latest WorkNote
         self.device: dict | None = None
         self.device_error: str | None = None
@@ -98,7 +98,7 @@ class RenderController(QObject):
         w.set_target_spp(target_spp)
         listen(doc.model.events.changed, self, self._on_change)
         w.start()
-        self.send_scene()
+        self.send_scene(another_scene=True)
 
     # -- keeping the worker up to date ----------------------------------------------------------------------
     def _next_generation(self) -> int:
@@ -118,13 +118,17 @@ class RenderController(QObject):
         cpu = self.device is None or "llvmpipe" in str(self.device.get("renderer", "")).lower()
         return viewport_size(self.doc.scene.camera.resolution, self.quality, self._widget_size, cpu)
 
-    def send_scene(self) -> None:
+    def send_scene(self, another_scene: bool = False) -> None:
+        """Send the worker a copy of the whole scene: ``another_scene`` when it is not the one on screen (File >
+        Open, New), so that the picture shown until its own comes is known to be another scene's."""
         size = self._view_size()
         if size != self._size:
             self.region = None  # the worker drops a region whose picture changed size, as here
         self._size = size
-        self.scene_generation = self._next_generation()
-        self.worker.set_scene(copy_scene(self.doc.scene), *self._size, self.scene_generation, self.margin)
+        generation = self._next_generation()
+        if another_scene:
+            self.scene_generation = generation
+        self.worker.set_scene(copy_scene(self.doc.scene), *self._size, generation, self.margin)
 
     def set_widget_size(self, width: int, height: int) -> None:
         """The viewport widget's size in device pixels: the picture follows it (except at "export" quality)."""
@@ -162,7 +166,7 @@ class RenderController(QObject):
                 return  # the export default; the viewport has its own sample limit
             self.worker.set_settings(dataclasses.replace(self.doc.scene.render), self._next_generation())
         else:
-            self.send_scene()
+            self.send_scene(another_scene=change.kind == "scene")
 
     def set_quality(self, quality: str) -> None:
         if quality in QUALITIES and quality != self.quality:

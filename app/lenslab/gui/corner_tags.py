@@ -21,6 +21,8 @@ from lenslab.optics.exposure import format_shutter
 
 #: How much each tag matters: the higher keeps its place and its text when two would overlap.
 CAMERA, FOCUSING, COMPARE, FRAME, FOCUS_PLANE, STATE, SENSOR = 100, 95, 90, 80, 70, 60, 40
+#: The work banner (gui/work_banner.py) is no tag, but the tags below it in importance keep out of its box.
+BANNER = 85
 GAP = 6  # pixels kept between two tags
 MIN_LETTERS = 4  # a tag shortened to fewer letters than this is left out: "f/1…" says nothing
 BACKGROUND = QColor(20, 20, 22, 200)
@@ -59,11 +61,18 @@ class TagBoard:
         self.area = QRectF(area)
         self.wanted: list[Tag] = []
         self.placed: list[tuple[str, QRectF]] = []
+        # Boxes drawn by others, each with the priority below which tags keep out of it.
+        self.reserved: list[tuple[QRectF, int]] = []
 
     def begin(self, area: QRectF) -> None:
-        """A new paint, over ``area``: no tag wanted yet."""
+        """A new paint, over ``area``: no tag wanted yet, no box reserved."""
         self.area = QRectF(area)
         self.wanted = []
+        self.reserved = []
+
+    def reserve(self, box: QRectF, priority: int) -> None:
+        """Something else is drawn in ``box`` (the work banner): tags less important than ``priority`` keep out of it."""
+        self.reserved.append((QRectF(box), priority))
 
     def want(self, text: str, at: QPointF, colour: QColor | str, priority: int, grows: str = "right",
              background: QColor = BACKGROUND, opacity: float = 1.0, bounds: QRectF | None = None) -> None:
@@ -118,7 +127,9 @@ class TagBoard:
         placed on that row take on either side of its anchor."""
         left, right = bounds.left(), bounds.right()
         anchor = tag.at.x()
-        for _text, box in self.placed:
+        obstacles = [box for _text, box in self.placed]
+        obstacles += [box for box, priority in self.reserved if tag.priority < priority]
+        for box in obstacles:
             if box.bottom() + GAP / 2 <= top or box.top() - GAP / 2 >= bottom:
                 continue  # another row
             if box.right() + GAP <= anchor:
@@ -136,4 +147,4 @@ class TagBoard:
 
 
 __all__ = ["TagBoard", "Tag", "camera_tag", "CAMERA", "FOCUSING", "COMPARE", "FRAME", "FOCUS_PLANE", "STATE",
-           "SENSOR"]
+           "SENSOR", "BANNER"]

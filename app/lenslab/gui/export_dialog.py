@@ -298,8 +298,6 @@ class ExportDialog(QDialog):
         path = Path(self.path_edit.text()).expanduser()
         if not _suffix(path):
             return f"{path.name}: choose a .exr, .png, .tif or .jpg file name"
-        if not path.parent.is_dir():
-            return f"The folder {path.parent} does not exist"
         return export_problem(path, self.width_spin.value(), self.height_spin.value(), self.denoise_check.isChecked())
 
     def accept(self) -> None:

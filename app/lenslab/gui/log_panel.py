@@ -6,9 +6,9 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from datetime import datetime
-from pathlib import Path
 
 from PySide6.QtCore import Qt
+from PySide6.QtGui import QTextOption
 from PySide6.QtWidgets import QDockWidget, QHBoxLayout, QMainWindow, QPlainTextEdit, QPushButton, QVBoxLayout, QWidget
 
 from lenslab.messages import one_line
@@ -23,7 +23,10 @@ class LogPanel(QWidget):
         self.view = QPlainTextEdit()
         self.view.setObjectName("log")
         self.view.setReadOnly(True)
-        self.view.setLineWrapMode(QPlainTextEdit.NoWrap)
+        # Long lines wrap: unwrapped, each new line scrolled the view sideways to its end, hiding every line's
+        # time and file; a path with no spaces breaks anywhere rather than run on.
+        self.view.setLineWrapMode(QPlainTextEdit.WidgetWidth)
+        self.view.setWordWrapMode(QTextOption.WrapAtWordBoundaryOrAnywhere)
         self.view.setMaximumBlockCount(MAX_LINES)
         clear = QPushButton("Clear")
         clear.clicked.connect(self.view.clear)

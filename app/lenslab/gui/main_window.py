@@ -296,12 +296,13 @@ class MainWindow(QMainWindow):
         self.actions["stop_down"].setText(f"Stop Down {amount} Stop")
 
     def update_camera_tag(self) -> None:
-        """The camera tag describes the picture shown, not the document's latest camera: until the new picture
-        comes the work banner says one is on its way."""
+        """The camera tag and the frame's label describe the picture shown, not the document's latest camera:
+        until the new picture comes the work banner says one is on its way."""
         frame = self.controller.last_frame
         cam = frame.camera if frame is not None and frame.camera is not None else self.doc.scene.camera
         exposure = frame.exposure if frame is not None and frame.camera is cam else None
         self.viewport.hud_text = camera_tag(cam, exposure)  # as a snapshot's is written (the A/B comparison)
+        self.viewing.framing.set_camera(cam)
         self.viewport.update()
 
     # -- document events ---------------------------------------------------------------------------------------

@@ -311,7 +311,6 @@ class ViewingAids(QObject):
 
     # -- the camera ------------------------------------------------------------------------------------------------
     def _scene_changed(self, change) -> None:
-        if change.kind in ("camera", "scene"):
-            self.framing.set_camera(self.doc.scene.camera)
+        if change.kind in ("camera", "scene"):  # the frame's label follows the picture (window.update_camera_tag)
             self.peaking.changed()
             self.viewport.update()

@@ -8,6 +8,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from PySide6.QtCore import Signal
+from PySide6.QtGui import QTextOption
 from PySide6.QtWidgets import QFrame, QHBoxLayout, QLabel, QPlainTextEdit, QToolButton, QVBoxLayout, QWidget
 
 from lenslab.gui.theme import ACCENT
@@ -46,7 +47,8 @@ class WarningBar(QFrame):
             row.addWidget(button)
         self.details = QPlainTextEdit()
         self.details.setReadOnly(True)
-        self.details.setLineWrapMode(QPlainTextEdit.NoWrap)
+        self.details.setLineWrapMode(QPlainTextEdit.WidgetWidth)  # a long line whole, not cut at the edge
+        self.details.setWordWrapMode(QTextOption.WrapAtWordBoundaryOrAnywhere)
         self.details.setMaximumHeight(self.details.fontMetrics().lineSpacing() * DETAIL_LINES + 12)
         self.details.hide()
         layout = QVBoxLayout(self)

@@ -17,6 +17,7 @@ from PySide6.QtCore import QObject, QRectF, Qt, QTimer
 from PySide6.QtGui import QColor, QPainter
 
 from lenslab.gui import theme
+from lenslab.gui.corner_tags import BANNER
 
 BANNER_DELAY_SECONDS = 0.25
 POLL_MS = 100
@@ -28,17 +29,18 @@ class BannerState:
     """What the banner needs to know, gathered from the controller (plain values, for tests)."""
 
     current: bool  # the picture shows the latest edit
-    stale_seconds: float  # how long it has not
+    stale_seconds: float  # how long since that edit, while the picture does not show it
     has_picture: bool
     preview: bool  # the picture is the low-resolution preview of the latest edit
     new_scene: bool  # a whole other scene is on its way (its picture would be another scene's)
     paused: bool
     note: object = None  # the latest WorkNote for an edit the picture does not show, or None
+    snapshot_alone: bool = False  # a snapshot is shown in place of the live picture (A of the A/B): its tags say so
 
 
 def banner_text(state: BannerState) -> str | None:
     """The banner's line, or None for no banner."""
-    if state.current and not state.preview:
+    if (state.current and not state.preview) or state.snapshot_alone:
         return None
     if state.has_picture and not state.preview and state.stale_seconds < BANNER_DELAY_SECONDS:
         return None
@@ -78,7 +80,8 @@ class WorkBanner(QObject):
         self.text: str | None = None
         self.fraction: float | None = None
         self.dim = False
-        self._stale_since: float | None = None
+        self._stale_since: float | None = None  # when the latest edit the picture does not show was made
+        self._stale_generation: int | None = None  # that edit's generation
         self._timer = QTimer(self)
         self._timer.setInterval(POLL_MS)
         self._timer.timeout.connect(self.refresh)
@@ -93,18 +96,21 @@ class WorkBanner(QObject):
         current = c.picture_is_current
         now = time.perf_counter()
         if current:
-            self._stale_since = None
-        elif self._stale_since is None:
-            self._stale_since = now
+            self._stale_since = self._stale_generation = None
+        elif self._stale_generation != c.generation:  # the seconds count from the newest edit, not an older one
+            self._stale_since, self._stale_generation = now, c.generation
         stale = 0.0 if self._stale_since is None else now - self._stale_since
         note = c.work_note
         if note is not None and frame is not None and note.generation <= frame.generation and not frame.preview:
             note = None  # about a picture already shown
+        if note is not None and note.generation < c.scene_generation:
+            note = None  # about the scene before the one opening
         return BannerState(
             current=current, stale_seconds=stale, has_picture=frame is not None,
             preview=frame is not None and frame.preview and frame.generation >= c.generation,
             new_scene=frame is None or c.scene_generation > frame.generation,
-            paused=c.paused and not current, note=note)
+            paused=c.paused and not current, note=note,
+            snapshot_alone=self.viewport.compare is not None and self.viewport.compare.shows_a_alone())
 
     def refresh(self) -> None:
         state = self.state()
@@ -129,6 +135,7 @@ class WorkBanner(QObject):
         height = metrics.height() + 12
         top = max(4.0, image_rect.top() + 36)
         box = QRectF(viewport.width() / 2 - width / 2, top, width, height)
+        viewport.tags.reserve(box, BANNER)  # the less important tags give way (a sensor's size, a focus plane's)
         p.setPen(Qt.NoPen)
         p.setBrush(QColor(20, 20, 22, 215))
         p.drawRoundedRect(box, 4, 4)

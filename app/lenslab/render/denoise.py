@@ -13,7 +13,8 @@ OIDN's "RT" filter on them. Two ways, as OIDN's documentation advises:
 Making an OIDN device loads its library and kernels, so one device serves every call, and a preview's filter and
 buffers are kept for the next call of the same size and options: the viewport, which denoises the same size again
 and again, only copies pixels in and out and runs the network. A final frame frees its filters as it goes (their
-scratch memory is large: see MAX_MEMORY_MB). Calls are serialised (one lock).
+scratch memory is large: see MAX_MEMORY_MB). Calls are serialised (one lock). A thread that must denoise beside
+the others, not after them, keeps a :class:`Denoiser` of its own: its own device, buffers and lock.
 
 The device is OIDN's default: a GPU that OIDN supports and whose driver it finds (CUDA, HIP, SYCL), else the
 CPU. ``LENSLAB_DENOISE_DEVICE`` (cpu, cuda, hip, sycl, metal) forces one.
@@ -24,6 +25,7 @@ from __future__ import annotations
 import atexit
 import os
 import threading
+import weakref
 
 import numpy as np
 
@@ -51,11 +53,36 @@ def denoise(color: np.ndarray, albedo: np.ndarray | None = None, normal: np.ndar
     (H, W, 3). A normal needs an albedo (OIDN has no filter for a normal alone). ``prefilter``: denoise the
     guides first and trust them (OIDN's cleanAux), for final frames. Raises ValueError for input it cannot take
     and DenoiseError where denoising cannot run."""
-    if quality not in QUALITIES:
-        raise ValueError(f"unknown denoise quality '{quality}' (choose from {', '.join(QUALITIES)})")
-    images = _checked_images(color, albedo, normal)
+    images = _checked_images(color, albedo, normal, quality)
     with _LOCK:
         return _shared_denoiser().run(images, prefilter, quality)
+
+
+class Denoiser:
+    """A denoiser of one's own: an OIDN device, its buffers and its filter, shared with no other caller and made
+    on first use. Calls on one Denoiser are serialised; calls on two run at once. For a thread that denoises
+    beside the others (the studio's full-resolution pictures, off the render thread that denoises its previews
+    with :func:`denoise`). Its owner releases it; one still held at exit is released then."""
+
+    def __init__(self):
+        self._lock = threading.Lock()
+        self._impl: _Denoiser | None = None
+        _OWN_DENOISERS.add(self)
+
+    def denoise(self, color: np.ndarray, albedo: np.ndarray | None = None, normal: np.ndarray | None = None, *,
+                prefilter: bool = False, quality: str = "high") -> np.ndarray:
+        """As :func:`denoise`, on this denoiser's device."""
+        images = _checked_images(color, albedo, normal, quality)
+        with self._lock:
+            if self._impl is None:
+                self._impl = _Denoiser(_device_kind())
+            return self._impl.run(images, prefilter, quality)
+
+    def release(self) -> None:
+        with self._lock:
+            if self._impl is not None:
+                self._impl.release()
+                self._impl = None
 
 
 def describe() -> str:
@@ -64,7 +91,9 @@ def describe() -> str:
         return _shared_denoiser().description
 
 
-def _checked_images(color, albedo, normal) -> dict[str, np.ndarray]:
+def _checked_images(color, albedo, normal, quality: str) -> dict[str, np.ndarray]:
+    if quality not in QUALITIES:
+        raise ValueError(f"unknown denoise quality '{quality}' (choose from {', '.join(QUALITIES)})")
     if normal is not None and albedo is None:
         raise ValueError("a normal guide needs an albedo guide beside it (OIDN denoises with color, color + albedo "
                          "or color + albedo + normal)")
@@ -191,12 +220,17 @@ class _Denoiser:
 
 _LOCK = threading.Lock()
 _DENOISER: _Denoiser | None = None
+_OWN_DENOISERS: weakref.WeakSet = weakref.WeakSet()  # every Denoiser not yet collected
+
+
+def _device_kind() -> str:
+    return os.environ.get(DEVICE_ENV, "default").strip().lower() or "default"
 
 
 def _shared_denoiser() -> _Denoiser:
     global _DENOISER
     if _DENOISER is None:
-        _DENOISER = _Denoiser(os.environ.get(DEVICE_ENV, "default").strip().lower() or "default")
+        _DENOISER = _Denoiser(_device_kind())
     return _DENOISER
 
 
@@ -204,6 +238,8 @@ def _shared_denoiser() -> _Denoiser:
 def _release_at_exit() -> None:
     """Release the device before the interpreter unloads the library under it."""
     global _DENOISER
+    for own in list(_OWN_DENOISERS):
+        own.release()
     with _LOCK:
         if _DENOISER is not None:
             _DENOISER.release()

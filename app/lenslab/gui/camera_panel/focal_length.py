@@ -86,6 +86,8 @@ class FocalLengthSection(CameraSection):
         if focus != chosen:
             self.panel.status_message.emit(f"Focus moved out to {format_distance(focus)}: a "
                                            f"{format_focal_length(mm)} lens focuses no nearer")
+        elif self.doc.scene.camera.focus_distance_m != chosen:  # this drag had moved it out: the message is past
+            self.panel.status_message.emit(f"Focus back at {format_distance(chosen)}, where it was set")
         push_values(self.doc, CAMERA, dict(zip(_FOCAL_FIELDS, (float(mm), focus))), f"Focal length {mm:g} mm",
                     merge, gesture)
         self.panel.refresh()
