@@ -234,52 +234,81 @@ def test_the_frames_label_describes_the_picture_shown_not_the_newest_resolution(
     qtbot.waitUntil(lambda: framing.label().endswith(f"{w * 2} × {h}"), timeout=10000)
 
 
+# -- the render loop and its denoiser, without Qt ------------------------------------------------------------
+LOOP_SIZE = (320, 240)  # large enough for a quarter-resolution preview
+
+
+class FullPassDenoising:
+    """Holds back the denoising of full-resolution pictures (either denoiser: the shared one the previews use,
+    and a Denoiser of one's own) until ``let_go`` is set or ``seconds`` pass; a preview's goes through.
+    ``entered``: one is being held; ``timed_out``: a True for each that waited the whole time."""
+
+    def __init__(self, monkeypatch, seconds: float):
+        import threading
+
+        from lenslab.render import denoise as oidn
+
+        self.entered, self.let_go, self.timed_out = threading.Event(), threading.Event(), []
+        self.seconds = seconds
+        monkeypatch.setattr(oidn, "denoise", self._held(oidn.denoise))
+        monkeypatch.setattr(oidn.Denoiser, "denoise", self._held(oidn.Denoiser.denoise))
+
+    def _held(self, real):
+        def denoise(*args, **kwargs):
+            color = args[-3] if len(args) >= 3 else args[0]
+            if color.shape[:2] == LOOP_SIZE[::-1] and not self.let_go.is_set():
+                self.entered.set()
+                self.timed_out.append(not self.let_go.wait(self.seconds))
+            return real(*args, **kwargs)
+        return denoise
+
+
+class QuietEvents:
+    def __getattr__(self, name):
+        return lambda *args: None
+
+
+def denoising_loop(scene):
+    """A RenderLoop on a renderer of its own, rendering ``scene`` at LOOP_SIZE with the denoiser on."""
+    from lenslab.gui.render_loop import DenoiseEdit, RenderLoop, SceneEdit, TargetSpp
+    from lenslab.render.tracer import Renderer
+
+    loop = RenderLoop(Renderer(), QuietEvents())
+    loop.handle([DenoiseEdit(True), TargetSpp(None), SceneEdit(scene, LOOP_SIZE, 1)])
+    return loop
+
+
+def first_frame_of(loop, generation: int):
+    frame = None
+    while frame is None or frame.generation != generation:
+        loop.step()
+        frame = loop.take_frame() or frame
+    return frame
+
+
+def stopped_down(scene):
+    from lenslab.gui.render_loop import CameraEdit
+
+    camera = dataclasses.replace(scene.camera, f_number=scene.camera.f_number * 2)
+    return CameraEdit(camera, LOOP_SIZE, 2, False)
+
+
 @pytest.mark.smoke
 def test_an_edit_made_while_a_picture_is_denoised_is_rendered_at_once(gl_available, small_scene, monkeypatch):
     """The full-resolution pictures are denoised off the render thread: an edit that comes while one is being
     denoised gets its own denoised preview without waiting for that picture, which it has made stale and which
     is never shown."""
-    import threading
-
-    from lenslab.gui.render_loop import CameraEdit, DenoiseEdit, RenderLoop, SceneEdit, TargetSpp
-    from lenslab.render import denoise as oidn
-    from lenslab.render.tracer import Renderer
-
-    size = (320, 240)  # large enough for a quarter-resolution preview
-    entered, release = threading.Event(), threading.Event()
-    held_back = []
-
-    def held(real):
-        """The denoiser, held on a full-resolution picture until the test lets it go (or 20 s pass)."""
-        def denoise(*args, **kwargs):
-            color = args[-3] if len(args) >= 3 else args[0]
-            if color.shape[:2] == size[::-1]:
-                entered.set()
-                held_back.append(not release.wait(20))
-            return real(*args, **kwargs)
-        return denoise
-
-    monkeypatch.setattr(oidn, "denoise", held(oidn.denoise))
-    monkeypatch.setattr(oidn.Denoiser, "denoise", held(oidn.Denoiser.denoise))
-
-    class Events:
-        def __getattr__(self, name):
-            return lambda *args: None
-
-    loop = RenderLoop(Renderer(), Events())
+    held = FullPassDenoising(monkeypatch, seconds=20)
+    loop = denoising_loop(small_scene)
     try:
-        loop.handle([DenoiseEdit(True), TargetSpp(None), SceneEdit(small_scene, size, 1)])
-        while not entered.is_set():  # the preview, the first full pass, and its denoising begun
+        while not held.entered.is_set():  # the preview, the first full pass, and its denoising begun
             loop.step()
-        camera = dataclasses.replace(small_scene.camera, f_number=small_scene.camera.f_number * 2)
-        loop.handle([CameraEdit(camera, size, 2, False)])
-        first = None
-        while first is None or first.generation != 2:
-            loop.step()
-            first = loop.take_frame() or first
-        assert not release.is_set() and not any(held_back), "the edit waited for the stale picture's denoising"
+        loop.handle([stopped_down(small_scene)])
+        first = first_frame_of(loop, 2)
+        assert not held.let_go.is_set() and not any(held.timed_out), \
+            "the edit waited for the stale picture's denoising"
         assert first.preview and first.denoised
-        release.set()
+        held.let_go.set()
         shown = []
         while not shown or shown[-1].preview:
             loop.step()
@@ -287,9 +316,9 @@ def test_an_edit_made_while_a_picture_is_denoised_is_rendered_at_once(gl_availab
             if frame is not None:
                 shown.append(frame)
         assert all(f.generation == 2 and f.denoised for f in shown), "a picture of the edit before was shown"
-        assert shown[-1].samples_per_pixel >= 1 and not any(held_back)
+        assert shown[-1].samples_per_pixel >= 1 and not any(held.timed_out)
     finally:
-        release.set()
+        held.let_go.set()
         loop.release()
 
 
@@ -299,47 +328,22 @@ def test_a_preview_held_back_for_the_picture_on_screen_is_shown_when_the_hold_en
     """An edit's preview that comes sooner than the hold (the picture on screen is kept for a moment after an
     edit, so that a drag does not flash worse pictures) is shown when the hold ends, not dropped for the long
     wait until the full pass is denoised."""
-    import threading
-
     from lenslab.gui import render_loop
-    from lenslab.gui.render_loop import CameraEdit, DenoiseEdit, RenderLoop, SceneEdit, TargetSpp
-    from lenslab.render import denoise as oidn
-    from lenslab.render.tracer import Renderer
 
-    size = (320, 240)
     monkeypatch.setattr(render_loop, "HOLD_SECONDS", 0.5)  # longer than this preview takes
-    let_go, timed_out = threading.Event(), []
-
-    def slowed(real):
-        """The full pass's denoising, made to take up to 5 s (the preview's is left alone)."""
-        def denoise(*args, **kwargs):
-            color = args[-3] if len(args) >= 3 else args[0]
-            if color.shape[:2] == size[::-1] and not let_go.is_set():
-                timed_out.append(not let_go.wait(5))
-            return real(*args, **kwargs)
-        return denoise
-
-    class Events:
-        def __getattr__(self, name):
-            return lambda *args: None
-
-    loop = RenderLoop(Renderer(), Events())
+    loop = denoising_loop(small_scene)
+    held = None
     try:
-        loop.handle([DenoiseEdit(True), TargetSpp(None), SceneEdit(small_scene, size, 1)])
         frame = None
         while frame is None or frame.preview:  # a full-resolution denoised picture on screen
             loop.step()
             frame = loop.take_frame() or frame
-        monkeypatch.setattr(oidn, "denoise", slowed(oidn.denoise))
-        monkeypatch.setattr(oidn.Denoiser, "denoise", slowed(oidn.Denoiser.denoise))
-        camera = dataclasses.replace(small_scene.camera, f_number=small_scene.camera.f_number * 2)
-        loop.handle([CameraEdit(camera, size, 2, False)])
-        first = None
-        while first is None or first.generation != 2:
-            loop.step()
-            first = loop.take_frame() or first
+        held = FullPassDenoising(monkeypatch, seconds=5)  # the edit's full pass: up to 5 s
+        loop.handle([stopped_down(small_scene)])
+        first = first_frame_of(loop, 2)
         assert first.preview and first.denoised, "the preview was dropped for the full pass's picture"
-        assert not any(timed_out), "the edit showed nothing until its full pass was denoised"
+        assert not any(held.timed_out), "the edit showed nothing until its full pass was denoised"
     finally:
-        let_go.set()
+        if held is not None:
+            held.let_go.set()
         loop.release()
