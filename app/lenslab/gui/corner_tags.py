@@ -71,7 +71,8 @@ class TagBoard:
         self.reserved = []
 
     def reserve(self, box: QRectF, priority: int) -> None:
-        """Something else is drawn in ``box`` (the work banner): tags less important than ``priority`` keep out of it."""
+        """Something else is drawn in ``box`` (the work banner): tags less important than ``priority`` keep out
+        of it."""
         self.reserved.append((QRectF(box), priority))
 
     def want(self, text: str, at: QPointF, colour: QColor | str, priority: int, grows: str = "right",

@@ -15,18 +15,19 @@ at most HOLD_SECONDS, so a drag still shows the newest state several times a sec
 are Intel Open Image Denoise's, from the beauty and the first-hit albedo and normal the tracer accumulates, and
 raw samples are never shown: the denoised preview (marked as one) stands until the first full pass is done and
 denoised in its turn. The full-resolution pictures are denoised off this thread, by a denoiser of their own
-(``_DenoiseJob``), so that an edit made while one is denoised is rendered at once instead of waiting for a picture
-it makes stale (on a CPU that takes a few tenths of a second). While the picture does not show the latest edit yet, ``working`` says what the loop is
-doing and how far along (a scene's load step by step, a kernel compiling, the preview, the first pass). Each
-frame's picture is made on the GPU through the viewport's view transform (OpenColorIO's display, view and looks,
-the display exposure and contrast: ``RenderSession.display``), with the camera's own exposure added to the
-transform's exposure, so neither thread does per-pixel work on the CPU; the linear image, for the viewport's pixel
-readout, comes along a few times a second, and the light meter reads it as it comes (the frame's scene-linear
-luminance inside the sensor's gate, ``lenslab.optics.exposure.meter_luminance``). In the auto exposure mode that
-reading sets the picture's exposure (``ThinLensCamera.exposure``). Once per change of view it casts one ray per pixel
-through the same kd-tree to find the node and the depth under every pixel: the viewport outlines the selection
-with the first and shows the plane of focus with the second. Click-to-focus picks and exports (a second
-``RenderSession`` on the same context, a ``RenderJob``) run here too.
+(``_DenoiseJob``), so that an edit made while one is denoised is rendered at once instead of waiting for a
+picture it makes stale (on a CPU that takes a few tenths of a second). While the picture does not show the
+latest edit yet, ``working`` says what the loop is doing and how far along (a scene's load step by step, a
+kernel compiling, the preview, the first pass). Each frame's picture is made on the GPU through the viewport's
+view transform (OpenColorIO's display, view and looks, the display exposure and contrast:
+``RenderSession.display``), with the camera's own exposure added to the transform's exposure, so making it costs the
+CPU no work per pixel; the linear image, for the viewport's pixel readout, comes along a few times a second, and the
+light meter reads it as it comes (the frame's scene-linear luminance inside the sensor's gate,
+``lenslab.optics.exposure.meter_luminance``). In the auto exposure mode that reading sets the picture's exposure
+(``ThinLensCamera.exposure``). Once per change of view it casts one ray per pixel through the same kd-tree to find
+the node and the depth under every pixel: the viewport outlines the selection with the first and shows the plane of
+focus with the second. Click-to-focus picks and exports (a second ``RenderSession`` on the same context, a
+``RenderJob``) run here too.
 
 ``RenderLoop`` is driven by its owner, one call at a time on one thread: ``handle(messages)`` with what the GUI
 sent since the last call, then ``step()`` (one dispatch, while ``busy``). Its state is ``phase``, a ``Phase``.
