@@ -347,3 +347,30 @@ def test_a_preview_held_back_for_the_picture_on_screen_is_shown_when_the_hold_en
         if held is not None:
             held.let_go.set()
         loop.release()
+
+
+@pytest.mark.smoke
+def test_peaking_and_clipping_marks_are_not_drawn_over_a_picture_not_worth_judging(qtbot):
+    """The marks last worked out (the previous picture's edges) wait for the layer's next run; over an edit's
+    preview they would mark where the old picture was sharp."""
+    from types import SimpleNamespace
+
+    from PySide6.QtCore import QRectF
+    from PySide6.QtGui import QColor, QImage, QPainter
+
+    from lenslab.gui.layer_support import MaskLayer
+
+    layer = MaskLayer(SimpleNamespace(), interval_ms=200)
+    layer._overlay = QImage(4, 4, QImage.Format_RGBA8888)
+    layer._overlay.fill(QColor(255, 255, 0))
+
+    def painted(worth_judging: bool) -> QColor:
+        canvas = QImage(4, 4, QImage.Format_RGBA8888)
+        canvas.fill(QColor(0, 0, 0))
+        p = QPainter(canvas)
+        layer.paint(p, SimpleNamespace(worth_judging=worth_judging), QRectF(0, 0, 4, 4))
+        p.end()
+        return canvas.pixelColor(1, 1)
+
+    assert painted(True) == QColor(255, 255, 0)
+    assert painted(False) == QColor(0, 0, 0)

@@ -234,13 +234,16 @@ def test_closing_during_an_export_asks_and_keep_the_window_keeps_both(qtbot, win
 def test_closing_during_an_export_can_wait_for_it_to_be_written(qtbot, window, tmp_path):
     out = tmp_path / "awaited.png"
     wait_for_frame(qtbot, window)  # a window that has settled, as a user's is when they export
-    # Long enough (its clock is the device's, never ahead of the wall's) that the question is answered before the
-    # export ends even on a loaded machine, where the answer may take seconds to come round.
-    start_long_export(qtbot, window, out, seconds=12.0)
+    # An export that does not end by itself, so that the question is surely answered while it runs (with a time
+    # limit, a loaded machine once took longer to answer than the export took to finish).
+    start_long_export(qtbot, window, out, target_spp=1_000_000)
     seen = answer_export_question(window, QMessageBox.Ok)  # Close When Done
+    assert not window.close()  # not yet: the export goes on
+    assert seen and window.isVisible() and window.export_id is not None
     with qtbot.waitSignal(window.closed, timeout=30000):
-        assert not window.close()  # not yet: the export goes on
-        assert seen and window.isVisible() and window.export_id is not None
+        # Now let it end: its job's time is up once every pixel has a sample (a number the render thread reads at
+        # its next step), and the file is written as any export's is.
+        window.controller.worker._loop._export.job.time_limit = 0.0
     assert out.is_file() and not window.isVisible()
 
 

@@ -135,7 +135,9 @@ class MaskLayer(QObject):
     """A layer that draws a picture worked out from the viewport's (a mask painted in colours), worked out again
     at most every ``interval_ms`` after :meth:`changed`, and at once by :meth:`refresh`. Subclasses fill
     ``_overlay`` (a QImage of the picture's size, or None) in :meth:`refresh` and say in :meth:`forget` what
-    they drop when hidden."""
+    they drop when hidden. The marks judge the picture (its sharp edges, its clipped pixels): none is drawn over
+    a picture not worth judging (``viewport.worth_judging``: a preview, a few raw samples), whose own would follow
+    the noise and whose last ones, until the layer works them out again, are another picture's."""
 
     def __init__(self, viewport, interval_ms: int, parent: QObject | None = None):
         super().__init__(parent)
@@ -165,7 +167,7 @@ class MaskLayer(QObject):
         """Drop what was worked out (the layer is hidden)."""
 
     def paint(self, p: QPainter, viewport, image_rect: QRectF) -> None:
-        if self._overlay is not None:
+        if self._overlay is not None and viewport.worth_judging:
             p.drawImage(image_rect, self._overlay)
 
 
