@@ -44,6 +44,26 @@ def run_until(app, done, seconds: float) -> bool:
     return True
 
 
+def time_one_edit(app, window, seen: list, edit, seconds: float) -> tuple[float, str, float, int]:
+    """Make ``edit()`` and wait for its first full-resolution denoised picture: the seconds to its first picture,
+    which kind that was, the seconds to the full-resolution one, and how many raw pictures of it were shown."""
+    seen.clear()
+    edited = time.perf_counter()
+    edit()
+    generation = window.controller.generation
+
+    def pictures() -> list:
+        return [(t, f) for t, f in seen if f.generation >= generation]
+
+    if not run_until(app, lambda: any(not f.preview and f.denoised for _, f in pictures()), seconds):
+        raise SystemExit(f"no full-resolution picture within {seconds:g} s of an edit")
+    shown = pictures()
+    t, first = shown[0]
+    kind = "denoised preview" if first.preview and first.denoised else "denoised" if first.denoised else "raw"
+    full = next(t for t, f in shown if not f.preview and f.denoised)
+    return t - edited, kind, full - edited, sum(1 for _, f in shown if not f.denoised)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scene", default="cornell_box")
@@ -69,31 +89,21 @@ def main() -> None:
     if not run_until(app, settled, 600):
         raise SystemExit("the studio did not settle within 10 minutes")
     w, h = controller.size
+    device = (controller.device or {}).get("renderer", "?")
     print(f"{args.scene}: the window at {window.width()} x {window.height()}, the viewport's picture {w} x {h}; "
-          f"{(controller.device or {}).get('renderer', '?')}; settled {time.perf_counter() - start:.1f} s after opening")
+          f"{device}; settled {time.perf_counter() - start:.1f} s after opening")
     print("| edit | first picture (median) | which | full resolution, denoised (median) | raw pictures shown |")
     print("|---|---:|---|---:|---:|")
     for name, change in EDITS.items():
         firsts, fulls, kinds, raw = [], [], set(), 0
         for _ in range(args.repeat):
-            for undo in (False, True):  # the edit, then its undo: both are edits the photographer waits for
-                seen.clear()
-                edited = time.perf_counter()
-                if undo:
-                    window.doc.undo_stack.undo()
-                else:
-                    window.doc.set_camera(**change(window.doc.scene.camera))
-                generation = controller.generation
-                mine = lambda: [(t, f) for t, f in seen if f.generation >= generation]  # noqa: E731
-                if not run_until(app, lambda: any(not f.preview and f.denoised for _, f in mine()), args.seconds):
-                    raise SystemExit(f"{name}: no full-resolution picture within {args.seconds:g} s")
-                pictures = mine()
-                t, first = pictures[0]
-                firsts.append(t - edited)
-                kinds.add("denoised preview" if first.preview and first.denoised else
-                          "denoised" if first.denoised else "raw")
-                fulls.append(next(t for t, f in pictures if not f.preview and f.denoised) - edited)
-                raw += sum(1 for _, f in pictures if not f.denoised)
+            # The edit, then its undo: both are edits the photographer waits for.
+            for edit in (lambda: window.doc.set_camera(**change(window.doc.scene.camera)), window.doc.undo_stack.undo):
+                first, kind, full, raw_shown = time_one_edit(app, window, seen, edit, args.seconds)
+                firsts.append(first)
+                kinds.add(kind)
+                fulls.append(full)
+                raw += raw_shown
                 run_until(app, lambda: False, 0.5)  # let it sample on a moment, as between two edits
         print(f"  {name}: first pictures at " + ", ".join(f"{t:.2f}" for t in firsts) + " s", file=sys.stderr)
         print(f"| {name} | {statistics.median(firsts):.2f} s ({min(firsts):.2f} to {max(firsts):.2f}) | "

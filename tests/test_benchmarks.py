@@ -113,7 +113,7 @@ def test_edit_to_clean_times_every_edit_and_counts_raw_pictures(renderer, tmp_pa
     assert len(list(tmp_path.glob("edit_reference_*.npy"))) == 3
 
 
-def test_the_convergence_errors_compare_pictures_as_the_camera_exposes_them():
+def test_the_convergence_errors_compare_pictures_as_the_camera_exposes_them(monkeypatch):
     # relMSE's 0.01 and the display MAE assume the picture's scale (middle grey 0.18); a scene lit in nits has
     # radiance in the hundreds, which only the camera's exposure brings there.
     import dataclasses
@@ -122,7 +122,7 @@ def test_the_convergence_errors_compare_pictures_as_the_camera_exposes_them():
 
     from lenslab.scene.io.loader import open_scene
 
-    sys.path.insert(0, str(BENCHMARKS))
+    monkeypatch.syspath_prepend(str(BENCHMARKS))
     from denoise_convergence import camera_exposure_of
 
     scene = open_scene("cornell_box")

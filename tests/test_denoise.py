@@ -236,7 +236,7 @@ def test_cli_denoise_without_the_library_says_so_in_one_line_before_rendering(tm
 
     from lenslab.render import denoise
 
-    monkeypatch.setattr(denoise, "_DENOISER", None)
+    monkeypatch.setattr(denoise, "_SHARED", denoise.Denoiser())  # none made yet
     monkeypatch.setitem(sys.modules, "pyoidn", None)  # as if it were not installed
     out = tmp_path / "shot.png"
     status = main(["cornell_box", "--headless", "-o", str(out), "--spp", "1", "--denoise"])

@@ -239,9 +239,9 @@ LOOP_SIZE = (320, 240)  # large enough for a quarter-resolution preview
 
 
 class FullPassDenoising:
-    """Holds back the denoising of full-resolution pictures (either denoiser: the shared one the previews use,
-    and a Denoiser of one's own) until ``let_go`` is set or ``seconds`` pass; a preview's goes through.
-    ``entered``: one is being held; ``timed_out``: a True for each that waited the whole time."""
+    """Holds back the denoising of full-resolution pictures (on any Denoiser: the shared one the previews use, or
+    one of the loop's own) until ``let_go`` is set or ``seconds`` pass; a preview's goes through. ``entered``:
+    one is being held; ``timed_out``: a True for each that waited the whole time."""
 
     def __init__(self, monkeypatch, seconds: float):
         import threading
@@ -250,17 +250,15 @@ class FullPassDenoising:
 
         self.entered, self.let_go, self.timed_out = threading.Event(), threading.Event(), []
         self.seconds = seconds
-        monkeypatch.setattr(oidn, "denoise", self._held(oidn.denoise))
-        monkeypatch.setattr(oidn.Denoiser, "denoise", self._held(oidn.Denoiser.denoise))
+        real = oidn.Denoiser.denoise
 
-    def _held(self, real):
-        def denoise(*args, **kwargs):
-            color = args[-3] if len(args) >= 3 else args[0]
+        def denoise(denoiser, color, *args, **kwargs):
             if color.shape[:2] == LOOP_SIZE[::-1] and not self.let_go.is_set():
                 self.entered.set()
                 self.timed_out.append(not self.let_go.wait(self.seconds))
-            return real(*args, **kwargs)
-        return denoise
+            return real(denoiser, color, *args, **kwargs)
+
+        monkeypatch.setattr(oidn.Denoiser, "denoise", denoise)
 
 
 class QuietEvents:

@@ -74,6 +74,9 @@ HOLD_SECONDS = 0.15
 # The denoiser runs at most every DENOISE_MIN_INTERVAL seconds, and never more than a third of the time: it waits
 # twice as long as it took the last time before it runs again.
 DENOISE_MIN_INTERVAL = 0.25
+# OIDN's "fast" quality is the one its documentation gives interactive previews: about half the time of "high" on
+# the CPU. Exports that ask for the denoiser take "high" (render/job.py).
+VIEWPORT_DENOISE_QUALITY = "fast"
 GBUFFER_INTERVAL = 0.3  # during a drag, the selection's outline and the depth buffer follow this often
 EXPORT_PROGRESS_INTERVAL = 0.1
 WORK_NOTE_INTERVAL = 0.1  # seconds between notes on the first pass's progress
@@ -339,7 +342,7 @@ def _denoise_into(denoiser, base: np.ndarray, rect: tuple[int, int, int, int], i
     inside it (on the denoising thread: numpy arrays only, no GL)."""
     x, y, w, h = rect
     base[y:y + h, x:x + w] = denoiser.denoise(image[y:y + h, x:x + w], albedo[y:y + h, x:x + w],
-                                              normal[y:y + h, x:x + w], quality="fast")
+                                              normal[y:y + h, x:x + w], quality=VIEWPORT_DENOISE_QUALITY)
     return base
 
 
@@ -391,7 +394,7 @@ class RenderLoop:
         self._margin: float | None = None
         self._region: tuple[int, int, int, int] | None = None
         self._denoise = False
-        self._denoised: tuple | None = None  # (generation, spp, picture, linear): the last denoised frame
+        self._denoised: tuple | None = None  # (generation, spp, picture, view, linear): the last denoised frame
         self._denoise_ready_at = 0.0
         # The full-resolution pictures' denoiser and its thread, made on first use, and the picture it is on.
         self._picture_denoiser = None  # lenslab.render.denoise.Denoiser
@@ -438,9 +441,13 @@ class RenderLoop:
         return self._export is not None or self._rendering or self._denoise_job is not None
 
     @property
+    def _renderable(self) -> bool:
+        """A session whose scene and camera can be rendered (neither failed)."""
+        return self._session is not None and self._scene_ok and self._camera_ok
+
+    @property
     def _rendering(self) -> bool:
-        return (not self._paused and self._session is not None and self._scene_ok and self._camera_ok
-                and self._phase in (Phase.PREVIEW, Phase.FULL))
+        return not self._paused and self._renderable and self._phase in (Phase.PREVIEW, Phase.FULL)
 
     # -- the frame hand-off (any thread) -----------------------------------------------------------------------
     def take_frame(self) -> Frame | None:
@@ -455,7 +462,8 @@ class RenderLoop:
         self._events.device_ready(self._renderer.describe())
 
     def step(self) -> None:
-        """One bounded dispatch of the export, or else of the viewport's render if it is short of its target."""
+        """One bounded dispatch of the export, or else of the viewport's render if it is short of its target, or
+        else a dispatch's wait for the picture being denoised; and a picture held back shown once its hold ends."""
         self._show_held_picture()
         if self._export is not None:
             self._export_step()
@@ -612,7 +620,7 @@ class RenderLoop:
 
     def apply_region(self, edit: RegionEdit) -> None:
         self._region = edit.region
-        if self._session is not None and self._scene_ok and self._camera_ok:
+        if self._renderable:
             self._restart(edit.generation, view_changed=False)
 
     def apply_denoise(self, edit: DenoiseEdit) -> None:
@@ -641,8 +649,7 @@ class RenderLoop:
 
     def republish(self, with_linear: bool) -> None:
         """Publish the full-size picture as it stands again, if there is one."""
-        if self._session is not None and self._scene_ok and self._camera_ok \
-                and self._phase in (Phase.FULL, Phase.DONE) and self._published_spp >= 0:
+        if self._renderable and self._phase in (Phase.FULL, Phase.DONE) and self._published_spp >= 0:
             self._publish_session(converged=self._phase is Phase.DONE, with_linear=with_linear)
 
     def _resize(self, width: int, height: int, region=None) -> None:
@@ -869,9 +876,7 @@ class RenderLoop:
     def _denoise_image(self, image: np.ndarray, albedo: np.ndarray, normal: np.ndarray) -> np.ndarray:
         from lenslab.render.denoise import denoise
 
-        # OIDN's "fast" quality is the one its documentation gives interactive previews: about half the time of
-        # "high" on the CPU. Exports that ask for the denoiser take "high" (render/job.py).
-        return denoise(image, albedo, normal, quality="fast")
+        return denoise(image, albedo, normal, quality=VIEWPORT_DENOISE_QUALITY)
 
     def _denoised_frame(self, converged: bool) -> tuple[np.ndarray, np.ndarray] | None:
         """The picture and linear image of this edit through the denoiser (the render region's pixels over the
@@ -936,8 +941,7 @@ class RenderLoop:
         wait_for_futures([self._denoise_job.image], timeout=self.dispatch_seconds)
         if not self._denoise_job.image.done():
             return
-        if self._session is not None and self._scene_ok and self._camera_ok \
-                and self._phase in (Phase.FULL, Phase.DONE) and self._denoise:
+        if self._renderable and self._phase in (Phase.FULL, Phase.DONE) and self._denoise:
             self._publish_session(converged=self._phase is Phase.DONE)
         else:
             self._collect_denoised()
@@ -1021,7 +1025,7 @@ class RenderLoop:
 
     def pick(self, request: PickRequest) -> None:
         session = self._session
-        if session is None or not (self._scene_ok and self._camera_ok):
+        if not self._renderable:
             self._events.pick_ready(PickResult(request.request_id, self._generation, False))
             return
         pick = session.pick(request.u * session.width, request.v * session.height)

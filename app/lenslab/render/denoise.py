@@ -13,8 +13,9 @@ OIDN's "RT" filter on them. Two ways, as OIDN's documentation advises:
 Making an OIDN device loads its library and kernels, so one device serves every call, and a preview's filter and
 buffers are kept for the next call of the same size and options: the viewport, which denoises the same size again
 and again, only copies pixels in and out and runs the network. A final frame frees its filters as it goes (their
-scratch memory is large: see MAX_MEMORY_MB). Calls are serialised (one lock). A thread that must denoise beside
-the others, not after them, keeps a :class:`Denoiser` of its own: its own device, buffers and lock.
+scratch memory is large: see MAX_MEMORY_MB). Calls are serialised (the shared :class:`Denoiser`'s lock). A
+thread that must denoise beside the others, not after them, keeps a Denoiser of its own: its own device, buffers
+and lock.
 
 The device is OIDN's default: a GPU that OIDN supports and whose driver it finds (CUDA, HIP, SYCL), else the
 CPU. ``LENSLAB_DENOISE_DEVICE`` (cpu, cuda, hip, sycl, metal) forces one.
@@ -53,30 +54,31 @@ def denoise(color: np.ndarray, albedo: np.ndarray | None = None, normal: np.ndar
     (H, W, 3). A normal needs an albedo (OIDN has no filter for a normal alone). ``prefilter``: denoise the
     guides first and trust them (OIDN's cleanAux), for final frames. Raises ValueError for input it cannot take
     and DenoiseError where denoising cannot run."""
-    images = _checked_images(color, albedo, normal, quality)
-    with _LOCK:
-        return _shared_denoiser().run(images, prefilter, quality)
+    return _SHARED.denoise(color, albedo, normal, prefilter=prefilter, quality=quality)
 
 
 class Denoiser:
-    """A denoiser of one's own: an OIDN device, its buffers and its filter, shared with no other caller and made
-    on first use. Calls on one Denoiser are serialised; calls on two run at once. For a thread that denoises
-    beside the others (the studio's full-resolution pictures, off the render thread that denoises its previews
-    with :func:`denoise`). Its owner releases it; one still held at exit is released then."""
+    """A denoiser: an OIDN device, its buffers and its filter, made on first use. Calls on one Denoiser are
+    serialised; calls on two run at once. :func:`denoise` uses the one the process shares; a thread that denoises
+    beside the others (the studio's full-resolution pictures, off the render thread that denoises its previews)
+    keeps one of its own. Its owner releases it; one still held at exit is released then."""
 
     def __init__(self):
         self._lock = threading.Lock()
         self._impl: _Denoiser | None = None
-        _OWN_DENOISERS.add(self)
+        _DENOISERS.add(self)
 
     def denoise(self, color: np.ndarray, albedo: np.ndarray | None = None, normal: np.ndarray | None = None, *,
                 prefilter: bool = False, quality: str = "high") -> np.ndarray:
         """As :func:`denoise`, on this denoiser's device."""
         images = _checked_images(color, albedo, normal, quality)
         with self._lock:
-            if self._impl is None:
-                self._impl = _Denoiser(_device_kind())
-            return self._impl.run(images, prefilter, quality)
+            return self._device().run(images, prefilter, quality)
+
+    @property
+    def description(self) -> str:
+        with self._lock:
+            return self._device().description
 
     def release(self) -> None:
         with self._lock:
@@ -84,11 +86,15 @@ class Denoiser:
                 self._impl.release()
                 self._impl = None
 
+    def _device(self) -> _Denoiser:
+        if self._impl is None:
+            self._impl = _Denoiser(os.environ.get(DEVICE_ENV, "default").strip().lower() or "default")
+        return self._impl
+
 
 def describe() -> str:
     """The library and the device that denoises, e.g. "Intel Open Image Denoise 2.5.1 on CPU (2 threads)"."""
-    with _LOCK:
-        return _shared_denoiser().description
+    return _SHARED.description
 
 
 def _checked_images(color, albedo, normal, quality: str) -> dict[str, np.ndarray]:
@@ -218,29 +224,12 @@ class _Denoiser:
         self.device.release()
 
 
-_LOCK = threading.Lock()
-_DENOISER: _Denoiser | None = None
-_OWN_DENOISERS: weakref.WeakSet = weakref.WeakSet()  # every Denoiser not yet collected
-
-
-def _device_kind() -> str:
-    return os.environ.get(DEVICE_ENV, "default").strip().lower() or "default"
-
-
-def _shared_denoiser() -> _Denoiser:
-    global _DENOISER
-    if _DENOISER is None:
-        _DENOISER = _Denoiser(_device_kind())
-    return _DENOISER
+_DENOISERS: weakref.WeakSet = weakref.WeakSet()  # every Denoiser not yet collected
+_SHARED = Denoiser()  # denoise()'s
 
 
 @atexit.register
 def _release_at_exit() -> None:
-    """Release the device before the interpreter unloads the library under it."""
-    global _DENOISER
-    for own in list(_OWN_DENOISERS):
-        own.release()
-    with _LOCK:
-        if _DENOISER is not None:
-            _DENOISER.release()
-            _DENOISER = None
+    """Release the devices before the interpreter unloads the library under them."""
+    for denoiser in list(_DENOISERS):
+        denoiser.release()
